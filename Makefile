@@ -1,0 +1,29 @@
+# shellform: `make demo` runs the main job, `make test` the test suite.
+# Both create .venv with a Python >= 3.12 and install the project on first use.
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+OUT    ?= results/square_plate
+NPROC  ?= 2
+
+.PHONY: demo test venv clean bench docs
+
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml scripts/find-python.sh
+	@py=$$(scripts/find-python.sh) || exit 1; \
+	 echo "shellform: using $$py"; \
+	 [ -x $(PY) ] || $$py -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[wheel,test]'
+	$(PY) -c "import shellform; shellform.check_install()"
+	@touch $(STAMP)
+
+demo: $(STAMP)
+	$(VENV)/bin/shellform study plate --out $(OUT)
+
+test: $(STAMP)
+	$(PY) -m pytest -q tests
+
+clean:
+	rm -rf $(VENV) results

@@ -1,0 +1,48 @@
+"""pi_g = pi_m + pi_a - pi_b for the effects a scene switches on (paper eq. 5).
+
+Effects and the terms they add:
+- ``bending``           bending energy, curvature constraint, string-net boundary terms
+- ``membrane``          membrane energy, membrane-strain constraint
+- ``shallow_curvature`` the 1/R terms of f^p and f^b (needs bending and membrane)
+- ``pressure``          work of a uniform pressure (needs bending)
+"""
+
+import ufl
+
+from forms import assumed_strain, bending, loads, membrane, string_net
+from forms.fields import HybridFields, ShellParameters
+
+EFFECTS = ("bending", "membrane", "shallow_curvature")
+
+
+def strain_energy(f: HybridFields, p: ShellParameters, effects) -> ufl.Form | None:
+    """pi_m without the loads: the energy of the assumed strains."""
+    terms = []
+    if "membrane" in effects:
+        terms.append(membrane.energy(f.eps_p, p))
+    if "bending" in effects:
+        terms.append(bending.energy(f.eps_b, p))
+    return sum(terms[1:], terms[0])
+
+
+def constraints(f: HybridFields, p: ShellParameters, effects, n) -> ufl.Form:
+    """pi_a - pi_b: multipliers times (strain of the displacements - assumed strain)."""
+    kappa0 = p.kappa0 if "shallow_curvature" in effects else None
+    terms = []
+    if "membrane" in effects:
+        terms.append(assumed_strain.membrane_constraint(f.N, f.eps_p, f.u, f.w, kappa0))
+    if "bending" in effects:
+        terms.append(assumed_strain.bending_constraint(f.M, f.eps_b, f.u, kappa0))
+        terms.append(string_net.bending_boundary(f.M, f.w, f.g, n))
+    return sum(terms[1:], terms[0])
+
+
+def external_work(f: HybridFields, p: ShellParameters, effects) -> ufl.Form | None:
+    if p.pressure is None or f.w is None:
+        return None
+    return loads.pressure_work(f.w, p.pressure)
+
+
+def hybrid_functional(f: HybridFields, p: ShellParameters, effects, n) -> ufl.Form:
+    """pi_g without the external work (which shellform assembles as the load vector)."""
+    return strain_energy(f, p, effects) + constraints(f, p, effects, n)

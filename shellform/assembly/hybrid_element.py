@@ -1,0 +1,130 @@
+"""The reference element of the hybrid functional and the carrier that holds the unknowns.
+
+Carrier: a blocked P1 space on the mesh, one block per vertex with the physical nodal values,
+
+    membrane + bending: (u, v, w, w_x, w_y)      bending only: (w, w_x, w_y)
+
+DOLFINx owns its dofmap, ghosts, boundary conditions and output unchanged.
+
+Reference element (one triangle, fields of forms.fields.HybridFields), a basix mixed element:
+
+    nodal (q):   u  P1 vector       [membrane]
+                 w  reduced cubic   [bending]
+                 g  P1 vector       [bending]  the string-net normal slope carrier
+    local:       eps_p, eps_b       assumed strains (DG1 symmetric tensors)
+                 N, M               their multipliers (same spaces, same order)
+
+The map carrier -> q is linear with per-cell coefficients (identity or entries of J), at most
+two nonzeros per reference row; it is tabulated here as index tables for shellform.assembly.slope_map.
+"""
+
+from dataclasses import dataclass, field
+
+import basix.ufl
+import numpy as np
+
+from shellform.elements import reduced_cubic
+
+GROUPS = ("membrane", "bending")  # order of the element-local fields
+STRAIN_COMPONENTS = ("xx", "yy", "xy")
+
+
+@dataclass
+class HybridElement:
+    effects: tuple[str, ...]
+    carrier_components: tuple[str, ...] = field(init=False)
+    mixed: basix.ufl._ElementBase = field(init=False)
+    sub_names: tuple[str, ...] = field(init=False)
+    offsets: dict[str, slice] = field(init=False)
+
+    def __post_init__(self):
+        from forms.functional import EFFECTS
+
+        self.effects = tuple(e for e in EFFECTS if e in self.effects)  # canonical order
+        has_m, has_b = "membrane" in self.effects, "bending" in self.effects
+        if not (has_m or has_b):
+            raise ValueError("a hybrid element needs the membrane or the bending effect")
+        cell = "triangle"
+        p1v = basix.ufl.element("Lagrange", cell, 1, shape=(2,))
+        sym = basix.ufl.element("DG", cell, 1, shape=(2, 2), symmetry=True)
+        subs: list[tuple[str, basix.ufl._ElementBase]] = []
+        comps: list[str] = []
+        if has_m:
+            subs.append(("u", p1v))
+            comps += ["u", "v"]
+        if has_b:
+            subs += [("w", reduced_cubic.element()), ("g", p1v)]
+            comps += ["w", "w_x", "w_y"]
+        self.groups = tuple(gr for gr in GROUPS if gr in self.effects)
+        strain_name = {"membrane": "eps_p", "bending": "eps_b"}
+        mult_name = {"membrane": "N", "bending": "M"}
+        subs += [(strain_name[gr], sym) for gr in self.groups]
+        subs += [(mult_name[gr], sym) for gr in self.groups]
+        self.carrier_components = tuple(comps)
+        self.sub_names = tuple(n for n, _ in subs)
+        self.mixed = basix.ufl.mixed_element([e for _, e in subs])
+        self.offsets, start = {}, 0
+        for name, e in subs:
+            self.offsets[name] = slice(start, start + e.dim)
+            start += e.dim
+        nodal = [n for n in ("u", "w", "g") if n in self.offsets]
+        self.q = np.concatenate([np.arange(self.offsets[n].start, self.offsets[n].stop) for n in nodal])
+        self.eps = np.concatenate([self._range(strain_name[gr]) for gr in self.groups])
+        self.lam = np.concatenate([self._range(mult_name[gr]) for gr in self.groups])
+        self.sym_dim = sym.dim
+
+    def _range(self, name):
+        s = self.offsets[name]
+        return np.arange(s.start, s.stop)
+
+    @property
+    def block_size(self) -> int:
+        return len(self.carrier_components)
+
+    @property
+    def dim(self) -> int:
+        return self.mixed.dim
+
+    @property
+    def carrier_dim(self) -> int:
+        return 3 * self.block_size
+
+    def component(self, name: str) -> int:
+        return self.carrier_components.index(name)
+
+    def slope_map_tables(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per reference row of q: up to two (carrier column, coefficient code) pairs.
+
+        Coefficient codes: 0 -> none, 1 -> 1.0, 2 + 2a + b -> J[a, b] (a, b in {0, 1}), where
+        J[a, b] = dx_a/dX_b. Reference slope dw/dX_i = sum_j J[j, i] dw/dx_j (slopes = J^T grad).
+        """
+        nq, bs = len(self.q), self.block_size
+        cols = -np.ones((nq, 2), dtype=np.int32)
+        codes = np.zeros((nq, 2), dtype=np.int32)
+        row = {r: k for k, r in enumerate(self.q)}
+        for v in range(3):
+            if "u" in self.offsets:
+                for i in range(2):  # blocked P1: node-major, component-minor
+                    r = row[self.offsets["u"].start + 2 * v + i]
+                    cols[r, 0], codes[r, 0] = bs * v + self.component("u") + i, 1
+            if "w" in self.offsets:
+                r = row[self.offsets["w"].start + 3 * v]
+                cols[r, 0], codes[r, 0] = bs * v + self.component("w"), 1
+                for i in range(2):
+                    r = row[self.offsets["w"].start + 3 * v + 1 + i]
+                    for j in range(2):
+                        cols[r, j], codes[r, j] = bs * v + self.component("w_x") + j, 2 + 2 * j + i
+                    r = row[self.offsets["g"].start + 2 * v + i]
+                    cols[r, 0], codes[r, 0] = bs * v + self.component("w_x") + i, 1
+        return cols, codes
+
+    def centroid_average(self) -> np.ndarray:
+        """(3, sym_dim): centroid value (xx, yy, xy) of a DG1 symmetric tensor from its dofs.
+
+        basix.ufl blocks a symmetric 2x2 tensor as (xx, xy, yy), node-major; the Lagrange DG1
+        value at the centroid is the mean of the three nodal values.
+        """
+        avg = np.zeros((3, self.sym_dim))
+        for out, comp in enumerate((0, 2, 1)):  # xx, yy, xy
+            avg[out, comp::3] = 1.0 / 3.0
+        return avg

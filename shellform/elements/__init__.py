@@ -1,0 +1,1 @@
+"""Finite elements, one per module, each declared by a few attributes."""

@@ -1,0 +1,9 @@
+"""Errors shellform raises for bad input. Each names the offending field."""
+
+
+class InputError(ValueError):
+    """A scene or argument is invalid; raised before any computation starts."""
+
+    def __init__(self, field: str, message: str):
+        self.field = field
+        super().__init__(f"{field}: {message}")

@@ -1,0 +1,129 @@
+"""Linear static analysis of a scene: scene -> mesh -> forms -> assembly -> solve -> result.
+
+One solve of K q = f with the condensed, mapped hybrid element. Timings are split into
+compile (FFCx + numba), assembly and solve, as the accuracy-against-time studies report them.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import dolfinx.fem.petsc as fem_petsc
+import numpy as np
+from dolfinx import fem, la
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from forms.fields import ShellParameters
+from shellform import loads, supports
+from shellform.assembly.hybrid_element import HybridElement
+from shellform.assembly.kernels import HybridShellForms
+from shellform.mesh import rectangle
+from shellform.scene import Scene
+
+
+@dataclass
+class LinearResult:
+    scene: Scene
+    forms: HybridShellForms
+    q: fem.Function  # carrier solution: per vertex the active components
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def components(self) -> tuple[str, ...]:
+        return self.forms.element.carrier_components
+
+    @property
+    def num_cells(self) -> int:
+        return self.forms.mesh.topology.index_map(2).size_global
+
+    @property
+    def num_dofs(self) -> int:
+        V = self.forms.V
+        return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+
+    def value(self, name: str, x: float = 0.0, y: float = 0.0) -> float:
+        """A nodal value (e.g. 'w') at the vertex (x, y)."""
+        tol = 1e-9 * max(self.scene.geometry.lx, self.scene.geometry.ly)
+        return loads.value_at(self.q, self.components, name, x, y, tol)
+
+    def cell_fields(self) -> dict[str, fem.Function]:
+        """Centroid values of the assumed strains and stress resultants, as DG0 functions.
+
+        membrane_strain, membrane_force, curvature, moment: components (xx, yy, xy), tensor
+        off-diagonal (curvature xy = -w,xy; engineering twist = 2 x it).
+        """
+        e = self.forms.element
+        mesh = self.forms.mesh
+        W = fem.functionspace(mesh, ("DG", 0, (6 * len(e.groups),)))
+        vec = fem.assemble_vector(self.forms.recovery_form(self.q, W))
+        vec.scatter_reverse(la.InsertMode.add)
+        values = vec.array.reshape(-1, 6 * len(e.groups))
+        names = {"membrane": ("membrane_strain", "membrane_force"), "bending": ("curvature", "moment")}
+        out = {}
+        V3 = fem.functionspace(mesh, ("DG", 0, (3,)))
+        for g, group in enumerate(e.groups):
+            for k, name in enumerate(names[group]):
+                f = fem.Function(V3, name=name)
+                n = V3.dofmap.index_map.size_local
+                f.x.array[: 3 * n] = values[:n, 6 * g + 3 * k : 6 * g + 3 * k + 3].ravel()
+                f.x.scatter_forward()
+                out[name] = f
+        return out
+
+
+def parameters(mesh, scene: Scene) -> ShellParameters:
+    c = lambda v: fem.Constant(mesh, np.float64(v))  # noqa: E731
+    m = scene.material
+    kappa0 = None
+    if "shallow_curvature" in scene.effects:
+        kappa0 = fem.Constant(mesh, np.diag(scene.kappa0).astype(np.float64))
+    pressure = c(scene.loads.pressure) if "bending" in scene.effects else None
+    return ShellParameters(E=c(m.E), nu=c(m.nu), thickness=c(m.thickness), kappa0=kappa0, pressure=pressure)
+
+
+def mesh(scene: Scene, comm=MPI.COMM_WORLD):
+    g, m = scene.geometry, scene.mesh
+    points = [(p.x, p.y) for p in scene.loads.point]
+    return rectangle(comm, g.lx, g.ly, region=g.region, kind=m.kind, n=m.n, diagonal=m.diagonal, points=points)
+
+
+def compile_forms(scene: Scene, msh) -> HybridShellForms:
+    element = HybridElement(tuple(scene.effects))
+    return HybridShellForms(msh, element, parameters(msh, scene), mapped=scene.solver.mapped)
+
+
+def solve(scene: Scene, comm=MPI.COMM_WORLD) -> LinearResult:
+    t = time.perf_counter()
+    rect = mesh(scene, comm)
+    t0 = time.perf_counter()
+    forms = compile_forms(scene, rect.mesh)
+    t1 = time.perf_counter()
+    V, comps = forms.V, forms.element.carrier_components
+    bcs = supports.boundary_conditions(V, comps, rect.facet_tags, vars(scene.supports))
+    A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
+    A.assemble()
+    b = fem_petsc.assemble_vector(forms.load) if forms.load is not None else fem_petsc.create_vector(V)
+    tol = 1e-9 * max(scene.geometry.lx, scene.geometry.ly)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    loads.add_point_loads(b, V, comps, scene.loads.point, tol)
+    fem_petsc.apply_lifting(b, [forms.stiffness], bcs=[bcs])
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    fem_petsc.set_bc(b, bcs)
+    t2 = time.perf_counter()
+    q = fem.Function(V, name="carrier")
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    ksp.solve(b, q.x.petsc_vec)
+    if ksp.getConvergedReason() < 0:
+        raise RuntimeError(f"linear solve failed (PETSc reason {ksp.getConvergedReason()})")
+    q.x.scatter_forward()
+    ksp.destroy(), A.destroy(), b.destroy()
+    t3 = time.perf_counter()
+    if not np.all(np.isfinite(q.x.array)):
+        raise FloatingPointError("the solution has non-finite values: is the structure supported?")
+    timings = {"mesh_s": t0 - t, "compile_s": t1 - t0, "assemble_s": t2 - t1, "solve_s": t3 - t2,
+               "total_s": t3 - t}
+    return LinearResult(scene, forms, q, timings)
