@@ -84,7 +84,8 @@ def parameters(mesh, scene: Scene) -> ShellParameters:
 def mesh(scene: Scene, comm=MPI.COMM_WORLD):
     g, m = scene.geometry, scene.mesh
     points = [(p.x, p.y) for p in scene.loads.point]
-    return rectangle(comm, g.lx, g.ly, region=g.region, kind=m.kind, n=m.n, diagonal=m.diagonal, points=points)
+    return rectangle(comm, g.lx, g.ly, region=g.region, kind=m.kind, n=m.n, diagonal=m.diagonal, points=points,
+                     refine=m.refine)
 
 
 def compile_forms(scene: Scene, msh) -> HybridShellForms:

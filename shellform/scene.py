@@ -39,6 +39,7 @@ class MeshSpec:
     kind: str = "structured"
     n: int = 8  # elements along x of the region (structured: n x n x 2 triangles)
     diagonal: str = "right"
+    refine: int = 0  # uniform refinements of that mesh (nested meshes for convergence studies)
 
 
 @dataclass
@@ -200,6 +201,7 @@ def validate(s: Scene) -> None:
                      "a curved reference surface needs the effect 'shallow_curvature'")
     _require(m.kind in MESH_KINDS, "mesh.kind", f"must be one of {MESH_KINDS}, got {m.kind!r}")
     _require(m.n >= 1, "mesh.n", f"must be >= 1, got {m.n}")
+    _require(m.refine >= 0, "mesh.refine", f"must be >= 0, got {m.refine}")
     _require(m.diagonal in DIAGONALS, "mesh.diagonal", f"must be one of {DIAGONALS}, got {m.diagonal!r}")
     _require(math.isfinite(mat.E) and mat.E > 0, "material.E", f"must be > 0, got {mat.E}")
     _require(-1.0 < mat.nu < 0.5, "material.nu", f"must lie in (-1, 0.5), got {mat.nu}")

@@ -133,6 +133,8 @@ class ElementKernels:
         cell, facet = self._a.cell, self._a.facet
         gather, nconst, nz = self._a.gather(self._layout), self._nconst, self.element.dim
         ffi = _ffi
+        nfacets = 3 if facet is not None else 0  # membrane alone has no string-net terms
+        facet = facet if facet is not None else cell  # typed placeholder, never called
 
         @numba.njit
         def tabulate(c_, coords_, perm):
@@ -145,7 +147,7 @@ class ElementKernels:
             local = np.zeros(1, dtype=np.int32)
             cell(ffi.from_buffer(Az), ffi.from_buffer(wz), ffi.from_buffer(ck), coords_,
                  ffi.from_buffer(local), perm, empty_void_pointer())
-            for f in range(3):  # the element's own boundary: the string-net integrals
+            for f in range(nfacets):  # the element's own boundary: the string-net integrals
                 local[0] = f
                 facet(ffi.from_buffer(Az), ffi.from_buffer(wz), ffi.from_buffer(ck), coords_,
                       ffi.from_buffer(local), perm, empty_void_pointer())
