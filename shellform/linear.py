@@ -103,12 +103,15 @@ def solve(scene: Scene, comm=MPI.COMM_WORLD) -> LinearResult:
     bcs = supports.boundary_conditions(V, comps, rect.facet_tags, vars(scene.supports))
     A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
     A.assemble()
-    b = fem_petsc.assemble_vector(forms.load) if forms.load is not None else fem_petsc.create_vector(V)
-    tol = 1e-9 * max(scene.geometry.lx, scene.geometry.ly)
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    loads.add_point_loads(b, V, comps, scene.loads.point, tol)
+    if forms.load is not None:
+        b = fem_petsc.assemble_vector(forms.load)
+    else:
+        b = fem_petsc.create_vector(V)
+        b.set(0.0)
     fem_petsc.apply_lifting(b, [forms.stiffness], bcs=[bcs])
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)  # owned entries final
+    tol = 1e-9 * max(scene.geometry.lx, scene.geometry.ly)
+    loads.add_point_loads(b, V, comps, scene.loads.point, tol)  # owned vertices only
     fem_petsc.set_bc(b, bcs)
     t2 = time.perf_counter()
     q = fem.Function(V, name="carrier")

@@ -21,12 +21,14 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import IntegralType, form_cpp_class
+from dolfinx.mesh import CellType
 from dolfinx.jit import ffcx_jit
 
 from forms import functional
 from forms.fields import HybridFields, ShellParameters
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.hybrid_element import HybridElement
+from shellform.errors import InputError
 
 try:  # the module moves in FFCx 0.12
     from ffcx.codegeneration.utils import empty_void_pointer, numba_ufcx_kernel_signature
@@ -232,10 +234,21 @@ class ElementKernels:
         return kernel
 
 
+def check_mesh(mesh) -> None:
+    """The element needs a 2D mesh of affine triangles (the blank plane)."""
+    cell = mesh.topology.cell_type
+    if mesh.topology.dim != 2 or cell != CellType.triangle:
+        raise InputError("mesh", f"shellform needs a 2D mesh of triangles, got {cell.name} cells "
+                         f"of dimension {mesh.topology.dim}")
+    if mesh.geometry.cmaps[0].degree != 1:
+        raise InputError("mesh", f"shellform needs affine (degree 1) triangles, got degree {mesh.geometry.cmaps[0].degree}")
+
+
 class HybridShellForms:
     """Stiffness, load and recovery forms of the hybrid shell element on one mesh."""
 
     def __init__(self, mesh, element: HybridElement, params: ShellParameters, mapped: bool = True):
+        check_mesh(mesh)
         self.mesh, self.element, self.params, self.mapped = mesh, element, params, mapped
         self.kernels = ElementKernels.get(element, params, mapped, mesh.comm)
         self.constants = [getattr(params, name) for name in self.kernels.constant_names]

@@ -15,18 +15,20 @@ from shellform.studies.common import observed_rates, plot_error_time, say, write
 REFERENCE = {"simply_supported": 0.00406235, "clamped": 0.00126532}
 NU = 0.3
 THICKNESS = (12 * (1 - NU**2)) ** (1 / 3)  # D = E t^3 / (12 (1 - nu^2)) = 1 with E = 1
-LEVELS = (3, 6, 12, 24, 48, 70)  # elements along a quarter side; 70 -> 9800 structured cells
-QUICK_LEVELS = (3, 6, 12)
+BASE_N = 4  # elements along a quarter side of the coarsest mesh
+LEVELS = (0, 1, 2, 3, 4)  # uniform refinements of it: nested meshes, 32 ... 8192 structured cells
+QUICK_LEVELS = (0, 1, 2)
 COLUMNS = ["support", "mesh", "element", "cells", "dofs", "w_center", "rel_error", "abs_error_coeff",
            "rate", "compile_s", "assemble_s", "solve_s", "total_s"]
 
 
-def scene(support="simply_supported", kind="structured", n=6, diagonal="right", mapped=True) -> Scene:
+def scene(support="simply_supported", kind="structured", n=6, diagonal="right", mapped=True,
+          refine=0) -> Scene:
     return from_dict({
-        "title": f"square plate, {support}, {kind} n={n}",
+        "title": f"square plate, {support}, {kind} n={n}, refined {refine}x",
         "effects": ["bending"],
         "geometry": {"lx": 1.0, "ly": 1.0, "region": "quarter"},
-        "mesh": {"kind": kind, "n": n, "diagonal": diagonal},
+        "mesh": {"kind": kind, "n": n, "diagonal": diagonal, "refine": refine},
         "material": {"E": 1.0, "nu": NU, "thickness": THICKNESS},
         "supports": {"left": "symmetry", "bottom": "symmetry", "right": support, "top": support},
         "loads": {"pressure": 1.0},
@@ -34,8 +36,8 @@ def scene(support="simply_supported", kind="structured", n=6, diagonal="right", 
     })
 
 
-def solve_row(support, kind, n, diagonal="right", mapped=True) -> dict:
-    res = linear.solve(scene(support, kind, n, diagonal, mapped))
+def solve_row(support, kind, n, diagonal="right", mapped=True, refine=0) -> dict:
+    res = linear.solve(scene(support, kind, n, diagonal, mapped, refine))
     w = res.value("w", 0.0, 0.0)
     ref = REFERENCE[support]
     mesh = kind if kind == "unstructured" else f"structured-{diagonal}"
@@ -56,8 +58,8 @@ def run(outdir: Path, supports=("simply_supported", "clamped"), kinds=("structur
         f"{'rel_error':>10s} {'rate':>5s} {'total_s':>7s}")
     for support, kind, mapped in variants:
         part = []
-        for n in levels:
-            part.append(solve_row(support, kind, n, mapped=mapped))
+        for k in levels:
+            part.append(solve_row(support, kind, BASE_N, mapped=mapped, refine=k))
             part[-1]["rate"] = observed_rates(part)[-1]
             r = part[-1]
             say(f"{r['support']:17s} {r['mesh']:18s} {r['element']:8s} {r['cells']:6d} {r['w_center']:12.8f} "

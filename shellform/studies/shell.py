@@ -21,9 +21,10 @@ from shellform.studies.common import observed_rates, plot_error_time, say, write
 A, T, NU, E = 1.0, 0.01, 0.3, 1.0
 D = E * T**3 / (12 * (1 - NU**2))
 PLATE = 0.00406235
-LEVELS = (3, 6, 12, 24, 48)
-QUICK_LEVELS = (3, 6, 12)
-OVERKILL = 96
+BASE_N = 3  # elements along a quarter side of the coarsest mesh
+LEVELS = (0, 1, 2, 3, 4)  # uniform refinements: nested meshes
+QUICK_LEVELS = (0, 1, 2)
+OVERKILL = 96  # structured quarter, 96 x 96 x 2
 RADII = (2.0, 5.0, 10.0, 100.0, 1e3, 1e4, math.inf)
 COLUMNS = ["R", "mesh", "cells", "dofs", "coefficient", "navier", "rel_error", "rate", "compile_s",
            "assemble_s", "solve_s", "total_s"]
@@ -40,13 +41,13 @@ def navier_coefficient(R: float, terms: int = 2000) -> float:
     return float(w * D / A**4)
 
 
-def scene(R=5.0, n=12, kind="structured") -> Scene:
+def scene(R=5.0, n=12, kind="structured", refine=0) -> Scene:
     return from_dict({
-        "title": f"shallow shell block R={R}, {kind} n={n}",
+        "title": f"shallow shell block R={R}, {kind} n={n}, refined {refine}x",
         "effects": ["bending", "membrane", "shallow_curvature"],
         "geometry": {"lx": A, "ly": A, "region": "quarter"},
         "surface": {"R1": R, "R2": R},
-        "mesh": {"kind": kind, "n": n},
+        "mesh": {"kind": kind, "n": n, "refine": refine},
         "material": {"E": E, "nu": NU, "thickness": T},
         "supports": {"left": "symmetry", "bottom": "symmetry",
                      "right": "simply_supported", "top": "simply_supported"},
@@ -54,8 +55,8 @@ def scene(R=5.0, n=12, kind="structured") -> Scene:
     })
 
 
-def coefficient(R, n, kind="structured") -> dict:
-    res = linear.solve(scene(R, n, kind))
+def coefficient(R, n, kind="structured", refine=0) -> dict:
+    res = linear.solve(scene(R, n, kind, refine))
     c = res.value("w") * D / A**4
     return {"R": R, "mesh": kind, "n": n, "cells": res.num_cells, "dofs": res.num_dofs,
             "coefficient": c, **res.timings}
@@ -71,8 +72,8 @@ def run(outdir: Path, R=5.0, levels=LEVELS, overkill=OVERKILL, radii=RADII) -> l
     rows, series = [], {}
     for kind in ("structured", "unstructured"):
         part = []
-        for n in levels:
-            r = coefficient(R, n, kind)
+        for k in levels:
+            r = coefficient(R, BASE_N, kind, refine=k)
             r["rel_error"] = (r["coefficient"] - ref) / ref
             part.append(r)
             r["rate"] = observed_rates(part)[-1]
@@ -80,7 +81,7 @@ def run(outdir: Path, R=5.0, levels=LEVELS, overkill=OVERKILL, radii=RADII) -> l
                 f"rel_error {r['rel_error']:9.2e} rate {r['rate']:5.2f} {r['total_s']:.2f} s")
         rows += part
         series[f"R = {R}, {kind}"] = part
-    n_limit = levels[-1]
+    n_limit = BASE_N * 2 ** levels[-1]
     for radius in radii:
         r = coefficient(radius, n_limit)
         r["navier"] = navier_coefficient(radius)

@@ -1,0 +1,46 @@
+"""Two MPI ranks give the serial results to 1e-10 (plate and shell, unstructured meshes)."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from shellform import linear
+from shellform.studies import plate, shell
+
+SCRIPT = """
+import json, shellform
+from mpi4py import MPI
+from shellform import linear
+from shellform.studies import plate, shell
+w_plate = linear.solve(plate.scene("clamped", "unstructured", 4, refine=2)).value("w")
+w_shell = linear.solve(shell.scene(5.0, 3, "unstructured", refine=2)).value("w")
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps({"plate": w_plate, "shell": w_shell}))
+"""
+
+
+def mpiexec():
+    local = Path(sys.executable).parent / "mpiexec"
+    return str(local) if local.exists() else shutil.which("mpiexec")
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_two_ranks_match_serial(tmp_path):
+    script = tmp_path / "run.py"
+    script.write_text(SCRIPT)
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    out = subprocess.run([mpiexec(), "-n", "2", sys.executable, str(script)], capture_output=True,
+                         text=True, timeout=300, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    line = [ln for ln in out.stdout.splitlines() if ln.startswith("RESULT ")][-1]
+    parallel = json.loads(line[len("RESULT "):])
+    serial_plate = linear.solve(plate.scene("clamped", "unstructured", 4, refine=2)).value("w")
+    serial_shell = linear.solve(shell.scene(5.0, 3, "unstructured", refine=2)).value("w")
+    assert parallel["plate"] == pytest.approx(serial_plate, rel=1e-10)
+    assert parallel["shell"] == pytest.approx(serial_shell, rel=1e-10)
