@@ -1,7 +1,7 @@
 """The ``shellform`` command.
 
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
-    shellform study NAME --out DIR          run a convergence study (plate, shell)
+    shellform study NAME --out DIR          run a study: plate, shell (convergence), assembly (benchmark)
 """
 
 import argparse
@@ -43,7 +43,7 @@ def main(argv=None) -> int:
     p_run.add_argument("scene", type=Path)
     p_run.add_argument("--out", type=Path, required=True)
     p_study = sub.add_parser("study", help="run a convergence study")
-    p_study.add_argument("name", choices=["plate", "shell"])
+    p_study.add_argument("name", choices=["plate", "shell", "assembly"])
     p_study.add_argument("--out", type=Path, required=True)
     p_study.add_argument("--quick", action="store_true", help="coarse levels only (for tests)")
     args = parser.parse_args(argv)
@@ -56,9 +56,9 @@ def main(argv=None) -> int:
             print(f"shellform: {summary['title']}: {summary['cells']} cells, w_center = {summary['w_center']}, "
                   f"{summary['wall_time_s']:.2f} s; results in {args.out}")
         else:
-            from shellform.studies import plate, shell
+            from shellform.studies import assembly, plate, shell
 
-            study = {"plate": plate, "shell": shell}[args.name]
+            study = {"plate": plate, "shell": shell, "assembly": assembly}[args.name]
             kwargs = {"levels": study.QUICK_LEVELS} if args.quick else {}
             study.run(args.out, **kwargs)
     except InputError as err:
