@@ -35,20 +35,35 @@
 #         2    288  0.0002742012   -5.03e-03  2.07    0.02
 #         3   1152  0.0002753133   -9.94e-04  2.34    0.05
 #     order from successive differences (levels 1-3): 2.00
-#     Richardson limit of the model 0.0002756840, +3.51e-04 relative to Donnell's
+#     Richardson limit of the model 0.0002756841, +3.51e-04 relative to Donnell's
 #
 #     radius sweep on the structured n = 24 mesh (1152 cells):
 #            R  a^2/(R t)   coefficient        Navier   vs_Navier  vs_plate
-#            2       50.0  0.0000369816  0.0000369885   -1.85e-04    0.0091
-#           10       10.0  0.0010057904  0.0010067177   -9.21e-04    0.2476
-#          100        1.0  0.0039486385  0.0039490457   -1.03e-04    0.9720
+#            2         50  0.0000369816  0.0000369885   -1.85e-04    0.0091
+#           10         10  0.0010057904  0.0010067177   -9.21e-04    0.2476
+#          100          1  0.0039486385  0.0039490457   -1.03e-04    0.9720
 #        10000       0.01  0.0040620478  0.0040623410   -7.22e-05    0.9999
 #          inf          0  0.0040620594  0.0040623527   -7.22e-05    0.9999
 #
 #     rate against Navier 2.34 (levels 2-3); order from differences 2.00;
 #     R = 1e4 within 7.44e-05 of the plate: OK
 #
+#     $ python demos/demo_shallow_shell.py --levels 4 --kind unstructured
+#     ...
+#         2    416  0.0002751390   -1.63e-03  2.22    0.03
+#         3   1664  0.0002755474   -1.44e-04  3.49    0.07
+#         4   6656  0.0002756496    2.26e-04 -0.65    0.32
+#     order from successive differences (levels 2-4): 2.00
+#     Richardson limit of the model 0.0002756836, +3.50e-04 relative to Donnell's
+#     ...
+#     rate against Navier 2.22 (levels 1-2); order from differences 2.00;
+#     R = 1e4 within 7.44e-05 of the plate: OK
+#
 # The first solve includes the one-off compilation of the element kernels (FFCx and numba).
+# The checks at the end are made for shallow blocks, $a^2/(R t) \lesssim 20$ ($R \gtrsim 5$):
+# a deeper block such as `--radius 2` ($a^2/(R t) = 50$) has edge layers of width about
+# $\sqrt{R t} \approx 0.14$ at the diaphragms; on these meshes its successive differences still
+# change sign, and the order check fails.
 
 # ## The shallow shell
 #
@@ -190,7 +205,7 @@ judged = pairs[-1] if pairs else None
 
 plate_value = shell.PLATE
 sweep = []
-print(f"\nradius sweep on the structured n = {args.sweep_n} mesh:")
+print(f"\nradius sweep on the structured n = {args.sweep_n} mesh ({2 * args.sweep_n**2} cells):")
 print(f"{'R':>8s} {'a^2/(R t)':>10s} {'coefficient':>13s} {'Navier':>13s} {'vs_Navier':>11s} {'vs_plate':>9s}")
 for radius in (2.0, 10.0, 100.0, 1e4, math.inf):
     r = shell.coefficient(radius, args.sweep_n)
@@ -198,7 +213,6 @@ for radius in (2.0, 10.0, 100.0, 1e4, math.inf):
     sweep.append((radius, r["coefficient"]))
     print(f"{radius:8g} {A**2 / (radius * T):10.3g} {r['coefficient']:13.10f} {nav:13.10f} "
           f"{(r['coefficient'] - nav) / nav:11.2e} {r['coefficient'] / plate_value:9.4f}")
-print(f"({r['cells']} cells)")
 
 # ## Checks
 #
@@ -211,7 +225,8 @@ c_1e4 = dict(sweep)[1e4]
 plate_error = abs(c_1e4 - plate_value) / plate_value
 assert judged is not None, f"no pair of meshes has errors above twice the model gap {abs(gap):.1e}: coarser meshes"
 print(f"\nrate against Navier {rates[judged]:.2f} (levels {judged - 1}-{judged}); order from differences "
-      f"{diff_order:.2f}; R = 1e4 within {plate_error:.2e} of the plate: ", end="")
+      f"{diff_order:.2f};")
+print(f"R = 1e4 within {plate_error:.2e} of the plate: ", end="")
 assert rates[judged] >= 1.9, f"rate against Navier {rates[judged]:.3f} < 1.9"
 assert diff_order >= 1.9, f"order from successive differences {diff_order:.3f} < 1.9"
 assert all(c0 < c1 for (_, c0), (_, c1) in zip(sweep, sweep[1:])), "the block must soften as R grows"

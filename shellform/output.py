@@ -45,11 +45,23 @@ def write_vtx(outdir: Path, q, components, cell_fields: dict) -> list[Path]:
     return paths
 
 
+def _offscreen_backend() -> None:
+    """Render without a display: OSMesa where installed, else EGL, else VTK's own fallback."""
+    import ctypes.util
+
+    if "VTK_DEFAULT_OPENGL_WINDOW" in os.environ:
+        return
+    if ctypes.util.find_library("OSMesa"):
+        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkOSOpenGLRenderWindow"
+    elif ctypes.util.find_library("EGL"):
+        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
+
+
 def write_png(path: Path, q, components, title: str = "", scale: float | None = None) -> Path | None:
     """The deformed mid-surface coloured by w (rank 0 gathers nothing: serial runs only)."""
     if q.function_space.mesh.comm.size > 1:
         return None
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
+    _offscreen_backend()
     import pyvista
 
     mesh = q.function_space.mesh

@@ -1,0 +1,68 @@
+"""The demos and the demo scenes: they run, print their tables and reproduce the references."""
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from shellform import cli, scene
+from shellform.studies import plate, shell
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMOS = ROOT / "demos"
+
+
+def run_demo(name, *flags):
+    proc = subprocess.run([sys.executable, str(DEMOS / name), *flags], cwd=ROOT, capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, f"{name} {' '.join(flags)} exited {proc.returncode}\n{proc.stdout}\n{proc.stderr}"
+    return proc.stdout
+
+
+def test_plate_convergence_demo():
+    out = run_demo("demo_plate_convergence.py", "--levels", "3")
+    assert re.search(r"^\s*level\s+cells\s+w_center\s+rel_error\s+rate\s+time_s\s*$", out, re.M), out
+    assert len(re.findall(r"^\s*\d+\s+\d+\s+0\.\d+\s+-?\d", out, re.M)) == 4, out  # levels 0..3
+    assert out.rstrip().endswith("OK"), out
+
+
+def test_shallow_shell_demo():
+    out = run_demo("demo_shallow_shell.py", "--levels", "3")
+    assert re.search(r"^\s*level\s+cells\s+coefficient\s+rel_error\s+rate\s+time_s\s*$", out, re.M), out
+    assert re.search(r"^\s*R\s+a\^2/\(R t\)\s+coefficient\s+Navier\s+vs_Navier\s+vs_plate\s*$", out, re.M), out
+    assert out.rstrip().endswith("OK"), out
+
+
+def run_scene(name, outdir):
+    assert cli.main(["run", str(DEMOS / name), "--out", str(outdir)]) == 0
+    summary = outdir / "summary.json"
+    assert summary.is_file()
+    return json.loads(summary.read_text())
+
+
+def test_square_plate_scene(tmp_path):
+    """D = 1, q = 1, a = 1: w_center is the coefficient w D/(q a^4) of the simply supported plate."""
+    summary = run_scene("square_plate.toml", tmp_path)
+    reference = plate.REFERENCE["simply_supported"]
+    assert reference == 0.00406235
+    assert summary["cells"] == 288
+    assert summary["w_center"] == pytest.approx(reference, rel=5e-4)
+    assert (tmp_path / "nodal.bp").is_dir() and (tmp_path / "cells.bp").is_dir()
+    png = tmp_path / "deformed.png"
+    assert png.is_file()
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert png.stat().st_size > 10_000
+
+
+def test_shallow_shell_scene(tmp_path):
+    """The shell block of demos/shallow_shell.toml against the Navier (Donnell) series."""
+    s = scene.load(DEMOS / "shallow_shell.toml")
+    assert (s.surface.R1, s.surface.R2) == (5.0, 5.0)
+    m = s.material
+    D = m.E * m.thickness**3 / (12 * (1 - m.nu**2))
+    summary = run_scene("shallow_shell.toml", tmp_path)
+    assert summary["cells"] == 1152
+    assert summary["w_center"] * D == pytest.approx(shell.navier_coefficient(5.0), rel=2e-3)
