@@ -93,6 +93,39 @@ def compile_forms(scene: Scene, msh) -> HybridShellForms:
     return HybridShellForms(msh, element, parameters(msh, scene), mapped=scene.solver.mapped)
 
 
+def assemble_system(forms: HybridShellForms, bcs, point_loads=(), tol=1e-9):
+    """K and f with the Dirichlet conditions applied (lifted), point loads on owned vertices."""
+    A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
+    A.assemble()
+    if forms.load is not None:
+        b = fem_petsc.assemble_vector(forms.load)
+    else:
+        b = fem_petsc.create_vector(forms.V)
+        b.set(0.0)
+    fem_petsc.apply_lifting(b, [forms.stiffness], bcs=[bcs])
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)  # owned entries final
+    loads.add_point_loads(b, forms.V, forms.element.carrier_components, point_loads, tol)
+    fem_petsc.set_bc(b, bcs)
+    return A, b
+
+
+def lu_solve(A, b, V) -> fem.Function:
+    """q = A^-1 b by MUMPS LU; A and b are destroyed."""
+    q = fem.Function(V, name="carrier")
+    ksp = PETSc.KSP().create(V.mesh.comm)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    ksp.solve(b, q.x.petsc_vec)
+    reason = ksp.getConvergedReason()
+    ksp.destroy(), A.destroy(), b.destroy()
+    if reason < 0:
+        raise RuntimeError(f"linear solve failed (PETSc reason {reason})")
+    q.x.scatter_forward()
+    return q
+
+
 def solve(scene: Scene, comm=MPI.COMM_WORLD) -> LinearResult:
     t = time.perf_counter()
     rect = mesh(scene, comm)
@@ -101,30 +134,9 @@ def solve(scene: Scene, comm=MPI.COMM_WORLD) -> LinearResult:
     t1 = time.perf_counter()
     V, comps = forms.V, forms.element.carrier_components
     bcs = supports.boundary_conditions(V, comps, rect.facet_tags, vars(scene.supports))
-    A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
-    A.assemble()
-    if forms.load is not None:
-        b = fem_petsc.assemble_vector(forms.load)
-    else:
-        b = fem_petsc.create_vector(V)
-        b.set(0.0)
-    fem_petsc.apply_lifting(b, [forms.stiffness], bcs=[bcs])
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)  # owned entries final
-    tol = 1e-9 * max(scene.geometry.lx, scene.geometry.ly)
-    loads.add_point_loads(b, V, comps, scene.loads.point, tol)  # owned vertices only
-    fem_petsc.set_bc(b, bcs)
+    A, b = assemble_system(forms, bcs, scene.loads.point, 1e-9 * max(scene.geometry.lx, scene.geometry.ly))
     t2 = time.perf_counter()
-    q = fem.Function(V, name="carrier")
-    ksp = PETSc.KSP().create(comm)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    ksp.solve(b, q.x.petsc_vec)
-    if ksp.getConvergedReason() < 0:
-        raise RuntimeError(f"linear solve failed (PETSc reason {ksp.getConvergedReason()})")
-    q.x.scatter_forward()
-    ksp.destroy(), A.destroy(), b.destroy()
+    q = lu_solve(A, b, V)
     t3 = time.perf_counter()
     if not np.all(np.isfinite(q.x.array)):
         raise FloatingPointError("the solution has non-finite values: is the structure supported?")

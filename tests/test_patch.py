@@ -25,6 +25,7 @@ from petsc4py import PETSc
 
 from forms.fields import ShellParameters
 from shellform.assembly.hybrid_element import HybridElement
+from shellform import linear
 from shellform.assembly.kernels import HybridShellForms
 
 E, NU, THICKNESS = 2.0e3, 0.3, 0.05
@@ -115,23 +116,7 @@ def _solve_patch(msh, effects, field):
     bdofs = fem.locate_dofs_topological(V, 1, bfacets)  # block (vertex) indices of the blocked V
     bcs = [fem.dirichletbc(g, bdofs)]  # every component of every boundary vertex
 
-    A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
-    A.assemble()
-    b = fem_petsc.create_vector(V)
-    b.set(0.0)  # no load
-    fem_petsc.apply_lifting(b, [forms.stiffness], bcs=[bcs])
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    fem_petsc.set_bc(b, bcs)
-    ksp = PETSc.KSP().create(msh.comm)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    q = fem.Function(V)
-    ksp.solve(b, q.x.petsc_vec)
-    assert ksp.getConvergedReason() > 0
-    q.x.scatter_forward()
-    ksp.destroy(), A.destroy(), b.destroy()
+    q = linear.lu_solve(*linear.assemble_system(forms, bcs), V)  # no load
 
     nloc = V.dofmap.index_map.size_local
     interior = np.setdiff1d(np.arange(nloc), bdofs)

@@ -24,6 +24,7 @@ from petsc4py import PETSc
 
 from forms.fields import ShellParameters
 from shellform.assembly.hybrid_element import HybridElement
+from shellform import linear
 from shellform.assembly.kernels import HybridShellForms
 
 THETA = 0.7
@@ -55,22 +56,7 @@ def clamped_solve(msh, mapped):
     msh.topology.create_connectivity(1, 2)
     bdofs = fem.locate_dofs_topological(V, 1, dmesh.exterior_facet_indices(msh.topology))
     bcs = [fem.dirichletbc(np.zeros(V.dofmap.index_map_bs), bdofs, V)]  # w = w_x = w_y = 0
-    A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
-    A.assemble()
-    b = fem_petsc.assemble_vector(forms.load)
-    fem_petsc.apply_lifting(b, [forms.stiffness], bcs=[bcs])
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    fem_petsc.set_bc(b, bcs)
-    ksp = PETSc.KSP().create(msh.comm)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    q = fem.Function(V)
-    ksp.solve(b, q.x.petsc_vec)
-    assert ksp.getConvergedReason() > 0
-    q.x.scatter_forward()
-    ksp.destroy(), A.destroy(), b.destroy()
+    q = linear.lu_solve(*linear.assemble_system(forms, bcs), V)  # uniform pressure
     n = V.dofmap.index_map.size_local
     vals = q.x.array.reshape(-1, 3)[:n]  # (w, w_x, w_y) per vertex
     return vals, V.tabulate_dof_coordinates()[:n, :2]
