@@ -15,13 +15,11 @@ in every cell.
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
-import dolfinx.fem.petsc as fem_petsc
 import numpy as np
 import pytest
 from dolfinx import fem, la
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from forms.fields import ShellParameters
 from shellform.assembly.hybrid_element import HybridElement
