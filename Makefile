@@ -21,7 +21,7 @@ $(STAMP): pyproject.toml scripts/find-python.sh
 
 demo: $(STAMP)
 	$(VENV)/bin/shellform study plate --out $(OUT)
-	@echo "shellform: table, plot and log in $(OUT)"
+	@echo "shellform: table (CSV) and error-against-time plot in $(OUT)"
 
 test: $(STAMP)
 	$(PY) -m pytest -q tests
