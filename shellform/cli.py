@@ -59,7 +59,7 @@ def main(argv=None) -> int:
             from shellform.studies import assembly, plate, shell
 
             study = {"plate": plate, "shell": shell, "assembly": assembly}[args.name]
-            kwargs = {"levels": study.QUICK_LEVELS} if args.quick else {}
+            kwargs = {"levels": study.QUICK_LEVELS} if args.quick and hasattr(study, "QUICK_LEVELS") else {}
             study.run(args.out, **kwargs)
     except InputError as err:
         print(f"shellform: input error: {err}", file=sys.stderr)

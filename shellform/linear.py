@@ -38,8 +38,7 @@ class LinearResult:
 
     @property
     def num_dofs(self) -> int:
-        V = self.forms.V
-        return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+        return self.forms.num_dofs
 
     def value(self, name: str, x: float = 0.0, y: float = 0.0) -> float:
         """A nodal value (e.g. 'w') at the vertex (x, y)."""
@@ -93,6 +92,12 @@ def compile_forms(scene: Scene, msh) -> HybridShellForms:
     return HybridShellForms(msh, element, parameters(msh, scene), mapped=scene.solver.mapped)
 
 
+def boundary_conditions(scene: Scene, rect, forms: HybridShellForms):
+    """The scene's named supports on the sides of the meshed rectangle."""
+    return supports.boundary_conditions(forms.V, forms.element.carrier_components, rect.facet_tags,
+                                        vars(scene.supports))
+
+
 def assemble_system(forms: HybridShellForms, bcs, point_loads=(), tol=1e-9):
     """K and f with the Dirichlet conditions applied (lifted), point loads on owned vertices."""
     A = fem_petsc.assemble_matrix(forms.stiffness, bcs=bcs)
@@ -132,11 +137,10 @@ def solve(scene: Scene, comm=MPI.COMM_WORLD) -> LinearResult:
     t0 = time.perf_counter()
     forms = compile_forms(scene, rect.mesh)
     t1 = time.perf_counter()
-    V, comps = forms.V, forms.element.carrier_components
-    bcs = supports.boundary_conditions(V, comps, rect.facet_tags, vars(scene.supports))
+    bcs = boundary_conditions(scene, rect, forms)
     A, b = assemble_system(forms, bcs, scene.loads.point, 1e-9 * max(scene.geometry.lx, scene.geometry.ly))
     t2 = time.perf_counter()
-    q = lu_solve(A, b, V)
+    q = lu_solve(A, b, forms.V)
     t3 = time.perf_counter()
     if not np.all(np.isfinite(q.x.array)):
         raise FloatingPointError("the solution has non-finite values: is the structure supported?")

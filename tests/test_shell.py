@@ -16,13 +16,9 @@ import pytest
 
 from shellform import linear
 from shellform.studies import plate, shell
+from shellform.studies.common import convergence_rates
 
 R = 5.0  # a^2 / (R t) = 20: membrane action dominates
-
-
-def rates(errors, cells):
-    e, h = np.abs(errors), np.asarray(cells, dtype=float) ** -0.5
-    return np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:]), np.polyfit(np.log(h), np.log(e), 1)[0]
 
 
 def test_navier_series_flat_limit():
@@ -39,7 +35,7 @@ def test_shell_converges_to_overkill(overkill):
     """Second-order convergence of the centre deflection on nested meshes (up to 1152 cells)."""
     rows = [shell.coefficient(R, shell.BASE_N, refine=k) for k in (0, 1, 2, 3)]
     err = [(r["coefficient"] - overkill) / overkill for r in rows]
-    pairwise, fit = rates(err, [r["cells"] for r in rows])
+    pairwise, fit = convergence_rates(err, [r["cells"] for r in rows])
     assert pairwise[-1] >= 1.9 and fit >= 1.9, pairwise
     assert abs(err[-1]) < 2e-3
 
@@ -69,7 +65,7 @@ def test_donnell_variant_converges_to_navier_series():
     rows = json.loads(out.stdout.strip().splitlines()[-1])
     navier = shell.navier_coefficient(R)
     err = [(r["coefficient"] - navier) / navier for r in rows]
-    pairwise, _ = rates(err, [r["cells"] for r in rows])
+    pairwise, _ = convergence_rates(err, [r["cells"] for r in rows])
     assert np.all(pairwise >= 1.9), pairwise
     assert abs(err[-1]) < 4e-4  # measured -3.4e-4 at 4608 cells, -8.4e-5 at 18432
 

@@ -269,3 +269,8 @@ class HybridShellForms:
     def recovery_form(self, q: fem.Function, W: fem.FunctionSpace):
         """Vector form on a DG0 space W (block 6 per group): centroid strains and resultants."""
         return self._form([W], self.kernels.recovery, [q])
+
+    @property
+    def num_dofs(self) -> int:
+        """Global number of carrier unknowns (vertices x components)."""
+        return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs

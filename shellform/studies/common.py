@@ -5,6 +5,7 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
 from mpi4py import MPI
 
 
@@ -24,14 +25,21 @@ def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
             writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
 
 
+def convergence_rates(errors, cells) -> tuple[np.ndarray, float]:
+    """Observed orders in h ~ cells^(-1/2): between consecutive meshes, log(e0/e1) / log(h0/h1),
+    and the least-squares slope of log|e| against log h over all of them."""
+    e = np.abs(np.asarray(errors, dtype=float))
+    h = np.asarray(cells, dtype=float) ** -0.5
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pairwise = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
+    fitted = float(np.polyfit(np.log(h), np.log(e), 1)[0]) if len(e) > 1 and np.all(e > 0) else math.nan
+    return pairwise, fitted
+
+
 def observed_rates(rows: list[dict], size="cells", error="rel_error") -> list[float]:
-    """Rates in h ~ cells^(-1/2) between consecutive rows: log(e0/e1) / log(h0/h1)."""
-    rates = [math.nan]
-    for r0, r1 in zip(rows, rows[1:]):
-        e0, e1 = abs(r0[error]), abs(r1[error])
-        h = math.sqrt(r1[size] / r0[size])
-        rates.append(math.log(e0 / e1) / math.log(h) if e0 > 0 and e1 > 0 else math.nan)
-    return rates
+    """Pairwise rates of a table, nan for the first row (and where an error is zero)."""
+    pairwise, _ = convergence_rates([r[error] for r in rows], [r[size] for r in rows])
+    return [math.nan] + [float(x) if np.isfinite(x) else math.nan for x in pairwise]
 
 
 def plot_error_time(path: Path, series: dict[str, list[dict]], title: str, error="rel_error") -> None:

@@ -10,9 +10,9 @@ E t / R^2); and the flat-plate limit (0.00406235) as R grows.
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
-from pathlib import Path
 
 from shellform import linear
 from shellform.scene import Scene, from_dict
