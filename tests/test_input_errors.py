@@ -25,6 +25,8 @@ from shellform.linear import parameters
     ({"surface": {"R1": 3.0}}, "surface.R1"),
     ({"surface": {"R2": 0.0}, "effects": ["bending", "membrane", "shallow_curvature"]}, "surface.R2"),
     ({"mesh": {"n": 0}}, "mesh.n"),
+    ({"mesh": {"refine": -1}}, "mesh.refine"),
+    ({"mesh": {"refine": 1.5}}, "mesh.refine"),
     ({"mesh": {"kind": "quad"}}, "mesh.kind"),
     ({"geometry": {"lx": -1.0}}, "geometry.lx"),
     ({"loads": {"point": [{"x": 5.0, "y": 0.0, "fz": 1.0}]}}, "loads.point[0]"),
