@@ -5,6 +5,11 @@ Effects and the terms they add:
 - ``membrane``          membrane energy, membrane-strain constraint
 - ``shallow_curvature`` the 1/R terms of f^p and f^b (needs bending and membrane)
 - ``pressure``          work of a uniform pressure (needs bending)
+
+Effects of the nonlinear sheet (forms.nonlinear, shellform.nonlinear):
+- ``geometric_nonlinearity``  exact (total-Lagrangian Kirchhoff-Love) membrane and bending strains
+- ``plasticity``              elastic-plastic layers through the thickness (Hill 1979)
+- ``anisotropy``              r != 1 or m != 2 in the Hill 1979 yield function (needs plasticity)
 """
 
 import ufl
@@ -12,7 +17,8 @@ import ufl
 from forms import assumed_strain, bending, loads, membrane, string_net
 from forms.fields import HybridFields, ShellParameters
 
-EFFECTS = ("bending", "membrane", "shallow_curvature")
+EFFECTS = ("bending", "membrane", "shallow_curvature", "geometric_nonlinearity", "plasticity", "anisotropy")
+NONLINEAR_EFFECTS = ("geometric_nonlinearity", "plasticity", "anisotropy")
 
 
 def strain_energy(f: HybridFields, p: ShellParameters, effects) -> ufl.Form | None:

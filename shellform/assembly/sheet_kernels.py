@@ -1,0 +1,237 @@
+"""FFCx kernels of the nonlinear sheet (forms.kirchhoff_love) and the per-cell numba loop.
+
+Compiled once per (effects, quadrature degree) on a mesh-free domain, like ElementKernels:
+
+    hessian    d2/dz2 of the weak-Hessian constraint (bending-only hybrid element)
+    strain     the expression e(z) at the quadrature points
+    force      d/dz int S . e              (coefficients z, S)
+    tangent    int de . D . te + S . d2e   (coefficients z, S, D)
+    pressure   d/dz int p U_3              (dead pressure per unit p)
+
+Two numba loops over the owned cells do the element around the constitutive update (which is
+shellform.material.section.update, a loop of its own so that its time is measured apart):
+
+    strain_loop   gather the carrier values q, map them (z = Q q), strains e at the points
+    tensor_loop   r = Q^T r_z and K = Q^T K_z Q from the resultants S and section tangents D
+
+Assembly is DOLFINx's (shellform.nonlinear.assemble).
+"""
+
+import basix.ufl
+import cffi
+import numba
+import numpy as np
+import ufl
+from dolfinx.jit import ffcx_jit
+
+from forms import kirchhoff_love as kl
+from shellform.assembly import condensation, slope_map
+from shellform.assembly.kernels import reference_fields
+from shellform.assembly.sheet_element import NDOF, SheetElement, build_q
+
+try:  # the module moves in FFCx 0.12
+    from ffcx.codegeneration.utils import empty_void_pointer
+except ImportError:  # pragma: no cover
+    from ffcx.codegeneration.numba.utils import empty_void_pointer
+
+_ffi = cffi.FFI()
+_OPTIONS = {"scalar_type": "float64"}
+
+
+def _cell_kernel(comm, form):
+    ufcx, _, _ = ffcx_jit(comm, form, form_compiler_options=_OPTIONS)
+    return ufcx.form_integrals[0].tabulate_tensor_float64, ufcx
+
+
+def _facet_kernel(ufcx):
+    off = [ufcx.form_integral_offsets[i] for i in range(3)]
+    return ufcx.form_integrals[off[1]].tabulate_tensor_float64
+
+
+class SheetKernels:
+    """The compiled kernels of one configuration of the nonlinear sheet."""
+
+    _cache: dict = {}
+
+    @classmethod
+    def get(cls, nonlinear: bool, shallow: bool, comm, quadrature_degree: int = 4):
+        key = (nonlinear, shallow, quadrature_degree)
+        if key not in cls._cache:
+            cls._cache[key] = cls(nonlinear, shallow, comm, quadrature_degree)
+        return cls._cache[key]
+
+    def __init__(self, nonlinear, shallow, comm, quadrature_degree):
+        self.element = el = SheetElement(quadrature_degree)
+        self.nonlinear, self.shallow = nonlinear, shallow
+        cell = "triangle"
+        domain = ufl.Mesh(basix.ufl.element("Lagrange", cell, 1, shape=(2,)))
+        x = ufl.SpatialCoordinate(domain)
+        n = ufl.FacetNormal(domain)
+
+        # The weak Hessian of one component: the bending-only hybrid element of issue 2.
+        Zh = ufl.FunctionSpace(domain, el.hessian.mixed)
+        zh = ufl.Coefficient(Zh)
+        f = reference_fields(el.hessian, zh)
+        c = kl.weak_hessian_constraint(f.M, f.eps_b, f.w, f.g, n)
+        ah = ufl.derivative(ufl.derivative(c, zh, ufl.TestFunction(Zh)), zh, ufl.TrialFunction(Zh))
+        self.hessian_cell, ufcx = _cell_kernel(comm, ah)
+        self.hessian_facet = _facet_kernel(ufcx)
+
+        # The energy element and its quadrature fields S (6) and D (36) per point.
+        Z = ufl.FunctionSpace(domain, el.energy)
+        z = ufl.Coefficient(Z)
+        dz, tz = ufl.TestFunction(Z), ufl.TrialFunction(Z)
+        qdeg = quadrature_degree
+        Sq = ufl.Coefficient(ufl.FunctionSpace(domain, basix.ufl.quadrature_element(cell, (6,), degree=qdeg)))
+        Dq = ufl.Coefficient(ufl.FunctionSpace(domain, basix.ufl.quadrature_element(cell, (36,), degree=qdeg)))
+        D = ufl.as_matrix([[Dq[6 * i + j] for j in range(6)] for i in range(6)])
+        dx = ufl.dx(metadata={"quadrature_degree": qdeg})
+        parts = ufl.split(z)
+        U, H = parts[0], parts[1:]
+        kappa0 = ufl.Constant(domain, shape=(2, 2)) if shallow else None
+        e = kl.section_strain(U, H, x, kappa0, nonlinear)
+        de, te = ufl.derivative(e, z, dz), ufl.derivative(e, z, tz)
+        self.force, _ = _cell_kernel(comm, kl.internal_work(de, Sq, dx))
+        self.tangent, _ = _cell_kernel(comm, kl.tangent(e, de, te, Sq, D, z, dz, tz, dx))
+        p = ufl.Constant(domain)
+        self.pressure, _ = _cell_kernel(comm, ufl.derivative(kl.dead_pressure(p, U, dx), z, dz))
+        ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS)
+        self.strain = ufcx_e.tabulate_tensor_float64
+        self.nconst = 4 if shallow else 0  # kappa0 in every kernel that sees it
+
+        self.setup = self._setup_loop()
+        self.strain_loop = self._strain_loop()
+        self.tensor_loop = self._tensor_loop()
+
+    # -- numba ---------------------------------------------------------------------------------
+    def _setup_loop(self):
+        """Per cell: P (H = P q_c) and the element pressure vector for p = 1."""
+        hc, hf, pk = self.hessian_cell, self.hessian_facet, self.pressure
+        el = self.element
+        he = el.hessian
+        iq, ie, il = he.q, he.eps, he.lam
+        hcols, hcodes = el.hessian_tables
+        qcols, qcodes = el.q_map()
+        ccols = el.component_columns()
+        nzh, nz, ns = he.dim, el.nz, el.sym_dim
+        ffi = _ffi
+
+        @numba.njit
+        def setup(cells_coords, P_out, F_out):
+            Ah = np.zeros((nzh, nzh))
+            wz = np.zeros(1)
+            ck = np.zeros(1)
+            one = np.ones(1)
+            local = np.zeros(1, dtype=np.int32)
+            perm = np.zeros(1, dtype=np.uint8)
+            Q = np.zeros((nz, NDOF))
+            fz = np.zeros(nz)
+            for cidx in range(cells_coords.shape[0]):
+                coords = cells_coords[cidx]
+                Ah[:, :] = 0.0
+                local[0] = 0
+                hc(ffi.from_buffer(Ah), ffi.from_buffer(wz), ffi.from_buffer(ck), ffi.from_buffer(coords),
+                   ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
+                for f in range(3):
+                    local[0] = f
+                    hf(ffi.from_buffer(Ah), ffi.from_buffer(wz), ffi.from_buffer(ck), ffi.from_buffer(coords),
+                       ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
+                # G H + C q_ref = 0  ->  H = -G^-1 C T q_c
+                G = np.empty((ns, ns))
+                C = np.empty((ns, iq.size))
+                for a in range(ns):
+                    for b in range(ns):
+                        G[a, b] = Ah[il[a], ie[b]]
+                    for b in range(iq.size):
+                        C[a, b] = Ah[il[a], iq[b]]
+                J = slope_map.jacobian(coords)
+                coef = slope_map.coefficients(J, hcodes, True)
+                CT = np.zeros((ns, 9))
+                for a in range(ns):
+                    for r in range(iq.size):
+                        for k in range(2):
+                            if hcols[r, k] >= 0:
+                                CT[a, hcols[r, k]] += C[a, r] * coef[r, k]
+                CT *= -1.0
+                condensation.cholesky_solve(condensation.cholesky(G), CT)
+                P_out[cidx] = CT
+                build_q(J, P_out[cidx], qcols, qcodes, ccols, Q)
+                fz[:] = 0.0
+                local[0] = 0
+                pk(ffi.from_buffer(fz), ffi.from_buffer(wz), ffi.from_buffer(one), ffi.from_buffer(coords),
+                   ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
+                F_out[cidx, :] = Q.T @ fz
+
+        return setup
+
+    def _strain_loop(self):
+        strain = self.strain
+        el = self.element
+        qcols, qcodes = el.q_map()
+        ccols = el.component_columns()
+        nz, nconst = el.nz, self.nconst
+        ffi = _ffi
+
+        @numba.njit
+        def loop(cells, cells_coords, dofs, x, P, consts, z_out, e_out):
+            """z = Q q and the section strains e at the quadrature points of every cell."""
+            Q = np.zeros((nz, NDOF))
+            q = np.empty(NDOF)
+            c = np.zeros(max(nconst, 1))
+            c[:nconst] = consts[:nconst]
+            local = np.zeros(1, dtype=np.int32)
+            perm = np.zeros(1, dtype=np.uint8)
+            for k in range(cells.size):
+                cidx = cells[k]
+                coords = cells_coords[cidx]
+                build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
+                for v in range(3):
+                    for b in range(9):
+                        q[9 * v + b] = x[9 * dofs[cidx, v] + b]
+                z_out[k, :] = Q @ q
+                e = e_out[k].ravel()
+                e[:] = 0.0
+                strain(ffi.from_buffer(e), ffi.from_buffer(z_out[k]), ffi.from_buffer(c),
+                       ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
+                       empty_void_pointer())
+
+        return loop
+
+    def _tensor_loop(self):
+        force, tangent = self.force, self.tangent
+        el = self.element
+        qcols, qcodes = el.q_map()
+        ccols = el.component_columns()
+        nz, nqp, nconst = el.nz, el.nqp, self.nconst
+        ffi = _ffi
+
+        @numba.njit
+        def loop(cells, cells_coords, P, consts, z, S, D, want_tangent, R_out, K_out):
+            """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell."""
+            Q = np.zeros((nz, NDOF))
+            w = np.zeros(nz + 42 * nqp)
+            rz = np.zeros(nz)
+            Kz = np.zeros((nz, nz))
+            c = np.zeros(max(nconst, 1))
+            c[:nconst] = consts[:nconst]
+            local = np.zeros(1, dtype=np.int32)
+            perm = np.zeros(1, dtype=np.uint8)
+            for k in range(cells.size):
+                cidx = cells[k]
+                coords = cells_coords[cidx]
+                build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
+                w[:nz] = z[k]
+                w[nz: nz + 6 * nqp] = S[k].ravel()
+                w[nz + 6 * nqp:] = D[k].ravel()
+                rz[:] = 0.0
+                force(ffi.from_buffer(rz), ffi.from_buffer(w), ffi.from_buffer(c), ffi.from_buffer(coords),
+                      ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
+                R_out[k, :] = Q.T @ rz
+                if want_tangent:
+                    Kz[:, :] = 0.0
+                    tangent(ffi.from_buffer(Kz), ffi.from_buffer(w), ffi.from_buffer(c),
+                            ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
+                            empty_void_pointer())
+                    K_out[k, :, :] = Q.T @ (Kz @ Q)
+
+        return loop

@@ -1,0 +1,35 @@
+"""The constitutive update of every section point of the sheet, in one numba loop.
+
+For each cell c and quadrature point g, from the section strains e = (E, K) (6), either the
+closed-form elastic section (no layers) or the layered elastic-plastic section from the
+committed state (ep_n, p_n) to the trial state (ep, p). Returns the resultants S (6), the
+section tangents D (6 x 6) and the counts of plastic and failed layers.
+"""
+
+import numba
+import numpy as np
+
+from shellform.material import section
+
+
+@numba.njit(cache=True)
+def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D):
+    nplastic, nfail = 0, 0
+    Sg = np.zeros(6)
+    Dg = np.zeros((6, 6))
+    for c in range(e.shape[0]):
+        for g in range(e.shape[1]):
+            em = e[c, g, :3].copy()
+            k = e[c, g, 3:].copy()
+            if plastic:
+                st = section.section_response(em, k, thickness, zeta, wz, ep_n[c, g], p_n[c, g], mat,
+                                              Sg, Dg, ep[c, g], p[c, g])
+                if st < 0:
+                    nfail += 1
+                else:
+                    nplastic += st
+            else:
+                section.elastic_section(em, k, thickness, mat, Sg, Dg)
+            S[c, g, :] = Sg
+            D[c, g, :, :] = Dg
+    return nplastic, nfail

@@ -1,0 +1,280 @@
+"""The incremental Newton driver: load factor stepping, cut-back, growth, checkpoints.
+
+The problem is  R(q, lambda) = f_int(q) - lambda f_ext(q) = 0  with prescribed values
+q_D = lambda qbar_D on the Dirichlet dofs (loads and prescribed displacements share lambda).
+Each increment lambda_n -> lambda_n + dlambda:
+
+    predictor   q = q_n + (dlambda / dlambda_prev) (q_n - q_n-1), then q_D = lambda qbar_D
+    Newton      K dq = -R (consistent tangent, dq_D = 0), q += alpha dq
+    line search on the energy slope s(alpha) = dq . R(q + alpha dq): alpha = 1 unless the step
+                overshoots the energy minimum along dq (s(1) > |s(0)|), then secant steps
+                towards s = 0; halved where the material update fails or |R| is not finite
+    converged   |R_free| <= rtol max(|lambda f_ext|, |element forces|) (the element forces
+                before they cancel in the sum: the scale of round-off), or a correction at
+                round-off level (|dq| <= stol |q|) with |R_free| <= 1e3 rtol max(...)
+
+A failing increment (too many iterations, a non-finite value, a failed return mapping, no
+descent) is restored and retried with dlambda / 4; an easy one (few iterations) lets the next
+grow by 1.5. Below min_step the run stops with ConvergenceFailure, after writing the last
+converged state to disk. Nothing non-finite is ever committed.
+"""
+
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import dolfinx.fem.petsc as fem_petsc
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from shellform.errors import InputError
+from shellform.studies.common import say
+
+
+class ConvergenceFailure(RuntimeError):
+    """The driver could not continue; the last converged state is on disk (``checkpoint``)."""
+
+    def __init__(self, message, checkpoint=None):
+        super().__init__(message + (f" (last converged state: {checkpoint})" if checkpoint else ""))
+        self.checkpoint = checkpoint
+
+
+@dataclass
+class Controls:
+    initial_step: float = 0.1  # first dlambda
+    min_step: float = 1e-4
+    max_step: float = 0.25
+    max_iterations: int = 12
+    rtol: float = 1e-9  # |R_free| <= rtol * max(|element forces|, |lambda f_ext|)
+    stol: float = 1e-13  # or a Newton correction at round-off: |dq|_inf <= stol |q|_inf
+    easy_iterations: int = 4  # converged in at most this many: grow the next step by `growth`
+    growth: float = 1.5
+    cut: float = 0.25
+    line_search: int = 6  # halvings
+    predictor: bool = True
+
+    def check(self):
+        for name in ("initial_step", "min_step", "max_step", "rtol"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InputError(f"process.{name}", f"must be > 0, got {v}")
+        if self.min_step > self.initial_step or self.initial_step > self.max_step:
+            raise InputError("process.initial_step", "needs min_step <= initial_step <= max_step")
+        if self.max_iterations < 1:
+            raise InputError("process.max_iterations", f"must be >= 1, got {self.max_iterations}")
+
+
+@dataclass
+class Increment:
+    number: int
+    lam: float
+    dlam: float
+    iterations: int
+    residuals: list[float]
+    plastic_layers: int
+    cutbacks: int
+    seconds: dict = field(default_factory=dict)
+
+
+class Driver:
+    """Newton on the sheet model with DOLFINx assembly and a MUMPS LU solve."""
+
+    def __init__(self, model, bcs, prescribed=None, pressure=0.0, nodal=None, controls=None,
+                 checkpoint_dir=None, verbose=True):
+        """bcs: Dirichlet conditions of the carrier (values = the prescribed values at lambda = 1,
+        held in the `prescribed` Function, or homogeneous); pressure: dead pressure at lambda = 1;
+        nodal: shellform.nonlinear.loads.NodalLoads."""
+        self.model, self.bcs, self.nodal = model, bcs, nodal
+        self.controls = controls or Controls()
+        self.controls.check()
+        self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
+        self.verbose = verbose
+        V = model.V
+        self.q = fem.Function(V, name="carrier")
+        self.q_prev = fem.Function(V)
+        self.prescribed = prescribed  # Function with qbar on the Dirichlet dofs (or None: zero)
+        self.bc_dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])) if bcs else \
+            np.zeros(0, dtype=np.int32)
+        self.lam = 0.0
+        self.history: list[Increment] = []
+        self.times = {"element_s": 0.0, "constitutive_s": 0.0, "assembly_s": 0.0, "solve_s": 0.0}
+        # external load at lambda = 1: dead pressure (element vectors assembled once)
+        self.f_ext = fem_petsc.create_vector(V)
+        self.f_ext.set(0.0)
+        if pressure:
+            model.forms.vectors[:] = pressure * model.pressure_load()
+            fem_petsc.assemble_vector(self.f_ext, model.forms.vector)
+            self.f_ext.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.A = fem_petsc.create_matrix(model.forms.matrix)
+        self.b = fem_petsc.create_vector(V)
+        self.dq = fem.Function(V)
+        self.ksp = PETSc.KSP().create(V.mesh.comm)
+        self.ksp.setOperators(self.A)
+        self.ksp.setType("preonly")
+        self.ksp.getPC().setType("lu")
+        self.ksp.getPC().setFactorSolverType("mumps")
+        self._dlam_prev = None
+        self._free = None
+
+    # -- residual and tangent ----------------------------------------------------------------
+    def _set_dirichlet(self, lam):
+        x = self.q.x.array
+        x[self.bc_dofs] = lam * self.prescribed.x.array[self.bc_dofs] if self.prescribed else 0.0
+
+    def residual(self, lam, tangent: bool):
+        """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free|, scale, ev)."""
+        m = self.model
+        self.q.x.scatter_forward()
+        ev = m.evaluate(self.q, tangent=tangent)
+        t0 = time.perf_counter()
+        with self.b.localForm() as bl:
+            bl.set(0.0)
+        fem_petsc.assemble_vector(self.b, m.forms.vector)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        # scale of the residual: the element forces before they cancel in the sum (round-off)
+        f_int = np.sqrt(m.mesh.comm.allreduce(float(np.sum(m.forms.vectors**2)), op=MPI.SUM))
+        self.b.axpy(-lam, self.f_ext)
+        R = self.b.getArray(readonly=False)
+        if tangent:
+            self.A.zeroEntries()
+            fem_petsc.assemble_matrix(self.A, m.forms.matrix, bcs=self.bcs)
+            self.A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
+            self.A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+        if self.nodal is not None:
+            self.nodal.add(lam, self.q.x.array, R, self.A if tangent else None)
+        if tangent:
+            self.A.assemble()
+        owned = self.bc_dofs[self.bc_dofs < R.size]
+        self.reactions = R[owned].copy()
+        R[owned] = 0.0
+        del R
+        self.times["element_s"] += ev.element_s
+        self.times["constitutive_s"] += ev.constitutive_s
+        self.times["assembly_s"] += time.perf_counter() - t0
+        ext = abs(lam) * self.f_ext.norm()
+        if self.nodal is not None:
+            ext = max(ext, abs(lam) * self.nodal.magnitude())
+        return self.b.norm(), max(f_int, ext), ev
+
+    def _solve(self):
+        t0 = time.perf_counter()
+        self.b.scale(-1.0)
+        self.ksp.solve(self.b, self.dq.x.petsc_vec)
+        self.times["solve_s"] += time.perf_counter() - t0
+        if self.ksp.getConvergedReason() < 0:
+            return False
+        self.dq.x.scatter_forward()
+        self.dq.x.array[self.bc_dofs] = 0.0
+        return bool(np.all(np.isfinite(self.dq.x.array)))
+
+    # -- one increment -------------------------------------------------------------------------
+    def _newton(self, lam):
+        """Newton at load factor lam from the current q; returns (converged, iterations, residuals, ev)."""
+        c = self.controls
+        self._set_dirichlet(lam)
+        norm, scale, ev = self.residual(lam, tangent=True)
+        residuals = [norm]
+        for it in range(1, c.max_iterations + 1):
+            if not np.isfinite(norm) or ev.failures:
+                return False, it, residuals, ev
+            if norm <= c.rtol * scale:
+                return True, it - 1, residuals, ev
+            if it > 1 and step <= c.stol * np.abs(self.q.x.array).max() and norm <= 1e3 * c.rtol * scale:
+                return True, it - 1, residuals, ev
+            R0 = self.b.copy()
+            ok = self._solve()
+            if not ok:
+                R0.destroy()
+                return False, it, residuals, ev
+            x0 = self.q.x.array.copy()
+            s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) = -dq . K dq < 0: the energy slope
+            alpha, accepted = 1.0, False
+            for _ in range(c.line_search + 1):
+                self.q.x.array[:] = x0 + alpha * self.dq.x.array
+                trial, scale, ev = self.residual(lam, tangent=True)
+                if not np.isfinite(trial) or ev.failures:
+                    alpha *= 0.5  # outside the material's reach: shorten
+                    continue
+                s1 = self.dq.x.petsc_vec.dot(self.b)
+                if s1 <= abs(s0) or s0 >= 0:  # not past the energy minimum along dq by much
+                    accepted = True
+                    break
+                alpha *= max(0.1, min(0.5, s0 / (s0 - s1)))  # secant towards dq . R = 0
+            R0.destroy()
+            if not accepted:
+                return False, it, residuals, ev
+            norm = trial
+            step = alpha * np.abs(self.dq.x.array).max()
+            residuals.append(norm)
+        converged = np.isfinite(norm) and norm <= c.rtol * scale
+        return converged, c.max_iterations, residuals, ev
+
+    def _predict(self, dlam, x_n, x_prev):
+        if self.controls.predictor and self._dlam_prev:
+            self.q.x.array[:] = x_n + (dlam / self._dlam_prev) * (x_n - x_prev)
+        else:
+            self.q.x.array[:] = x_n
+
+    def run(self, target: float = 1.0, on_increment=None):
+        """Step lambda from its current value to `target` (up or down)."""
+        c = self.controls
+        direction = 1.0 if target >= self.lam else -1.0
+        dlam = min(c.initial_step, abs(target - self.lam))
+        x_prev = self.q.x.array.copy()
+        while abs(target - self.lam) > 1e-14:
+            dlam = min(dlam, abs(target - self.lam))
+            x_n = self.q.x.array.copy()
+            cutbacks = 0
+            while True:
+                lam = self.lam + direction * dlam
+                self._predict(dlam, x_n, x_prev)
+                t0 = time.perf_counter()
+                ok, its, res, ev = self._newton(lam)
+                if ok:
+                    break
+                self.q.x.array[:] = x_n
+                cutbacks += 1
+                dlam *= c.cut
+                if self.verbose:
+                    say(f"  cut back: lambda {lam:.6g} failed after {its} iterations "
+                        f"(|R| {res[-1]:.3e}{', return mapping failed' if ev.failures else ''}); "
+                        f"retry with dlambda {dlam:.3g}")
+                if dlam < c.min_step:
+                    path = self.save_checkpoint()
+                    raise ConvergenceFailure(
+                        f"increment at lambda {self.lam:.6g} -> {lam:.6g} did not converge and the step "
+                        f"fell below min_step {c.min_step:g}", path)
+                self._dlam_prev = None  # no extrapolation after a failure
+            self.model.commit()
+            x_prev = x_n
+            self.lam = lam
+            self._dlam_prev = dlam
+            inc = Increment(len(self.history) + 1, lam, dlam, its, res, ev.plastic_layers, cutbacks,
+                            {"wall_s": time.perf_counter() - t0})
+            self.history.append(inc)
+            if self.verbose:
+                say(f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "
+                    f"|R| {res[0]:.2e} -> {res[-1]:.2e}  plastic layers {ev.plastic_layers}")
+            if on_increment is not None:
+                on_increment(self)
+            if its <= c.easy_iterations and cutbacks == 0:
+                dlam = min(dlam * c.growth, c.max_step)
+        return self.history
+
+    # -- disk ----------------------------------------------------------------------------------
+    def save_checkpoint(self):
+        """The last converged state: carrier values, material state, history (npz + json)."""
+        if self.checkpoint_dir is None:
+            return None
+        d = self.checkpoint_dir
+        d.mkdir(parents=True, exist_ok=True)
+        rank = self.model.mesh.comm.rank
+        path = d / f"last_converged.rank{rank}.npz"
+        m = self.model
+        np.savez(path, lam=self.lam, q=self.q.x.array, ep=m.ep_n, p=m.p_n)
+        if rank == 0:
+            (d / "history.json").write_text(json.dumps([asdict(h) for h in self.history], indent=1))
+        return path

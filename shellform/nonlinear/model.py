@@ -1,0 +1,119 @@
+"""The nonlinear sheet on one mesh: carrier, per-cell data, material state, element forces.
+
+``SheetModel.evaluate(q)`` runs the element loop (shellform.assembly.sheet_kernels) over the
+owned cells at the carrier state q and hands the element vectors and matrices to DOLFINx through
+two cell-wise "copy" forms (assemble.py), so DOLFINx owns assembly, ghosts and boundary
+conditions. The material state (plastic strain and equivalent plastic strain per quadrature
+point and thickness layer) is committed only when an increment converges.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem
+
+from shellform.assembly.kernels import check_mesh
+from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
+from shellform.assembly.sheet_kernels import SheetKernels
+from shellform.material import section
+from shellform.material.update import section_update
+from shellform.nonlinear.assemble import CellArrayForms
+
+
+@dataclass
+class Evaluation:
+    """Counts and times of one evaluation of the element loops."""
+
+    plastic_layers: int  # quadrature-point layers that flowed plastically
+    failures: int  # layers whose return mapping did not converge
+    element_s: float  # kinematics and element tensors (FFCx kernels, maps)
+    constitutive_s: float  # the section update
+
+
+class SheetModel:
+    """Mesh, effects, material and state of the nonlinear sheet."""
+
+    components = COMPONENTS
+
+    def __init__(self, mesh, material, thickness: float, effects=("geometric_nonlinearity",),
+                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4):
+        check_mesh(mesh)
+        self.mesh, self.effects = mesh, tuple(effects)
+        self.nonlinear = "geometric_nonlinearity" in self.effects
+        self.plastic = "plasticity" in self.effects
+        self.shallow = kappa0 is not None
+        self.kernels = SheetKernels.get(self.nonlinear, self.shallow, mesh.comm, quadrature_degree)
+        self.material = np.asarray(material, dtype=np.float64)
+        self.thickness = float(thickness)
+        self.consts = np.zeros(4) if kappa0 is None else np.asarray(kappa0, dtype=np.float64).ravel()
+        self.V = fem.functionspace(mesh, ("Lagrange", 1, (BS,)))
+        tdim = mesh.topology.dim
+        self.num_cells = mesh.topology.index_map(tdim).size_local
+        self.cells = np.arange(self.num_cells, dtype=np.int32)
+        self.dofs = np.ascontiguousarray(self.V.dofmap.list[: self.num_cells], dtype=np.int32)
+        g = mesh.geometry
+        self.cell_coords = np.ascontiguousarray(g.x[g.dofmap[: self.num_cells]].reshape(self.num_cells, 9))
+        el = self.kernels.element
+        self.nqp = el.nqp
+        self.P = np.zeros((self.num_cells, el.sym_dim, 9))
+        self.pressure_vectors = np.zeros((self.num_cells, NDOF))
+        self.kernels.setup(self.cell_coords, self.P, self.pressure_vectors)
+        # Material state: committed (n) and trial, per cell, quadrature point and layer.
+        nz = thickness_points if self.plastic else 1
+        if self.plastic:
+            self.zeta, self.wz = section.through_thickness_rule(thickness_points)
+        else:
+            self.zeta, self.wz = np.zeros(1), np.ones(1)
+        shape = (self.num_cells, self.nqp, nz)
+        self.ep_n, self.p_n = np.zeros(shape + (3,)), np.zeros(shape)
+        self.ep, self.p = np.zeros(shape + (3,)), np.zeros(shape)
+        self.z = np.zeros((self.num_cells, el.nz))
+        self.strain = np.zeros((self.num_cells, self.nqp, 6))
+        self.resultants = np.zeros((self.num_cells, self.nqp, 6))
+        self.tangents = np.zeros((self.num_cells, self.nqp, 6, 6))
+        self.forms = CellArrayForms(self.V, self.cells, NDOF)
+
+    # -- the element loop -------------------------------------------------------------------
+    def evaluate(self, q: fem.Function, tangent: bool = True) -> Evaluation:
+        """Element forces (and tangents) at the carrier state q, into the copy forms."""
+        k = self.kernels
+        t0 = time.perf_counter()
+        k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.z,
+                      self.strain)
+        t1 = time.perf_counter()
+        nplastic, nfail = section_update(self.strain, self.material, self.thickness, self.plastic, self.zeta,
+                                         self.wz, self.ep_n, self.p_n, self.ep, self.p, self.resultants,
+                                         self.tangents)
+        t2 = time.perf_counter()
+        k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.z, self.resultants,
+                      self.tangents, tangent, self.forms.vectors, self.forms.matrices)
+        t3 = time.perf_counter()
+        return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1)
+
+    def commit(self) -> None:
+        """Accept the trial material state (an increment converged)."""
+        self.ep_n[...] = self.ep
+        self.p_n[...] = self.p
+
+    def pressure_load(self) -> np.ndarray:
+        """Element vectors of a unit dead pressure along +z."""
+        return self.pressure_vectors
+
+    # -- output fields ------------------------------------------------------------------------
+    def cell_fields(self) -> dict[str, np.ndarray]:
+        """Per owned cell, averaged over its quadrature points: equivalent plastic strain
+        (max over the layers) and thickness strain of the mid-surface (mean over the layers)."""
+        from shellform.material import hill79
+
+        peq = self.p_n.max(axis=2).mean(axis=1)
+        e33 = np.zeros(self.num_cells)
+        for c in range(self.num_cells):
+            acc = 0.0
+            for g in range(self.nqp):
+                em = self.strain[c, g, :3]
+                for k in range(self.zeta.size):
+                    layer = em + self.zeta[k] * self.thickness * self.strain[c, g, 3:]
+                    acc += self.wz[k] * hill79.thickness_strain(layer, self.ep_n[c, g, k], self.material)
+            e33[c] = acc / self.nqp
+        return {"equivalent_plastic_strain": peq, "thickness_strain": e33}
