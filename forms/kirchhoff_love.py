@@ -91,15 +91,17 @@ def internal_work(e, S, dx):
     return ufl.inner(S, e) * dx
 
 
-def tangent(e, de, te, S, D, z, dz, tz, dx):
+def tangent(e, de, te, S, D, z, dz, tz, dx, nonlinear=True):
     """The consistent tangent: material part de . D . te plus initial-stress part S . d2e.
 
     de, te: the first variations of e in the test and trial directions; the initial-stress
-    (geometric) stiffness K^s is the second variation of e weighted by the resultants S.
+    (geometric) stiffness K^s is the second variation of e weighted by the resultants S (zero
+    for the linearised strains).
     """
     material = ufl.inner(de, ufl.dot(D, te)) * dx
-    initial_stress = ufl.derivative(ufl.derivative(ufl.inner(S, e) * dx, z, dz), z, tz)
-    return material + initial_stress
+    if not nonlinear:
+        return material
+    return material + ufl.derivative(ufl.derivative(ufl.inner(S, e) * dx, z, dz), z, tz)
 
 
 def weak_hessian_constraint(Psi, H, w, g, n):

@@ -2,8 +2,11 @@
 
 A scene states the geometry of the blank, its reference surface, the mesh, the material, the
 supports, the loads and the physical effects to simulate; only the terms of those effects are
-assembled. Every bad value raises shellform.errors.InputError naming its field, e.g.
-``material.thickness: must be > 0, got -1.0``. See docs/scenes.md for every key.
+assembled. A scene with any of the effects geometric_nonlinearity, plasticity, anisotropy
+(``Scene.nonlinear``) is a nonlinear elastic-plastic sheet, stepped through the load factors of
+its [process] section; ``Scene.hill79()`` is its material. Every bad value raises
+shellform.errors.InputError naming its field, e.g. ``material.thickness: must be > 0, got -1.0``.
+See docs/scenes.md for every key.
 """
 
 import math
@@ -11,14 +14,17 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from forms.functional import EFFECTS
+from forms.functional import EFFECTS, NONLINEAR_EFFECTS
 from shellform.errors import InputError
 
-SUPPORTS = ("simply_supported", "clamped", "symmetry", "free")
+SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
+NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
 SIDES = ("left", "right", "bottom", "top")
 REGIONS = ("full", "quarter")
 MESH_KINDS = ("structured", "unstructured")
 DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
+HARDENING = ("none", "power", "swift")
+CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n")}
 
 
 @dataclass
@@ -47,6 +53,13 @@ class Material:
     E: float = 1.0
     nu: float = 0.3
     thickness: float = 0.01
+    hardening: str = "none"  # "none" (elastic), "power" (yield_stress, n) or "swift" (K, eps0, n)
+    yield_stress: float = 0.0  # power law: sigma_y (0: unset)
+    n: float = 0.0  # power law: n >= 1; Swift: n >= 0
+    K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset)
+    eps0: float = 0.0  # Swift (0: unset)
+    r: float = 1.0  # Lankford coefficient of Hill 1979 (> 0; != 1 needs 'anisotropy')
+    m: float = 2.0  # Hill 1979 exponent (>= 1; != 2 needs 'anisotropy')
 
 
 @dataclass
@@ -54,12 +67,21 @@ class PointLoad:
     x: float = 0.0
     y: float = 0.0
     fz: float = 0.0  # force along +w
+    fx: float = 0.0  # in-plane forces along +x, +y (need 'membrane')
+    fy: float = 0.0
+
+
+@dataclass
+class EdgeMoment:
+    side: str = ""  # left, right, bottom or top
+    m: float = 0.0  # per unit length about the side's tangent; > 0 turns the outward fibre towards +z
 
 
 @dataclass
 class Loads:
     pressure: float = 0.0  # uniform, along +w
     point: list[PointLoad] = field(default_factory=list)
+    moment: list[EdgeMoment] = field(default_factory=list)  # nonlinear scenes only
 
 
 @dataclass
@@ -73,6 +95,20 @@ class Supports:
 @dataclass
 class Solver:
     mapped: bool = True  # False: no Jacobian map of the slopes (plain DOLFINx); for studies only
+
+
+@dataclass
+class Process:
+    """Load stepping of the nonlinear sheet (shellform.nonlinear.driver); ignored by linear scenes."""
+
+    thickness_points: int = 5  # Gauss points through the thickness (>= 2 with plasticity)
+    initial_step: float = 0.1  # first load-factor increment
+    min_step: float = 1e-4  # 0 < min_step <= initial_step <= max_step <= 1
+    max_step: float = 0.25
+    max_iterations: int = 12  # Newton iterations per increment (>= 1)
+    rtol: float = 1e-9  # residual tolerance (> 0)
+    path: list[float] = field(default_factory=lambda: [1.0])  # load factors to step through, in order
+    report: list[float] = field(default_factory=list)  # load factors at which results are recorded
 
 
 @dataclass
@@ -92,6 +128,7 @@ class Scene:
     supports: Supports = field(default_factory=Supports)
     loads: Loads = field(default_factory=Loads)
     solver: Solver = field(default_factory=Solver)
+    process: Process = field(default_factory=Process)
     output: Output = field(default_factory=Output)
 
     def __post_init__(self):
@@ -101,11 +138,30 @@ class Scene:
     def kappa0(self) -> tuple[float, float]:
         return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
 
+    @property
+    def nonlinear(self) -> bool:
+        """Whether any effect of the nonlinear sheet is on (forms.functional.NONLINEAR_EFFECTS)."""
+        return any(e in NONLINEAR_EFFECTS for e in self.effects)
+
+    def hill79(self):
+        """The scene's shellform.material.Hill79Material: elastic (hardening "none") unless the
+        effect 'plasticity' is on. Its own validation names the field (material.yield_stress, ...)."""
+        from shellform.material import Hill79Material  # numba modules: imported only when needed
+
+        mat = self.material
+        if "plasticity" not in self.effects:
+            return Hill79Material(mat.E, mat.nu, mat.r, mat.m)
+        unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
+        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
+        n = unset(mat.n) if mat.hardening == "power" else mat.n
+        return Hill79Material(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
+                              unset(mat.K), unset(mat.eps0))
+
 
 # -- reading ---------------------------------------------------------------------------------
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
-    "supports": Supports, "solver": Solver, "output": Output,
+    "supports": Supports, "solver": Solver, "process": Process, "output": Output,
 }
 
 
@@ -114,6 +170,18 @@ def _number(value, name, integer=False):
     if isinstance(value, bool) or not ok:
         raise InputError(name, f"must be {'an integer' if integer else 'a number'}, got {value!r}")
     return value if integer else float(value)
+
+
+def _numbers(value, name) -> list[float]:
+    if not isinstance(value, list):
+        raise InputError(name, f"must be a list of numbers, got {value!r}")
+    return [_number(v, name) for v in value]
+
+
+def _records(cls, tables, name) -> list:
+    if not isinstance(tables, list):
+        raise InputError(name, f"must be an array of tables [[{name}]]")
+    return [_record(cls, t, f"{name}[{i}]") for i, t in enumerate(tables)]
 
 
 def _record(cls, data, name):
@@ -132,6 +200,8 @@ def _record(cls, data, name):
             value = _number(value, f"{name}.{key}", integer=isinstance(default, int))
         elif isinstance(default, str) and not isinstance(value, str):
             raise InputError(f"{name}.{key}", f"must be a string, got {value!r}")
+        elif isinstance(default, list):  # lists of numbers (process.path, process.report)
+            value = _numbers(value, f"{name}.{key}")
         values[key] = value
     return cls(**values)
 
@@ -147,11 +217,10 @@ def from_dict(data: dict) -> Scene:
         loads = dict(data["loads"]) if isinstance(data["loads"], dict) else data["loads"]
         if not isinstance(loads, dict):
             raise InputError("loads", "must be a table")
-        points = loads.pop("point", [])
-        if not isinstance(points, list):
-            raise InputError("loads.point", "must be an array of tables [[loads.point]]")
+        points = _records(PointLoad, loads.pop("point", []), "loads.point")
+        moments = _records(EdgeMoment, loads.pop("moment", []), "loads.moment")
         kwargs["loads"] = _record(Loads, loads, "loads")
-        kwargs["loads"].point = [_record(PointLoad, p, f"loads.point[{i}]") for i, p in enumerate(points)]
+        kwargs["loads"].point, kwargs["loads"].moment = points, moments
     if "effects" in data:
         effects = data["effects"]
         if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
@@ -180,15 +249,8 @@ def _require(cond, name, message):
 
 
 def validate(s: Scene) -> None:
-    for e in s.effects:
-        _require(e in EFFECTS, "effects", f"unknown effect {e!r}; known effects: {', '.join(EFFECTS)}")
-    _require(len(set(s.effects)) == len(s.effects), "effects", "an effect is listed twice")
-    _require("bending" in s.effects or "membrane" in s.effects, "effects",
-             "needs 'bending' or 'membrane' (nothing would be assembled)")
-    if "shallow_curvature" in s.effects:
-        _require("bending" in s.effects and "membrane" in s.effects, "effects",
-                 "'shallow_curvature' couples membrane and bending: switch both on")
-    g, m, mat = s.geometry, s.mesh, s.material
+    _validate_effects(s)
+    g, m = s.geometry, s.mesh
     for name in ("lx", "ly"):
         v = getattr(g, name)
         _require(math.isfinite(v) and v > 0, f"geometry.{name}", f"must be > 0, got {v}")
@@ -203,21 +265,110 @@ def validate(s: Scene) -> None:
     _require(m.n >= 1, "mesh.n", f"must be >= 1, got {m.n}")
     _require(m.refine >= 0, "mesh.refine", f"must be >= 0, got {m.refine}")
     _require(m.diagonal in DIAGONALS, "mesh.diagonal", f"must be one of {DIAGONALS}, got {m.diagonal!r}")
+    _validate_material(s)
+    for side in SIDES:
+        v = getattr(s.supports, side)
+        _require(v in SUPPORTS, f"supports.{side}", f"unknown support {v!r}; known supports: {', '.join(SUPPORTS)}")
+        _require(v not in NONLINEAR_SUPPORTS or s.nonlinear, f"supports.{side}", f"{v!r} is a support of the "
+                 f"nonlinear sheet: needs one of the effects {', '.join(NONLINEAR_EFFECTS)}")
+    _validate_loads(s)
+    _validate_process(s)
+
+
+def _validate_effects(s: Scene) -> None:
+    for e in s.effects:
+        _require(e in EFFECTS, "effects", f"unknown effect {e!r}; known effects: {', '.join(EFFECTS)}")
+    _require(len(set(s.effects)) == len(s.effects), "effects", "an effect is listed twice")
+    _require("bending" in s.effects or "membrane" in s.effects, "effects",
+             "needs 'bending' or 'membrane' (nothing would be assembled)")
+    if "shallow_curvature" in s.effects:
+        _require("bending" in s.effects and "membrane" in s.effects, "effects",
+                 "'shallow_curvature' couples membrane and bending: switch both on")
+    for e in s.effects:
+        if e in NONLINEAR_EFFECTS:
+            _require("bending" in s.effects and "membrane" in s.effects, "effects",
+                     f"{e!r} is an effect of the nonlinear sheet, a full shell: switch on 'bending' and 'membrane'")
+    _require("anisotropy" not in s.effects or "plasticity" in s.effects, "effects",
+             "'anisotropy' shapes the yield function: it needs 'plasticity'")
+
+
+def _validate_material(s: Scene) -> None:
+    mat = s.material
     _require(math.isfinite(mat.E) and mat.E > 0, "material.E", f"must be > 0, got {mat.E}")
     _require(-1.0 < mat.nu < 0.5, "material.nu", f"must lie in (-1, 0.5), got {mat.nu}")
     _require(math.isfinite(mat.thickness) and mat.thickness > 0, "material.thickness",
              f"must be > 0, got {mat.thickness}")
-    for side in SIDES:
-        v = getattr(s.supports, side)
-        _require(v in SUPPORTS, f"supports.{side}", f"unknown support {v!r}; known supports: {', '.join(SUPPORTS)}")
-    _require(math.isfinite(s.loads.pressure), "loads.pressure", "must be finite")
-    needs_w = s.loads.pressure != 0 or any(p.fz != 0 for p in s.loads.point)
+    _require(math.isfinite(mat.r) and mat.r > 0, "material.r", f"must be > 0, got {mat.r}")
+    _require(math.isfinite(mat.m) and mat.m >= 1, "material.m",
+             f"must be >= 1 (convex yield function), got {mat.m}")
+    if "anisotropy" not in s.effects:
+        _require(mat.r == 1.0, "material.r", f"r = {mat.r} (isotropic: 1) needs the effect 'anisotropy'")
+        _require(mat.m == 2.0, "material.m", f"m = {mat.m} (von Mises: 2) needs the effect 'anisotropy'")
+    _require(mat.hardening in HARDENING, "material.hardening",
+             f"must be one of {', '.join(HARDENING)}, got {mat.hardening!r}")
+    plastic = "plasticity" in s.effects
+    if not plastic:
+        _require(mat.hardening == "none", "material.hardening",
+                 "set, but the scene's effects do not include 'plasticity'")
+    elif mat.hardening == "none":
+        raise InputError("material.hardening",
+                         "plasticity needs a hardening curve: 'power' (yield_stress, n) or 'swift' (K, eps0, n)")
+    for name in ("yield_stress", "n", "K", "eps0"):
+        v = getattr(mat, name)
+        _require(math.isfinite(v), f"material.{name}", f"must be finite, got {v}")
+        if v != 0.0:
+            _require(plastic, f"material.{name}", "set, but the scene's effects do not include 'plasticity'")
+            _require(name in CURVE_PARAMETERS[mat.hardening], f"material.{name}",
+                     f"is no parameter of hardening = {mat.hardening!r} "
+                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")
+    if plastic:
+        s.hill79()  # Hill79Material validates the curve and names the field
+
+
+def _validate_loads(s: Scene) -> None:
+    g, loads = s.geometry, s.loads
+    _require(math.isfinite(loads.pressure), "loads.pressure", "must be finite")
+    for i, p in enumerate(loads.point):
+        for name in ("x", "y", "fx", "fy", "fz"):
+            _require(math.isfinite(getattr(p, name)), f"loads.point[{i}].{name}", "must be finite")
+    needs_w = loads.pressure != 0 or any(p.fz != 0 for p in loads.point)
     _require(not needs_w or "bending" in s.effects, "loads", "transverse loads need the effect 'bending'")
     x0, x1, y0, y1 = bounds(s)
     tol = 1e-12 * max(g.lx, g.ly)
-    for i, p in enumerate(s.loads.point):
+    for i, p in enumerate(loads.point):
         _require(x0 - tol <= p.x <= x1 + tol and y0 - tol <= p.y <= y1 + tol, f"loads.point[{i}]",
                  f"({p.x}, {p.y}) lies outside the blank [{x0}, {x1}] x [{y0}, {y1}]")
+        _require((p.fx == 0 and p.fy == 0) or "membrane" in s.effects, f"loads.point[{i}]",
+                 "in-plane forces (fx, fy) need the effect 'membrane'")
+    for i, mo in enumerate(loads.moment):
+        _require(mo.side in SIDES, f"loads.moment[{i}].side", f"must be one of {', '.join(SIDES)}, got {mo.side!r}")
+        _require(math.isfinite(mo.m), f"loads.moment[{i}].m", f"must be finite, got {mo.m}")
+        _require(s.nonlinear, f"loads.moment[{i}]", "edge moments are loads of the nonlinear sheet: "
+                 f"need one of the effects {', '.join(NONLINEAR_EFFECTS)}")
+
+
+def _validate_process(s: Scene) -> None:
+    """Checked in every scene, though only nonlinear scenes step through a load path."""
+    pr = s.process
+    low = 2 if "plasticity" in s.effects else 1
+    _require(pr.thickness_points >= low, "process.thickness_points",
+             f"must be >= {low}{' with plasticity' if low == 2 else ''}, got {pr.thickness_points}")
+    for name in ("min_step", "initial_step", "max_step"):
+        v = getattr(pr, name)
+        _require(math.isfinite(v) and v > 0, f"process.{name}", f"must be > 0, got {v}")
+    _require(pr.min_step <= pr.initial_step, "process.min_step",
+             f"must be <= initial_step ({pr.initial_step}), got {pr.min_step}")
+    _require(pr.initial_step <= pr.max_step, "process.initial_step",
+             f"must be <= max_step ({pr.max_step}), got {pr.initial_step}")
+    _require(pr.max_step <= 1, "process.max_step", f"must be <= 1, got {pr.max_step}")
+    _require(pr.max_iterations >= 1, "process.max_iterations", f"must be >= 1, got {pr.max_iterations}")
+    _require(math.isfinite(pr.rtol) and pr.rtol > 0, "process.rtol", f"must be > 0, got {pr.rtol}")
+    _require(len(pr.path) > 0, "process.path", "must list at least one load factor, e.g. [1.0]")
+    _require(all(math.isfinite(v) for v in pr.path), "process.path", f"must be finite numbers, got {pr.path}")
+    lo, hi = min(0.0, *pr.path), max(0.0, *pr.path)  # the path starts at load factor 0
+    for v in pr.report:
+        _require(math.isfinite(v) and lo <= v <= hi, "process.report",
+                 f"{v} lies outside the load factors [{lo}, {hi}] that process.path covers")
 
 
 def bounds(s: Scene) -> tuple[float, float, float, float]:

@@ -40,6 +40,92 @@ def test_scene_errors_name_the_field(data, field):
     assert str(err.value).startswith(field + ":")
 
 
+FULL = ["bending", "membrane"]
+SHEET = FULL + ["geometric_nonlinearity"]
+PLASTIC = SHEET + ["plasticity"]
+POWER = {"hardening": "power", "yield_stress": 2.0e-3, "n": 5.0}
+
+
+@pytest.mark.parametrize("data, field", [
+    ({"effects": FULL + ["hyperelasticity"]}, "effects"),
+    ({"effects": ["membrane", "geometric_nonlinearity"]}, "effects"),  # the sheet is a full shell
+    ({"effects": SHEET + ["anisotropy"]}, "effects"),  # anisotropy without plasticity
+    ({"effects": PLASTIC}, "material.hardening"),  # plasticity without a curve
+    ({"effects": SHEET, "material": POWER}, "material.hardening"),  # a curve without plasticity
+    ({"effects": PLASTIC + ["anisotropy"], "material": {**POWER, "r": 0.0}}, "material.r"),
+    ({"effects": PLASTIC + ["anisotropy"], "material": {**POWER, "r": -1.5}}, "material.r"),
+    ({"material": {"r": 0.0}}, "material.r"),  # r > 0 even without plasticity
+    ({"effects": PLASTIC + ["anisotropy"], "material": {**POWER, "m": 0.5}}, "material.m"),
+    ({"material": {"m": 0.5}}, "material.m"),
+    ({"effects": PLASTIC, "material": {**POWER, "r": 1.5}}, "material.r"),  # r != 1 without anisotropy
+    ({"effects": PLASTIC, "material": {**POWER, "m": 8.0}}, "material.m"),
+    ({"effects": PLASTIC, "material": {"hardening": "power", "n": 5.0}}, "material.yield_stress"),
+    ({"effects": PLASTIC, "material": {"hardening": "power", "yield_stress": 2.0e-3}}, "material.n"),
+    ({"effects": PLASTIC, "material": {**POWER, "yield_stress": -1.0}}, "material.yield_stress"),
+    ({"effects": PLASTIC, "material": {"hardening": "swift", "eps0": 0.01, "n": 0.2}}, "material.K"),
+    ({"effects": PLASTIC, "material": {"hardening": "swift", "K": 1.0, "n": 0.2}}, "material.eps0"),
+    ({"effects": PLASTIC, "material": {**POWER, "K": 1.0}}, "material.K"),  # not a power-law parameter
+    ({"effects": PLASTIC, "material": {"hardening": "voce"}}, "material.hardening"),
+    ({"effects": PLASTIC, "material": {**POWER, "thickness": -0.01}}, "material.thickness"),
+    ({"effects": PLASTIC, "material": POWER, "process": {"thickness_points": 1}}, "process.thickness_points"),
+    ({"process": {"min_step": 0.2, "initial_step": 0.1}}, "process.min_step"),
+    ({"process": {"initial_step": 0.5, "max_step": 0.25}}, "process.initial_step"),
+    ({"process": {"max_step": 2.0}}, "process.max_step"),
+    ({"process": {"min_step": 0.0}}, "process.min_step"),
+    ({"process": {"max_iterations": 0}}, "process.max_iterations"),
+    ({"process": {"rtol": 0.0}}, "process.rtol"),
+    ({"process": {"path": []}}, "process.path"),
+    ({"process": {"path": [1.0, "unload"]}}, "process.path"),
+    ({"process": {"path": 1.0}}, "process.path"),
+    ({"process": {"path": [1.0, 0.0], "report": [1.5]}}, "process.report"),
+    ({"process": {"path": [1.0], "report": [-0.1]}}, "process.report"),
+    ({"process": {"steps": 10}}, "process.steps"),
+    ({"effects": SHEET, "loads": {"moment": [{"side": "front", "m": 1.0}]}}, "loads.moment[0].side"),
+    ({"effects": SHEET, "loads": {"moment": [{"side": "right", "m": "big"}]}}, "loads.moment[0].m"),
+    ({"effects": SHEET, "loads": {"moment": {"side": "right", "m": 1.0}}}, "loads.moment"),
+    ({"effects": FULL, "loads": {"moment": [{"side": "right", "m": 1.0}]}}, "loads.moment[0]"),
+    ({"loads": {"point": [{"fx": 1.0}]}}, "loads.point[0]"),  # in-plane force without membrane
+    ({"effects": FULL, "supports": {"right": "clamped_sliding"}}, "supports.right"),
+])
+def test_nonlinear_scene_errors_name_the_field(data, field):
+    with pytest.raises(InputError) as err:
+        scene.from_dict(data)
+    assert err.value.field == field
+    assert str(err.value).startswith(field + ":")
+
+
+def test_plasticity_without_a_curve_says_which_curves():
+    with pytest.raises(InputError, match="needs a hardening curve: 'power'.*'swift'"):
+        scene.from_dict({"effects": PLASTIC})
+
+
+def test_elastic_plastic_anisotropic_scene():
+    s = scene.from_dict({
+        "title": "deep-drawing blank",
+        "effects": PLASTIC + ["anisotropy"],
+        "geometry": {"region": "quarter"},
+        "material": {"E": 2.1e5, "nu": 0.3, "thickness": 0.8, "hardening": "swift", "K": 550.0,
+                     "eps0": 0.005, "n": 0.22, "r": 1.8, "m": 6.0},
+        "supports": {"left": "symmetry", "bottom": "symmetry", "right": "clamped_sliding", "top": "clamped"},
+        "loads": {"pressure": 1.0, "point": [{"x": 0.0, "y": 0.0, "fx": 0.5, "fz": 1.0}],
+                  "moment": [{"side": "right", "m": -2.0}]},
+        "process": {"thickness_points": 7, "initial_step": 0.05, "path": [1.0, 0.0],
+                    "report": [0.5, 1.0, 0.0]},
+    })
+    assert s.nonlinear
+    assert s.loads.moment == [scene.EdgeMoment("right", -2.0)]
+    assert s.process.path == [1.0, 0.0] and s.process.thickness_points == 7
+    mat = s.hill79().pack()
+    assert (mat[2], mat[3]) == (1.8, 6.0)  # r and m
+    assert list(mat) == [2.1e5, 0.3, 1.8, 6.0, 2.0, 550.0, 0.005, 0.22]  # law 2: Swift
+
+
+def test_linear_scenes_are_not_nonlinear():
+    s = scene.from_dict({"effects": FULL, "process": {"path": [0.5]}})  # [process] is allowed, ignored
+    assert not s.nonlinear
+    assert s.hill79().pack()[4] == 0.0  # elastic
+
+
 def test_mesh_that_is_not_triangles():
     msh = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2, mesh.CellType.quadrilateral)
     s = scene.from_dict({})

@@ -40,7 +40,26 @@ _OPTIONS = {"scalar_type": "float64"}
 
 def _cell_kernel(comm, form):
     ufcx, _, _ = ffcx_jit(comm, form, form_compiler_options=_OPTIONS)
+    if ufcx.form_integral_offsets[1] != 1:
+        raise RuntimeError(f"expected one cell integral, FFCx made {ufcx.form_integral_offsets[1]}")
     return ufcx.form_integrals[0].tabulate_tensor_float64, ufcx
+
+
+def packed_offsets(ufcx, form, coefficients) -> np.ndarray:
+    """Offset of each of `coefficients` in the kernel's packed w (-1 where the form lacks it).
+
+    FFCx packs only the coefficients a form still depends on after differentiation (the
+    linearised strains' tangent has no z and no S), in its own order.
+    """
+    original = form.coefficients()
+    out, start = -np.ones(len(coefficients), dtype=np.int64), 0
+    for i in range(ufcx.num_coefficients):
+        c = original[ufcx.original_coefficient_positions[i]]
+        for k, ck in enumerate(coefficients):
+            if c == ck:
+                out[k] = start
+        start += c.ufl_element().dim
+    return out
 
 
 def _facet_kernel(ufcx):
@@ -91,8 +110,12 @@ class SheetKernels:
         kappa0 = ufl.Constant(domain, shape=(2, 2)) if shallow else None
         e = kl.section_strain(U, H, x, kappa0, nonlinear)
         de, te = ufl.derivative(e, z, dz), ufl.derivative(e, z, tz)
-        self.force, _ = _cell_kernel(comm, kl.internal_work(de, Sq, dx))
-        self.tangent, _ = _cell_kernel(comm, kl.tangent(e, de, te, Sq, D, z, dz, tz, dx))
+        fforce = kl.internal_work(de, Sq, dx)
+        ftangent = kl.tangent(e, de, te, Sq, D, z, dz, tz, dx, nonlinear)
+        self.force, ufcx_f = _cell_kernel(comm, fforce)
+        self.tangent, ufcx_t = _cell_kernel(comm, ftangent)
+        self.force_offsets = packed_offsets(ufcx_f, fforce, [z, Sq, Dq])
+        self.tangent_offsets = packed_offsets(ufcx_t, ftangent, [z, Sq, Dq])
         p = ufl.Constant(domain)
         self.pressure, _ = _cell_kernel(comm, ufl.derivative(kl.dead_pressure(p, U, dx), z, dz))
         ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS)
@@ -203,7 +226,17 @@ class SheetKernels:
         qcols, qcodes = el.q_map()
         ccols = el.component_columns()
         nz, nqp, nconst = el.nz, el.nqp, self.nconst
+        fo, to = self.force_offsets, self.tangent_offsets
         ffi = _ffi
+
+        @numba.njit
+        def pack(w, offsets, z, S, D):
+            if offsets[0] >= 0:
+                w[offsets[0]: offsets[0] + nz] = z
+            if offsets[1] >= 0:
+                w[offsets[1]: offsets[1] + 6 * nqp] = S
+            if offsets[2] >= 0:
+                w[offsets[2]: offsets[2] + 36 * nqp] = D
 
         @numba.njit
         def loop(cells, cells_coords, P, consts, z, S, D, want_tangent, R_out, K_out):
@@ -220,14 +253,13 @@ class SheetKernels:
                 cidx = cells[k]
                 coords = cells_coords[cidx]
                 build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
-                w[:nz] = z[k]
-                w[nz: nz + 6 * nqp] = S[k].ravel()
-                w[nz + 6 * nqp:] = D[k].ravel()
+                pack(w, fo, z[k], S[k].ravel(), D[k].ravel())
                 rz[:] = 0.0
                 force(ffi.from_buffer(rz), ffi.from_buffer(w), ffi.from_buffer(c), ffi.from_buffer(coords),
                       ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
                 R_out[k, :] = Q.T @ rz
                 if want_tangent:
+                    pack(w, to, z[k], S[k].ravel(), D[k].ravel())
                     Kz[:, :] = 0.0
                     tangent(ffi.from_buffer(Kz), ffi.from_buffer(w), ffi.from_buffer(c),
                             ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),

@@ -3,7 +3,8 @@
 For each cell c and quadrature point g, from the section strains e = (E, K) (6), either the
 closed-form elastic section (no layers) or the layered elastic-plastic section from the
 committed state (ep_n, p_n) to the trial state (ep, p). Returns the resultants S (6), the
-section tangents D (6 x 6) and the counts of plastic and failed layers.
+section tangents D (6 x 6) and the counts of plastic and failed layers. A point whose strain is
+not finite or beyond 1000 % is not updated but counted as failed: the driver then cuts back.
 """
 
 import numba
@@ -12,7 +13,7 @@ import numpy as np
 from shellform.material import section
 
 
-@numba.njit(cache=True)
+@numba.njit  # not cached: numba would not see edits of section.py
 def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D):
     nplastic, nfail = 0, 0
     Sg = np.zeros(6)
@@ -21,7 +22,11 @@ def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D)
         for g in range(e.shape[1]):
             em = e[c, g, :3].copy()
             k = e[c, g, 3:].copy()
-            if plastic:
+            size = max(np.abs(em).max(), np.abs(k).max() * thickness)
+            if not np.isfinite(size) or size > 10.0:  # no material takes 1000 % strain: reject
+                nfail += 1
+                section.elastic_section(em * 0.0, k * 0.0, thickness, mat, Sg, Dg)
+            elif plastic:
                 st = section.section_response(em, k, thickness, zeta, wz, ep_n[c, g], p_n[c, g], mat,
                                               Sg, Dg, ep[c, g], p[c, g])
                 if st < 0:

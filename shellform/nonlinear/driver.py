@@ -4,13 +4,15 @@ The problem is  R(q, lambda) = f_int(q) - lambda f_ext(q) = 0  with prescribed v
 q_D = lambda qbar_D on the Dirichlet dofs (loads and prescribed displacements share lambda).
 Each increment lambda_n -> lambda_n + dlambda:
 
-    predictor   q = q_n + (dlambda / dlambda_prev) (q_n - q_n-1), then q_D = lambda qbar_D
-    Newton      K dq = -R (consistent tangent, dq_D = 0), q += alpha dq
+    predictor   q = q_n + (dlambda / dlambda_prev) (q_n - q_n-1) (after a converged increment)
+    Newton      K dq = -R (consistent tangent) with dq_D = lambda qbar_D - q_D in the first
+                iteration (lifted, so a prescribed displacement spreads through the structure
+                by the converged tangent), dq_D = 0 after; q += alpha dq
     line search on the energy slope s(alpha) = dq . R(q + alpha dq): alpha = 1 unless the step
                 overshoots the energy minimum along dq (s(1) > |s(0)|), then secant steps
                 towards s = 0; halved where the material update fails or |R| is not finite
-    converged   |R_free| <= rtol max(|lambda f_ext|, |element forces|) (the element forces
-                before they cancel in the sum: the scale of round-off), or a correction at
+    converged   |R_free| <= rtol max(|lambda f_ext|, |element forces|) or below the round-off
+                floor 1e3 eps max(K_ii) h (a very thin sheet), or a correction at
                 round-off level (|dq| <= stol |q|) with |R_free| <= 1e3 rtol max(...)
 
 A failing increment (too many iterations, a non-finite value, a failed return mapping, no
@@ -96,8 +98,9 @@ class Driver:
         self.q = fem.Function(V, name="carrier")
         self.q_prev = fem.Function(V)
         self.prescribed = prescribed  # Function with qbar on the Dirichlet dofs (or None: zero)
-        self.bc_dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])) if bcs else \
-            np.zeros(0, dtype=np.int32)
+        self.bc_dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])).astype(np.int32) \
+            if bcs else np.zeros(0, dtype=np.int32)
+        self.g = np.zeros_like(self.q.x.array)  # Dirichlet values at the current load factor
         self.lam = 0.0
         self.history: list[Increment] = []
         self.times = {"element_s": 0.0, "constitutive_s": 0.0, "assembly_s": 0.0, "solve_s": 0.0}
@@ -117,12 +120,15 @@ class Driver:
         self.ksp.getPC().setType("lu")
         self.ksp.getPC().setFactorSolverType("mumps")
         self._dlam_prev = None
-        self._free = None
+        self._floor = 0.0
 
     # -- residual and tangent ----------------------------------------------------------------
     def _set_dirichlet(self, lam):
-        x = self.q.x.array
-        x[self.bc_dofs] = lam * self.prescribed.x.array[self.bc_dofs] if self.prescribed else 0.0
+        """g = lam qbar on the Dirichlet dofs; returns the largest jump |g - q| there."""
+        g = self.g
+        g[self.bc_dofs] = lam * self.prescribed.x.array[self.bc_dofs] if self.prescribed else 0.0
+        jump = np.abs(g[self.bc_dofs] - self.q.x.array[self.bc_dofs]).max() if self.bc_dofs.size else 0.0
+        return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
 
     def residual(self, lam, tangent: bool):
         """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free|, scale, ev)."""
@@ -147,45 +153,60 @@ class Driver:
             self.nodal.add(lam, self.q.x.array, R, self.A if tangent else None)
         if tangent:
             self.A.assemble()
-        owned = self.bc_dofs[self.bc_dofs < R.size]
-        self.reactions = R[owned].copy()
-        R[owned] = 0.0
+        self.residual_full = R.copy()  # with the reactions on the Dirichlet rows
+        R[self.bc_dofs[self.bc_dofs < R.size]] = 0.0
         del R
         self.times["element_s"] += ev.element_s
         self.times["constitutive_s"] += ev.constitutive_s
         self.times["assembly_s"] += time.perf_counter() - t0
+        if tangent:  # the residual's round-off floor: eps times stiffness times a cell size
+            kmax = float(np.abs(np.einsum("cii->ci", m.forms.matrices)).max()) if m.num_cells else 0.0
+            self._floor = 1e3 * np.finfo(float).eps * m.mesh.comm.allreduce(kmax, op=MPI.MAX) * m.cell_size
         ext = abs(lam) * self.f_ext.norm()
         if self.nodal is not None:
             ext = max(ext, abs(lam) * self.nodal.magnitude())
-        return self.b.norm(), max(f_int, ext), ev
+        return self.b.norm(), max(f_int, ext, self._floor / self.controls.rtol), ev
 
-    def _solve(self):
+    def _solve(self, jump):
+        """dq = -K^-1 R with dq_D = g - q_D (lifted: the free rows see -K_fD (g - q_D))."""
         t0 = time.perf_counter()
         self.b.scale(-1.0)
+        if jump > 0:
+            delta = np.zeros_like(self.q.x.array)
+            delta[self.bc_dofs] = self.g[self.bc_dofs] - self.q.x.array[self.bc_dofs]
+            m = self.model
+            m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, delta[m.unrolled_dofs])
+            lift = fem_petsc.assemble_vector(m.forms.vector)
+            lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            self.b.axpy(-1.0, lift)
+            lift.destroy()
+            arr = self.b.getArray(readonly=False)
+            owned = self.bc_dofs[self.bc_dofs < arr.size]
+            arr[owned] = delta[owned]
+            del arr
         self.ksp.solve(self.b, self.dq.x.petsc_vec)
         self.times["solve_s"] += time.perf_counter() - t0
         if self.ksp.getConvergedReason() < 0:
             return False
         self.dq.x.scatter_forward()
-        self.dq.x.array[self.bc_dofs] = 0.0
         return bool(np.all(np.isfinite(self.dq.x.array)))
 
     # -- one increment -------------------------------------------------------------------------
     def _newton(self, lam):
         """Newton at load factor lam from the current q; returns (converged, iterations, residuals, ev)."""
         c = self.controls
-        self._set_dirichlet(lam)
+        jump = self._set_dirichlet(lam)
         norm, scale, ev = self.residual(lam, tangent=True)
         residuals = [norm]
         for it in range(1, c.max_iterations + 1):
             if not np.isfinite(norm) or ev.failures:
                 return False, it, residuals, ev
-            if norm <= c.rtol * scale:
+            if norm <= c.rtol * scale and jump == 0:
                 return True, it - 1, residuals, ev
             if it > 1 and step <= c.stol * np.abs(self.q.x.array).max() and norm <= 1e3 * c.rtol * scale:
                 return True, it - 1, residuals, ev
             R0 = self.b.copy()
-            ok = self._solve()
+            ok = self._solve(jump)
             if not ok:
                 R0.destroy()
                 return False, it, residuals, ev
@@ -206,6 +227,10 @@ class Driver:
             R0.destroy()
             if not accepted:
                 return False, it, residuals, ev
+            if alpha < 1.0 and jump > 0:
+                self.q.x.array[self.bc_dofs] = self.g[self.bc_dofs]  # the prescribed values
+                trial, scale, ev = self.residual(lam, tangent=True)
+            jump = 0.0
             norm = trial
             step = alpha * np.abs(self.dq.x.array).max()
             residuals.append(norm)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import fem
+from mpi4py import MPI
 
 from shellform.assembly.kernels import check_mesh
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
@@ -52,8 +53,13 @@ class SheetModel:
         self.num_cells = mesh.topology.index_map(tdim).size_local
         self.cells = np.arange(self.num_cells, dtype=np.int32)
         self.dofs = np.ascontiguousarray(self.V.dofmap.list[: self.num_cells], dtype=np.int32)
+        self.unrolled_dofs = (BS * self.dofs[:, :, None] + np.arange(BS)).reshape(self.num_cells, NDOF)
         g = mesh.geometry
         self.cell_coords = np.ascontiguousarray(g.x[g.dofmap[: self.num_cells]].reshape(self.num_cells, 9))
+        x = self.cell_coords.reshape(-1, 3, 3)
+        a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
+        area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+        self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element
         self.nqp = el.nqp
         self.P = np.zeros((self.num_cells, el.sym_dim, 9))

@@ -42,7 +42,8 @@ def observed_rates(rows: list[dict], size="cells", error="rel_error") -> list[fl
     return [math.nan] + [float(x) if np.isfinite(x) else math.nan for x in pairwise]
 
 
-def plot_error_time(path: Path, series: dict[str, list[dict]], title: str, error="rel_error") -> None:
+def plot_error_time(path: Path, series: dict[str, list[dict]], title: str, error="rel_error",
+                    ylabel=None) -> None:
     """Log-log |error| against total wall time, one line per series."""
     if MPI.COMM_WORLD.rank != 0:
         return
@@ -59,7 +60,7 @@ def plot_error_time(path: Path, series: dict[str, list[dict]], title: str, error
         ax.loglog(t, e, "o-", label=label)
     ax.set_xlabel(f"wall time per solve [s]: mesh + assemble + solve (kernels compiled once: "
                   f"at most {compile_s:.1f} s)")
-    ax.set_ylabel(f"|{error}| of the centre deflection")
+    ax.set_ylabel(ylabel or f"|{error}| of the centre deflection")
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)

@@ -1,0 +1,70 @@
+"""A nonlinear sheet problem on a rectangular blank: mesh -> model -> supports -> loads -> driver.
+
+    p = SheetProblem.on_rectangle(comm, lx, ly, region, n, material, thickness, effects,
+                                  supports, loads, prescribed, controls)
+    p.driver.run(1.0)
+    p.value("w", x, y), p.reaction(side, "w")
+
+`prescribed` maps (side, component) to the value reached at load factor 1 (displacement
+control); those components are also held on the side. Studies, tests and `shellform run` build
+their problems here.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from shellform import supports as named_supports
+from shellform.loads import value_at
+from shellform.mesh import SIDE_TAG, rectangle
+from shellform.nonlinear.driver import Controls, Driver
+from shellform.nonlinear.loads import NodalLoads, SheetLoads
+from shellform.nonlinear.model import SheetModel
+
+
+@dataclass
+class SheetProblem:
+    rect: object
+    model: SheetModel
+    driver: Driver
+    prescribed_dofs: dict
+
+    @classmethod
+    def on_rectangle(cls, comm, lx, ly, n, material, thickness, effects, supports, loads=None,
+                     prescribed=None, controls=None, region="full", kind="structured", diagonal="right",
+                     thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
+        loads = loads or SheetLoads()
+        points = [(p.x, p.y) for p in loads.points]
+        rect = rectangle(comm, lx, ly, region=region, kind=kind, n=n, diagonal=diagonal, points=points)
+        mat = material.pack() if hasattr(material, "pack") else np.asarray(material, dtype=np.float64)
+        model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0)
+        V, comps = model.V, model.components
+        bcs = named_supports.boundary_conditions(V, comps, rect.facet_tags, supports,
+                                                 fixed=named_supports.sheet_fixed_components)
+        qbar = fem.Function(V)
+        pdofs = {}
+        for (side, comp), value in (prescribed or {}).items():
+            sub = V.sub(comps.index(comp))
+            dofs = fem.locate_dofs_topological(sub, 1, rect.facet_tags.find(SIDE_TAG[side]))
+            qbar.x.array[dofs] = value
+            pdofs[(side, comp)] = dofs
+            bcs.append(fem.dirichletbc(np.float64(0), dofs, sub))
+        tol = 1e-9 * max(lx, ly)
+        nodal = NodalLoads(V, rect.facet_tags, loads, tol) if (loads.points or loads.moments) else None
+        driver = Driver(model, bcs, prescribed=qbar if prescribed else None, pressure=loads.pressure,
+                        nodal=nodal, controls=controls or Controls(), checkpoint_dir=checkpoint_dir,
+                        verbose=verbose)
+        return cls(rect, model, driver, pdofs)
+
+    def value(self, name: str, x: float, y: float) -> float:
+        tol = 1e-9 * max(b - a for a, b in zip(self.rect.bounds[0::2], self.rect.bounds[1::2]))
+        return value_at(self.driver.q, self.model.components, name, x, y, tol)
+
+    def reaction(self, side: str, comp: str) -> float:
+        """Sum over the side of the internal force conjugate to a prescribed component."""
+        dofs = self.prescribed_dofs[(side, comp)]
+        owned = self.model.V.dofmap.index_map.size_local * self.model.V.dofmap.index_map_bs
+        local = float(np.sum(self.driver.residual_full[dofs[dofs < owned]]))
+        return self.model.mesh.comm.allreduce(local, op=MPI.SUM)
