@@ -5,6 +5,9 @@ closed-form elastic section (no layers) or the layered elastic-plastic section f
 committed state (ep_n, p_n) to the trial state (ep, p). Returns the resultants S (6), the
 section tangents D (6 x 6) and the counts of plastic and failed layers. A point whose strain is
 not finite or beyond 1000 % is not updated but counted as failed: the driver then cuts back.
+``elastic_tangent`` returns the elastic section tangent with the elastic-plastic stresses: the
+first iteration after a load reversal, where a perfectly plastic tangent is (nearly) singular
+along the very direction in which the sheet unloads elastically.
 """
 
 import numba
@@ -14,7 +17,7 @@ from shellform.material import section
 
 
 @numba.njit  # not cached: numba would not see edits of section.py
-def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D):
+def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D, elastic_tangent=False):
     nplastic, nfail = 0, 0
     Sg = np.zeros(6)
     Dg = np.zeros((6, 6))
@@ -36,5 +39,7 @@ def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D)
             else:
                 section.elastic_section(em, k, thickness, mat, Sg, Dg)
             S[c, g, :] = Sg
+            if elastic_tangent:  # the unloading predictor: stresses plastic, tangent elastic
+                section.elastic_section(em, k, thickness, mat, np.zeros(6), Dg)
             D[c, g, :, :] = Dg
     return nplastic, nfail

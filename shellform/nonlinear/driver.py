@@ -120,6 +120,7 @@ class Driver:
         self.ksp.getPC().setType("lu")
         self.ksp.getPC().setFactorSolverType("mumps")
         self._dlam_prev = None
+        self._direction = None
         self._floor = 0.0
 
     # -- residual and tangent ----------------------------------------------------------------
@@ -130,11 +131,11 @@ class Driver:
         jump = np.abs(g[self.bc_dofs] - self.q.x.array[self.bc_dofs]).max() if self.bc_dofs.size else 0.0
         return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
 
-    def residual(self, lam, tangent: bool):
+    def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
         """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free|, scale, ev)."""
         m = self.model
         self.q.x.scatter_forward()
-        ev = m.evaluate(self.q, tangent=tangent)
+        ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
         t0 = time.perf_counter()
         with self.b.localForm() as bl:
             bl.set(0.0)
@@ -192,11 +193,12 @@ class Driver:
         return bool(np.all(np.isfinite(self.dq.x.array)))
 
     # -- one increment -------------------------------------------------------------------------
-    def _newton(self, lam):
-        """Newton at load factor lam from the current q; returns (converged, iterations, residuals, ev)."""
+    def _newton(self, lam, reversal=False):
+        """Newton at load factor lam from the current q; returns (converged, iterations, residuals, ev).
+        After a load reversal the first tangent is the elastic one (elastic unloading)."""
         c = self.controls
         jump = self._set_dirichlet(lam)
-        norm, scale, ev = self.residual(lam, tangent=True)
+        norm, scale, ev = self.residual(lam, tangent=True, elastic_tangent=reversal)
         residuals = [norm]
         for it in range(1, c.max_iterations + 1):
             if not np.isfinite(norm) or ev.failures:
@@ -247,6 +249,8 @@ class Driver:
         """Step lambda from its current value to `target` (up or down)."""
         c = self.controls
         direction = 1.0 if target >= self.lam else -1.0
+        reversal = self._direction is not None and direction != self._direction
+        self._direction = direction
         dlam = min(c.initial_step, abs(target - self.lam))
         x_prev = self.q.x.array.copy()
         while abs(target - self.lam) > 1e-14:
@@ -257,7 +261,7 @@ class Driver:
                 lam = self.lam + direction * dlam
                 self._predict(dlam, x_n, x_prev)
                 t0 = time.perf_counter()
-                ok, its, res, ev = self._newton(lam)
+                ok, its, res, ev = self._newton(lam, reversal)
                 if ok:
                     break
                 self.q.x.array[:] = x_n
@@ -274,6 +278,7 @@ class Driver:
                         f"fell below min_step {c.min_step:g}", path)
                 self._dlam_prev = None  # no extrapolation after a failure
             self.model.commit()
+            reversal = False
             x_prev = x_n
             self.lam = lam
             self._dlam_prev = dlam

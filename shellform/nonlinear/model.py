@@ -55,7 +55,7 @@ class SheetModel:
         self.dofs = np.ascontiguousarray(self.V.dofmap.list[: self.num_cells], dtype=np.int32)
         self.unrolled_dofs = (BS * self.dofs[:, :, None] + np.arange(BS)).reshape(self.num_cells, NDOF)
         g = mesh.geometry
-        self.cell_coords = np.ascontiguousarray(g.x[g.dofmap[: self.num_cells]].reshape(self.num_cells, 9))
+        self.cell_coords = np.ascontiguousarray(g.x[g.dofmaps[0][: self.num_cells]].reshape(self.num_cells, 9))
         x = self.cell_coords.reshape(-1, 3, 3)
         a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
         area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
@@ -81,7 +81,7 @@ class SheetModel:
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
 
     # -- the element loop -------------------------------------------------------------------
-    def evaluate(self, q: fem.Function, tangent: bool = True) -> Evaluation:
+    def evaluate(self, q: fem.Function, tangent: bool = True, elastic_tangent: bool = False) -> Evaluation:
         """Element forces (and tangents) at the carrier state q, into the copy forms."""
         k = self.kernels
         t0 = time.perf_counter()
@@ -90,7 +90,7 @@ class SheetModel:
         t1 = time.perf_counter()
         nplastic, nfail = section_update(self.strain, self.material, self.thickness, self.plastic, self.zeta,
                                          self.wz, self.ep_n, self.p_n, self.ep, self.p, self.resultants,
-                                         self.tangents)
+                                         self.tangents, elastic_tangent)
         t2 = time.perf_counter()
         k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.z, self.resultants,
                       self.tangents, tangent, self.forms.vectors, self.forms.matrices)

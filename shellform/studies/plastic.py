@@ -67,7 +67,7 @@ def solve(n, thickness_points=5, r=1.0, m=2.0) -> dict:
     d.run(1.0, on_increment=lambda drv: path.append((drv.lam, p.reaction("right", "w"))))
     b = L / n
     lam, P = np.array(path).T
-    dmax = float(p.driver.prescribed.x.array.max())
+    dmax = p.model.mesh.comm.allreduce(float(p.driver.prescribed.x.array.max()), op=MPI.MAX)
     k = P[0] / (lam[0] * dmax)  # the elastic slope (first increment is elastic)
     residual_pred = dmax - P[-1] / k
     d.run(residual_pred / dmax)  # unload the tip to where the elastic slope says P = 0

@@ -1,0 +1,89 @@
+"""Structural validation of the nonlinear sheet against closed forms and classical tables.
+
+- Levy's clamped plate in large deflection (validation.md section 2), his own edge conditions;
+- a strip rolled into a full circle by an end moment (section 3);
+- limit load and springback of an elastic-perfectly plastic cantilever (limit analysis);
+- effects: plasticity that stays elastic gives the elastic answer; the elastic path is cheaper.
+"""
+
+import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
+
+import numpy as np
+import pytest
+
+from shellform.material import Hill79Material
+from shellform.studies import levy, plastic, rollup
+
+
+def test_levy_clamped_plate():
+    """w_c/h within 2 % of Levy's table up to P = 318 and 2.1 % at P = 402 (16 x 16 quarter).
+
+    Our converged value at P = 402 is 2.03 % below Levy's (docs/levy.md: n = 24 gives the same),
+    inside the error Levy estimates for his own truncated series."""
+    rows = levy.solve(16)
+    errors = {r["P"]: abs(r["rel_error"]) for r in rows}
+    assert max(e for P, e in errors.items() if P <= 318) < 0.02, errors
+    assert errors[402.0] < 0.021, errors
+
+
+def test_levy_immovable_edges_are_stiffer():
+    """Edges held against sliding (validation.md's 'immovable') deflect less than Levy's."""
+    sliding = levy.solve(8, loads=[402.0])[-1]["w_over_h"]
+    immovable = levy.solve(8, "clamped", loads=[402.0])[-1]["w_over_h"]
+    assert immovable < sliding
+
+
+def test_rollup_full_circle():
+    """Tip within 1e-3 L of the exact arc at 8 stations up to M = 2 pi EI / L (a full circle)."""
+    r = rollup.solve(64)
+    assert r["max_tip_error"] < 1e-3, r["errors"]
+    assert r["full_circle_error"] < 1e-3
+
+
+def test_rollup_coarse_mesh_is_worse():
+    """The coarse mesh misses the tolerance: the fine one passes on accuracy, not luck."""
+    r = rollup.solve(16, stations=[0.5])
+    assert r["max_tip_error"] > 1e-3
+
+
+def test_plastic_limit_load_and_springback():
+    """P(d) rises to the limit load M_p b / L and levels off; unloading follows the elastic
+    slope, leaving the residual deflection it predicts (the reaction vanishes there)."""
+    r = plastic.solve(16, 9)
+    d, P = r["path"]
+    PL = plastic.limit_load(plastic.L / 16)
+    assert np.all(np.diff(P) > 0)  # monotonic hardening-free rise
+    assert abs(P[-1] / PL - 1) < 0.02  # limit analysis, within mesh and layer error
+    half = np.searchsorted(d, d[-1] / 2)
+    assert (P[-1] - P[half]) / P[-1] < 0.02  # a plateau: the hinge has formed
+    assert r["residual_deflection_error"] < 1e-8
+
+
+def test_plasticity_that_stays_elastic_is_elastic():
+    """The same plate with a yield stress never reached: the layered elastic-plastic path
+    gives the closed-form elastic path's answer to 1e-10 and never flows."""
+    strong = Hill79Material(E=1.0, nu=levy.NU, hardening="power", yield_stress=1e3, n=5.0)
+    nl = ("bending", "membrane", "geometric_nonlinearity")
+    elastic = levy.problem(4)
+    layered = levy.problem(4, effects=nl + ("plasticity",), material=strong)
+    for p in (elastic, layered):
+        p.driver.run(134.9 / max(levy.TABLE))
+    we, wl = elastic.value("w", 0, 0), layered.value("w", 0, 0)
+    assert abs(wl - we) <= 1e-10 * abs(we)
+    assert all(h.plastic_layers == 0 for h in layered.driver.history)
+    # the elastic path has no layers and spends less in the constitutive update
+    assert elastic.model.p_n.shape[2] == 1 and layered.model.p_n.shape[2] == 5
+    te = elastic.driver.times["constitutive_s"] / sum(h.iterations + 1 for h in elastic.driver.history)
+    tl = layered.driver.times["constitutive_s"] / sum(h.iterations + 1 for h in layered.driver.history)
+    assert te < tl
+
+
+@pytest.mark.parametrize("r, m", [(3.0, 2.0), (1.5, 8.0), (3.0, 8.0)])
+def test_anisotropic_limit_load(r, m):
+    """Strong anisotropy and a sharp yield surface: the limit load follows the plane-strain
+    yield stress of Hill 1979 (validation.md 4), and the run loads and unloads without a
+    failed return mapping. (Unloading is not purely elastic here: the narrow plane-strain
+    section of these yield surfaces lets the transverse stress re-yield, so no springback check.)"""
+    row = plastic.solve(16, 9, r=r, m=m)
+    assert abs(row["P_max_over_PL"] - 1) < 0.02
+    assert row["residual_deflection_error"] < 0.01
