@@ -1,7 +1,8 @@
 """The ``shellform`` command.
 
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
-    shellform study NAME --out DIR          run a study: plate, shell (convergence), assembly (benchmark)
+    shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
+                                            against time), assembly, newton (benchmarks)
 """
 
 import argparse
@@ -19,6 +20,10 @@ def run_scene(path: Path, outdir: Path) -> dict:
 
     s = scene.load(path)
     outdir.mkdir(parents=True, exist_ok=True)
+    if s.nonlinear:
+        from shellform.nonlinear import run as nonlinear_run
+
+        return nonlinear_run.run(s, outdir)
     t0 = time.perf_counter()
     res = linear.solve(s)
     cells = res.cell_fields()
@@ -35,6 +40,9 @@ def run_scene(path: Path, outdir: Path) -> dict:
     return summary
 
 
+STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "assembly", "newton"]
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="shellform", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -43,7 +51,7 @@ def main(argv=None) -> int:
     p_run.add_argument("scene", type=Path)
     p_run.add_argument("--out", type=Path, required=True)
     p_study = sub.add_parser("study", help="run a convergence study")
-    p_study.add_argument("name", choices=["plate", "shell", "assembly"])
+    p_study.add_argument("name", choices=STUDIES)
     p_study.add_argument("--out", type=Path, required=True)
     p_study.add_argument("--quick", action="store_true", help="coarse levels only (for tests)")
     args = parser.parse_args(argv)
@@ -53,12 +61,21 @@ def main(argv=None) -> int:
     try:
         if args.command == "run":
             summary = run_scene(args.scene, args.out)
-            print(f"shellform: {summary['title']}: {summary['cells']} cells, w_center = {summary['w_center']}, "
-                  f"{summary['wall_time_s']:.2f} s; results in {args.out}")
+            if "reports" in summary:
+                last = summary["reports"][-1] if summary["reports"] else {}
+                print(f"shellform: {summary['title']}: {summary['cells']} cells, {summary['increments']} "
+                      f"increments, load factor {last.get('load_factor')}, w = {last.get('w')}, "
+                      f"{summary['wall_time_s']:.2f} s; results in {args.out}")
+                if summary["stopped"]:
+                    print(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
+                    return 3
+            else:
+                print(f"shellform: {summary['title']}: {summary['cells']} cells, w_center = "
+                      f"{summary['w_center']}, {summary['wall_time_s']:.2f} s; results in {args.out}")
         else:
-            from shellform.studies import assembly, plate, shell
+            import importlib
 
-            study = {"plate": plate, "shell": shell, "assembly": assembly}[args.name]
+            study = importlib.import_module(f"shellform.studies.{args.name}")
             kwargs = {"levels": study.QUICK_LEVELS} if args.quick and hasattr(study, "QUICK_LEVELS") else {}
             study.run(args.out, **kwargs)
     except InputError as err:

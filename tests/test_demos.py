@@ -66,3 +66,26 @@ def test_shallow_shell_scene(tmp_path):
     summary = run_scene("shallow_shell.toml", tmp_path)
     assert summary["cells"] == 1152
     assert summary["w_center"] * D == pytest.approx(shell.navier_coefficient(5.0), rel=2e-3)
+
+
+def test_rollup_demo():
+    out = run_demo("demo_rollup.py", "--n", "48")
+    assert re.search(r"^\s*1\.000\s+360\.0\s", out, re.M), out  # it closed the circle
+    assert out.rstrip().endswith("OK"), out
+
+
+def test_springback_demo():
+    out = run_demo("demo_springback.py", "--n", "8", "--layers", "5")
+    assert "tip force there" in out, out
+    assert out.rstrip().endswith("OK"), out
+
+
+def test_levy_scene(tmp_path):
+    """The nonlinear scene through `shellform run`: Levy's w_c/h at P = 95 and 402 within 2.5 %
+    (12 x 12 quarter mesh), and every output file."""
+    run_scene("levy_plate.toml", tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    w = {round(r["load_factor"], 3): r["w"] / 0.01 for r in summary["reports"]}
+    assert abs(w[0.236] / 0.912 - 1) < 0.025 and abs(w[1.0] / 1.902 - 1) < 0.025, w
+    for name in ("increments.csv", "nodal.bp", "cells.bp", "summary.json"):
+        assert (tmp_path / name).exists()

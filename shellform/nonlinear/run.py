@@ -1,0 +1,103 @@
+"""A nonlinear scene from its TOML to results on disk: scene -> problem -> driver -> files.
+
+Writes into the output folder:
+    summary.json       per reported load factor: centre displacement, peak equivalent plastic
+                       strain and thickness strain; increments, Newton iterations, time split
+    increments.csv     every increment: load factor, step, iterations, residuals, plastic layers
+    nodal.bp, cells.bp the final state for ParaView (displacement, slopes; plastic and thickness
+                       strain per cell)
+    deformed.png       the final shape (serial runs)
+    last_converged.*   only if the run stops: the last converged state
+"""
+
+import time
+from pathlib import Path
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from shellform import output
+from shellform.nonlinear.driver import ConvergenceFailure, Controls
+from shellform.nonlinear.loads import EdgeMoment, PointForce, SheetLoads
+from shellform.nonlinear.problem import SheetProblem
+from shellform.scene import Scene
+from shellform.studies.common import say, write_csv
+
+
+def problem(s: Scene, comm=MPI.COMM_WORLD, outdir=None) -> SheetProblem:
+    g, m, pr = s.geometry, s.mesh, s.process
+    loads = SheetLoads(
+        pressure=s.loads.pressure,
+        points=[PointForce(p.x, p.y, (p.fx, p.fy, p.fz)) for p in s.loads.point],
+        moments=[EdgeMoment(mo.side, mo.m) for mo in s.loads.moment])
+    controls = Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
+                        max_iterations=pr.max_iterations, rtol=pr.rtol)
+    kappa0 = np.diag(s.kappa0) if "shallow_curvature" in s.effects else None
+    return SheetProblem.on_rectangle(
+        comm, g.lx, g.ly, m.n, s.hill79(), s.material.thickness, s.effects, vars(s.supports), loads,
+        controls=controls, region=g.region, kind=m.kind, diagonal=m.diagonal,
+        thickness_points=pr.thickness_points, kappa0=kappa0, checkpoint_dir=outdir, verbose=True)
+
+
+def cell_functions(p: SheetProblem) -> dict:
+    """Equivalent plastic strain and mid-surface thickness strain as DG0 functions."""
+    W = fem.functionspace(p.model.mesh, ("DG", 0))
+    out = {}
+    for name, values in p.model.cell_fields().items():
+        f = fem.Function(W, name=name)
+        f.x.array[: values.size] = values
+        f.x.scatter_forward()
+        out[name] = f
+    return out
+
+
+def _record(p: SheetProblem, s: Scene) -> dict:
+    x0 = 0.0 if s.geometry.region == "quarter" else 0.0
+    fields = p.model.cell_fields()
+    comm = p.model.mesh.comm
+    peq = comm.allreduce(float(fields["equivalent_plastic_strain"].max(initial=0.0)), op=MPI.MAX)
+    e33 = comm.allreduce(float(fields["thickness_strain"].min(initial=0.0)), op=MPI.MIN)
+    return {"load_factor": p.driver.lam, **{k: p.value(k, x0, 0.0) for k in ("u", "v", "w")},
+            "max_equivalent_plastic_strain": peq, "min_thickness_strain": e33}
+
+
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    p = problem(s, comm, outdir)
+    setup_s = time.perf_counter() - t0
+    reports, stopped = [], None
+    targets = sorted(set(s.process.report))
+    try:
+        for target in s.process.path:
+            # stop at every report point on the way to the target
+            lo, hi = sorted((p.driver.lam, target))
+            stops = [r for r in targets if lo < r < hi]
+            for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
+                p.driver.run(r)
+                if r in targets or r == target:
+                    reports.append(_record(p, s))
+    except ConvergenceFailure as err:
+        stopped = str(err)
+        say(f"shellform: stopped: {err}")
+    d = p.driver
+    summary = {
+        "title": s.title, "effects": list(s.effects), "ranks": comm.size,
+        "cells": p.model.mesh.topology.index_map(2).size_global,
+        "dofs": p.model.V.dofmap.index_map.size_global * 9, "reports": reports,
+        "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
+        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,
+        "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
+    }
+    rows = [{"increment": h.number, "load_factor": h.lam, "step": h.dlam, "iterations": h.iterations,
+             "first_residual": h.residuals[0], "last_residual": h.residuals[-1],
+             "plastic_layers": h.plastic_layers, "cutbacks": h.cutbacks} for h in d.history]
+    write_csv(outdir / "increments.csv", rows, list(rows[0]) if rows else ["increment"])
+    if s.output.vtx:
+        output.write_vtx(outdir, d.q, p.model.components, cell_functions(p))
+    if s.output.png:
+        output.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
+    output.write_json(outdir / "summary.json", summary)
+    return summary
