@@ -199,13 +199,13 @@ class Driver:
         c = self.controls
         jump = self._set_dirichlet(lam)
         norm, scale, ev = self.residual(lam, tangent=True, elastic_tangent=reversal)
-        residuals = [norm]
+        residuals, step = [norm], np.inf
         for it in range(1, c.max_iterations + 1):
             if not np.isfinite(norm) or ev.failures:
                 return False, it, residuals, ev
             if norm <= c.rtol * scale and jump == 0:
                 return True, it - 1, residuals, ev
-            if it > 1 and step <= c.stol * np.abs(self.q.x.array).max() and norm <= 1e3 * c.rtol * scale:
+            if step <= c.stol * np.abs(self.q.x.array).max() and norm <= 1e3 * c.rtol * scale:
                 return True, it - 1, residuals, ev
             R0 = self.b.copy()
             ok = self._solve(jump)

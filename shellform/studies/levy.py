@@ -11,7 +11,6 @@ the same table checks a very thin and a thick plate (tests/test_hard_cases.py).
 import time
 from pathlib import Path
 
-import numpy as np
 from mpi4py import MPI
 
 from shellform.material import Hill79Material
