@@ -187,12 +187,25 @@ class SheetKernels:
 
         return setup
 
+    def _scratch(self):
+        """A numba function giving a loop's per-call buffers: constants and kernel arguments."""
+        nconst = self.nconst
+
+        @numba.njit
+        def scratch(consts):
+            c = np.zeros(max(nconst, 1))
+            c[:nconst] = consts[:nconst]
+            return c, np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
+
+        return scratch
+
     def _strain_loop(self):
         strain = self.strain
         el = self.element
         qcols, qcodes = el.q_map()
         ccols = el.component_columns()
-        nz, nconst = el.nz, self.nconst
+        nz = el.nz
+        scratch = self._scratch()
         ffi = _ffi
 
         @numba.njit
@@ -200,10 +213,7 @@ class SheetKernels:
             """z = Q q and the section strains e at the quadrature points of every cell."""
             Q = np.zeros((nz, NDOF))
             q = np.empty(NDOF)
-            c = np.zeros(max(nconst, 1))
-            c[:nconst] = consts[:nconst]
-            local = np.zeros(1, dtype=np.int32)
-            perm = np.zeros(1, dtype=np.uint8)
+            c, local, perm = scratch(consts)
             for k in range(cells.size):
                 cidx = cells[k]
                 coords = cells_coords[cidx]
@@ -225,7 +235,8 @@ class SheetKernels:
         el = self.element
         qcols, qcodes = el.q_map()
         ccols = el.component_columns()
-        nz, nqp, nconst = el.nz, el.nqp, self.nconst
+        nz, nqp = el.nz, el.nqp
+        scratch = self._scratch()
         fo, to = self.force_offsets, self.tangent_offsets
         ffi = _ffi
 
@@ -245,10 +256,7 @@ class SheetKernels:
             w = np.zeros(nz + 42 * nqp)
             rz = np.zeros(nz)
             Kz = np.zeros((nz, nz))
-            c = np.zeros(max(nconst, 1))
-            c[:nconst] = consts[:nconst]
-            local = np.zeros(1, dtype=np.int32)
-            perm = np.zeros(1, dtype=np.uint8)
+            c, local, perm = scratch(consts)
             for k in range(cells.size):
                 cidx = cells[k]
                 coords = cells_coords[cidx]

@@ -39,14 +39,20 @@ MAXLS = 40
 
 
 @njit(cache=True)
-def _sbar(s0, s1, s2, r, m):
-    """sigma_bar (value only), scaled by sqrt(u^2 + rho^2) to avoid overflow at large m."""
+def _invariants(s0, s1, s2):
+    """u = s11 + s22, q = rho^2 and the regularised X = u^2 + eps^2 q, Y = q + eps^2 u^2, X + Y."""
     u = s0 + s1
     d = 0.5 * (s0 - s1)
     q = d * d + s2 * s2
     X = u * u + EPS2 * q
     Y = q + EPS2 * u * u
-    S2 = X + Y
+    return u, q, X, Y, X + Y
+
+
+@njit(cache=True)
+def _sbar(s0, s1, s2, r, m):
+    """sigma_bar (value only), scaled by sqrt(u^2 + rho^2) to avoid overflow at large m."""
+    u, q, X, Y, S2 = _invariants(s0, s1, s2)
     if not S2 > 0.0:
         return 0.0
     x, y = X / S2, Y / S2
@@ -65,12 +71,8 @@ def _hill(s0, s1, s2, r, m):
     Hess = phi_XX X'X'^T + phi_YY Y'Y'^T + phi_XY (X'Y'^T + Y'X'^T) + phi_X X'' + phi_Y Y''.
     At s = 0 everything is returned as 0.
     """
-    u = s0 + s1
+    u, q, X, Y, S2 = _invariants(s0, s1, s2)
     d = 0.5 * (s0 - s1)
-    q = d * d + s2 * s2
-    X = u * u + EPS2 * q
-    Y = q + EPS2 * u * u
-    S2 = X + Y
     if not S2 > 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     S = math.sqrt(S2)
