@@ -87,3 +87,25 @@ def test_anisotropic_limit_load(r, m):
     row = plastic.solve(16, 9, r=r, m=m)
     assert abs(row["P_max_over_PL"] - 1) < 0.02
     assert row["residual_deflection_error"] < 0.01
+
+
+@pytest.mark.parametrize("r, m", [(0.5, 2.0), (1.5, 2.0), (3.0, 8.0)])
+def test_lankford_value_of_a_strip_in_tension(r, m):
+    """A sheet strip pulled to 5 % in the structural model: its width/thickness plastic strain
+    ratio, read from the layers' plastic strains, is the material's r."""
+    from mpi4py import MPI
+
+    from shellform.nonlinear.driver import Controls
+    from shellform.nonlinear.problem import SheetProblem
+
+    mat = Hill79Material(E=200e3, nu=0.3, r=r, m=m, hardening="swift", K=500.0, eps0=0.01, n=0.2)
+    p = SheetProblem.on_rectangle(
+        MPI.COMM_WORLD, 10.0, 2.0, 5, mat, 1.0, ("bending", "membrane", "plasticity", "anisotropy"),
+        region="quarter", supports={"left": "symmetry", "bottom": "symmetry"},
+        prescribed={("right", "u"): 0.25, ("right", "u_y"): 0.0},  # the end stays straight
+        controls=Controls(initial_step=0.1, max_step=0.25))
+    p.driver.run(1.0)
+    ep = p.model.ep_n.reshape(-1, 3)
+    assert np.all(ep[:, 0] > 0.04)  # uniform plastic flow along the strip
+    ratio = ep[:, 1] / -(ep[:, 0] + ep[:, 1])
+    assert np.abs(ratio - r).max() < 1e-6 * r
