@@ -96,7 +96,6 @@ class Driver:
         self.verbose = verbose
         V = model.V
         self.q = fem.Function(V, name="carrier")
-        self.q_prev = fem.Function(V)
         self.prescribed = prescribed  # Function with qbar on the Dirichlet dofs (or None: zero)
         self.bc_dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])).astype(np.int32) \
             if bcs else np.zeros(0, dtype=np.int32)
@@ -108,7 +107,7 @@ class Driver:
         self.f_ext = fem_petsc.create_vector(V)
         self.f_ext.set(0.0)
         if pressure:
-            model.forms.vectors[:] = pressure * model.pressure_load()
+            model.forms.vectors[:] = pressure * model.pressure_vectors
             fem_petsc.assemble_vector(self.f_ext, model.forms.vector)
             self.f_ext.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         self.A = fem_petsc.create_matrix(model.forms.matrix)
@@ -165,7 +164,7 @@ class Driver:
             self._floor = 1e3 * np.finfo(float).eps * m.mesh.comm.allreduce(kmax, op=MPI.MAX) * m.cell_size
         ext = abs(lam) * self.f_ext.norm()
         if self.nodal is not None:
-            ext = max(ext, abs(lam) * self.nodal.magnitude())
+            ext = max(ext, abs(lam) * self.nodal.magnitude)
         return self.b.norm(), max(f_int, ext, self._floor / self.controls.rtol), ev
 
     def _solve(self, jump):

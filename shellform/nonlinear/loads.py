@@ -10,6 +10,7 @@
 from dataclasses import dataclass, field
 
 import numpy as np
+from dolfinx import fem
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS, COMPONENTS
@@ -42,8 +43,6 @@ class SheetLoads:
 
 def side_vertices(V, facet_tags, side):
     """Owned carrier blocks on a side and their tributary lengths (P1: half of each edge)."""
-    from dolfinx import fem
-
     dofs = fem.locate_dofs_topological(V, facet_tags.dim, facet_tags.find(SIDE_TAG[side]))
     owned = V.dofmap.index_map.size_local
     coords = V.tabulate_dof_coordinates()
@@ -76,7 +75,9 @@ class NodalLoads:
             blocks, lengths = side_vertices(V, facet_tags, mo.side)
             axis, sign = OUTWARD[mo.side]
             self.moments.append((blocks, sign * mo.m * lengths, axis))
-        self.comm = V.mesh.comm
+        # Euclidean norm of the nodal forces and moments at lambda = 1 (the residual's scale)
+        local = sum(float(f @ f) for _, f in self.forces) + sum(float(m @ m) for _, m, _ in self.moments)
+        self.magnitude = float(np.sqrt(V.mesh.comm.allreduce(local, op=MPI.SUM)))
 
     def add(self, lam, x, R, K=None):
         """R -= lam f(x) (external forces) and K -= lam df/dx, on owned blocks of the carrier.
@@ -101,12 +102,3 @@ class NodalLoads:
                     vals = -lam * mb * np.array([[h11, h12], [h12, h22]])
                     K.setValuesLocal(rows, rows, vals, addv=True)
 
-    def magnitude(self) -> float:
-        """Euclidean norm of the nodal forces and moments at lambda = 1 (the residual's scale)."""
-        local = sum(float(f @ f) for _, f in self.forces) + sum(float(m @ m) for _, m, _ in self.moments)
-        return float(np.sqrt(self.comm.allreduce(local, op=MPI.SUM)))
-
-    def total_force(self) -> np.ndarray:
-        """Sum of the point forces over all ranks (for equilibrium checks)."""
-        f = sum((f for _, f in self.forces), np.zeros(3))
-        return self.comm.allreduce(f, op=MPI.SUM)

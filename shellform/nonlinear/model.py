@@ -63,7 +63,7 @@ class SheetModel:
         el = self.kernels.element
         self.nqp = el.nqp
         self.P = np.zeros((self.num_cells, el.sym_dim, 9))
-        self.pressure_vectors = np.zeros((self.num_cells, NDOF))
+        self.pressure_vectors = np.zeros((self.num_cells, NDOF))  # a unit dead pressure along +z
         self.kernels.setup(self.cell_coords, self.P, self.pressure_vectors)
         # Material state: committed (n) and trial, per cell, quadrature point and layer.
         nz = thickness_points if self.plastic else 1
@@ -101,10 +101,6 @@ class SheetModel:
         """Accept the trial material state (an increment converged)."""
         self.ep_n[...] = self.ep
         self.p_n[...] = self.p
-
-    def pressure_load(self) -> np.ndarray:
-        """Element vectors of a unit dead pressure along +z."""
-        return self.pressure_vectors
 
     # -- output fields ------------------------------------------------------------------------
     def cell_fields(self) -> dict[str, np.ndarray]:

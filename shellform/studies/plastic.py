@@ -55,12 +55,12 @@ def problem(n, thickness_points=5, r=1.0, m=2.0, dmax=None, controls=None, comm=
         comm, L, b, n, mat, T, effects, thickness_points=thickness_points,
         supports={"left": "clamped", "top": "symmetry", "bottom": "symmetry"},
         prescribed={("right", "w"): dmax or 20 * dy},
-        controls=controls or Controls(initial_step=0.01, max_step=0.05)), dy
+        controls=controls or Controls(initial_step=0.01, max_step=0.05))
 
 
 def solve(n, thickness_points=5, r=1.0, m=2.0) -> dict:
     t0 = time.perf_counter()
-    p, dy = problem(n, thickness_points, r, m)
+    p = problem(n, thickness_points, r, m)
     compile_s = time.perf_counter() - t0
     d = p.driver
     path = []
