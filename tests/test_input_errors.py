@@ -142,3 +142,14 @@ def test_cli_reports_input_errors(tmp_path, capsys):
     assert cli.main(["run", str(bad), "--out", str(tmp_path / "out")]) == 2
     assert "material.thickness: must be > 0" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()  # nothing computed, nothing written
+
+
+def test_sheet_model_checks_its_thickness():
+    """The nonlinear sheet built from the API (no scene) checks the thickness too."""
+    from shellform.material import Hill79Material
+    from shellform.nonlinear.model import SheetModel
+
+    msh = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    with pytest.raises(InputError) as err:
+        SheetModel(msh, Hill79Material(E=1.0, nu=0.3).pack(), -0.01)
+    assert err.value.field == "material.thickness"

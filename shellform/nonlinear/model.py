@@ -15,6 +15,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from shellform.assembly.kernels import check_mesh
+from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly.sheet_kernels import SheetKernels
 from shellform.material import section
@@ -40,6 +41,8 @@ class SheetModel:
     def __init__(self, mesh, material, thickness: float, effects=("geometric_nonlinearity",),
                  thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4):
         check_mesh(mesh)
+        if not (np.isfinite(thickness) and thickness > 0):
+            raise InputError("material.thickness", f"must be > 0, got {thickness}")
         self.mesh, self.effects = mesh, tuple(effects)
         self.nonlinear = "geometric_nonlinearity" in self.effects
         self.plastic = "plasticity" in self.effects
