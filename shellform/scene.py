@@ -4,8 +4,10 @@ A scene states the geometry of the blank, its reference surface, the mesh, the m
 supports, the loads and the physical effects to simulate; only the terms of those effects are
 assembled. A scene with any of the effects geometric_nonlinearity, plasticity, anisotropy
 (``Scene.nonlinear``) is a nonlinear elastic-plastic sheet, stepped through the load factors of
-its [process] section; ``Scene.hill79()`` is its material. Every bad value raises
-shellform.errors.InputError naming its field, e.g. ``material.thickness: must be > 0, got -1.0``.
+its [process] section; ``Scene.hill79()`` is its material. The effect 'contact' needs a [tools]
+table (``Scene.tools``: the rigid tools of the square cup, shellform.contact.tools). Every bad
+value raises shellform.errors.InputError naming its field, e.g.
+``material.thickness: must be > 0, got -1.0``.
 See docs/scenes.md for every key.
 """
 
@@ -16,6 +18,8 @@ from pathlib import Path
 
 from forms.functional import EFFECTS, NONLINEAR_EFFECTS
 from shellform.errors import InputError
+
+CONTACT_EFFECTS = ("contact", "friction")  # the rigid tools of [tools] (shellform/contact/)
 
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
 NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
@@ -112,6 +116,22 @@ class Process:
 
 
 @dataclass
+class ToolsSpec:
+    """Rigid tools of the square-cup deep drawing (shellform.contact.tools), NUMISHEET'93."""
+
+    punch_half_width: float = 35.0  # 70 mm square punch
+    punch_corner_radius: float = 10.0  # plan corner radius
+    punch_profile_radius: float = 8.0  # nose radius
+    die_half_width: float = 37.0  # 74 mm die opening
+    die_corner_radius: float = 12.0
+    die_profile_radius: float = 5.0  # die shoulder radius
+    punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
+    blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
+    friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
+    stroke: float = 30.0  # punch travel, mm
+
+
+@dataclass
 class Output:
     vtx: bool = True
     png: bool = True
@@ -130,6 +150,7 @@ class Scene:
     solver: Solver = field(default_factory=Solver)
     process: Process = field(default_factory=Process)
     output: Output = field(default_factory=Output)
+    tools: ToolsSpec | None = None  # None: no [tools] table, no tools
 
     def __post_init__(self):
         validate(self)
@@ -161,7 +182,7 @@ class Scene:
 # -- reading ---------------------------------------------------------------------------------
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
-    "supports": Supports, "solver": Solver, "process": Process, "output": Output,
+    "supports": Supports, "solver": Solver, "process": Process, "output": Output, "tools": ToolsSpec,
 }
 
 
@@ -273,11 +294,13 @@ def validate(s: Scene) -> None:
                  f"nonlinear sheet: needs one of the effects {', '.join(NONLINEAR_EFFECTS)}")
     _validate_loads(s)
     _validate_process(s)
+    _validate_tools(s)
 
 
 def _validate_effects(s: Scene) -> None:
+    known = EFFECTS + CONTACT_EFFECTS
     for e in s.effects:
-        _require(e in EFFECTS, "effects", f"unknown effect {e!r}; known effects: {', '.join(EFFECTS)}")
+        _require(e in known, "effects", f"unknown effect {e!r}; known effects: {', '.join(known)}")
     _require(len(set(s.effects)) == len(s.effects), "effects", "an effect is listed twice")
     _require("bending" in s.effects or "membrane" in s.effects, "effects",
              "needs 'bending' or 'membrane' (nothing would be assembled)")
@@ -290,6 +313,10 @@ def _validate_effects(s: Scene) -> None:
                      f"{e!r} is an effect of the nonlinear sheet, a full shell: switch on 'bending' and 'membrane'")
     _require("anisotropy" not in s.effects or "plasticity" in s.effects, "effects",
              "'anisotropy' shapes the yield function: it needs 'plasticity'")
+    _require("friction" not in s.effects or "contact" in s.effects, "effects",
+             "'friction' acts at the contact with the tools: it needs 'contact'")
+    _require("contact" not in s.effects or "geometric_nonlinearity" in s.effects, "effects",
+             "'contact' with the tools needs the large displacements of 'geometric_nonlinearity'")
 
 
 def _validate_material(s: Scene) -> None:
@@ -372,6 +399,54 @@ def _validate_process(s: Scene) -> None:
     for v in pr.report:
         _require(math.isfinite(v) and lo <= v <= hi, "process.report",
                  f"{v} lies outside the load factors [{lo}, {hi}] that process.path covers")
+
+
+def _validate_tools(s: Scene) -> None:
+    """The [tools] table and the effects 'contact' and 'friction' (after the material: the
+    clearance is checked against the thickness)."""
+    t = s.tools
+    if t is None:
+        _require("contact" not in s.effects, "tools", "the effect 'contact' needs a [tools] table")
+        return
+    _require("contact" in s.effects, "effects", "a [tools] table needs the effect 'contact'")
+    for f in fields(ToolsSpec):
+        v = getattr(t, f.name)
+        _require(math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
+    for name in ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "stroke"):
+        v = getattr(t, name)
+        _require(v > 0, f"tools.{name}", f"must be > 0, got {v}")
+    for name in ("punch_corner_radius", "die_corner_radius", "blank_holder_force", "friction"):
+        v = getattr(t, name)
+        _require(v >= 0, f"tools.{name}", f"must be >= 0, got {v}")
+    _require(t.punch_profile_radius <= t.punch_corner_radius <= t.punch_half_width, "tools.punch_corner_radius",
+             f"must lie between punch_profile_radius ({t.punch_profile_radius}) and punch_half_width "
+             f"({t.punch_half_width}), got {t.punch_corner_radius}")
+    _require(t.die_corner_radius <= t.die_half_width, "tools.die_corner_radius",
+             f"must be <= die_half_width ({t.die_half_width}), got {t.die_corner_radius}")
+    _require(t.punch_half_width < t.die_half_width, "tools.punch_half_width",
+             f"the punch must fit in the die opening: must be < die_half_width ({t.die_half_width}), "
+             f"got {t.punch_half_width}")
+    thickness = s.material.thickness
+    _require(t.die_half_width - t.punch_half_width >= thickness, "tools.die_half_width",
+             f"the clearance die_half_width - punch_half_width = {t.die_half_width - t.punch_half_width} "
+             f"is smaller than the thickness {thickness}: the sheet cannot pass")
+    _require(t.punch_gap >= 0, "tools.punch_gap",
+             f"must be >= 0 (the punch would overlap the blank), got {t.punch_gap}")
+    g = s.geometry
+    flat = t.die_half_width + t.die_profile_radius  # where the die's flat top and the holder start
+    side = "lx" if g.lx <= g.ly else "ly"
+    _require(min(g.lx, g.ly) / 2 > flat, f"geometry.{side}",
+             f"the blank does not reach the blank holder and the die's flat top: half its size "
+             f"{getattr(g, side) / 2} must exceed die_half_width + die_profile_radius = {flat}")
+    if t.friction > 0:
+        _require("friction" in s.effects, "tools.friction", f"friction = {t.friction} needs the effect 'friction'")
+    else:
+        _require("friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
+    outer = ("right", "top") if g.region == "quarter" else SIDES
+    for side in outer:
+        v = getattr(s.supports, side)
+        _require(v == "free", f"supports.{side}",
+                 f"the tools hold the blank: its outer sides must be 'free', got {v!r}")
 
 
 def bounds(s: Scene) -> tuple[float, float, float, float]:

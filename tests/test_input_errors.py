@@ -153,3 +153,80 @@ def test_sheet_model_checks_its_thickness():
     with pytest.raises(InputError) as err:
         SheetModel(msh, Hill79Material(E=1.0, nu=0.3).pack(), -0.01)
     assert err.value.field == "material.thickness"
+
+
+# -- [tools]: the square cup's rigid tools (shellform/contact/tools.py) ------------------------
+CONTACT = SHEET + ["contact"]
+
+
+def cup(effects=CONTACT, tools=None, geometry=None, supports=None, thickness=0.8):
+    """A quarter blank of 100 mm x 100 mm on the NUMISHEET'93 tools, with overrides."""
+    return {"effects": effects, "geometry": {"lx": 100.0, "ly": 100.0, "region": "quarter", **(geometry or {})},
+            "material": {"E": 2.1e5, "thickness": thickness},
+            "supports": {"left": "symmetry", "bottom": "symmetry", **(supports or {})}, "tools": tools or {}}
+
+
+@pytest.mark.parametrize("data, field", [
+    ({"effects": CONTACT}, "tools"),  # contact without tools
+    ({**cup(), "effects": SHEET}, "effects"),  # tools without contact
+    (cup(effects=FULL + ["contact"]), "effects"),  # contact needs geometric_nonlinearity
+    (cup(effects=SHEET + ["friction"]), "effects"),  # friction needs contact
+    (cup(effects=CONTACT + ["sticking"]), "effects"),
+    ({**cup(), "tools": 35.0}, "tools"),
+    (cup(tools={"punch_radius": 8.0}), "tools.punch_radius"),
+    (cup(tools={"stroke": "deep"}), "tools.stroke"),
+    (cup(tools={"stroke": 0.0}), "tools.stroke"),
+    (cup(tools={"stroke": float("inf")}), "tools.stroke"),
+    (cup(tools={"punch_half_width": float("nan")}), "tools.punch_half_width"),
+    (cup(tools={"punch_half_width": -35.0}), "tools.punch_half_width"),
+    (cup(tools={"punch_profile_radius": 0.0}), "tools.punch_profile_radius"),
+    (cup(tools={"die_profile_radius": -5.0}), "tools.die_profile_radius"),
+    (cup(tools={"die_half_width": 0.0}), "tools.die_half_width"),
+    (cup(tools={"punch_corner_radius": -1.0}), "tools.punch_corner_radius"),
+    (cup(tools={"punch_corner_radius": 6.0}), "tools.punch_corner_radius"),  # < the nose radius 8
+    (cup(tools={"punch_corner_radius": 36.0}), "tools.punch_corner_radius"),  # > the half-width 35
+    (cup(tools={"die_corner_radius": -1.0}), "tools.die_corner_radius"),
+    (cup(tools={"die_corner_radius": 38.0}), "tools.die_corner_radius"),
+    (cup(tools={"blank_holder_force": -1.0}), "tools.blank_holder_force"),
+    (cup(tools={"friction": -0.1}), "tools.friction"),
+    (cup(tools={"punch_half_width": 38.0}), "tools.punch_half_width"),  # wider than the die opening
+    (cup(tools={"punch_half_width": 37.0}), "tools.punch_half_width"),
+    (cup(tools={"die_half_width": 35.5}), "tools.die_half_width"),  # clearance 0.5 < thickness 0.8
+    (cup(tools={"punch_gap": -0.1}), "tools.punch_gap"),  # the punch overlaps the blank
+    (cup(geometry={"lx": 80.0}), "geometry.lx"),  # half of 80 < 37 + 5: short of the blank holder
+    (cup(geometry={"ly": 84.0}), "geometry.ly"),  # just at the die's flat top
+    (cup(tools={"friction": 0.1}), "tools.friction"),  # friction without the effect
+    (cup(effects=CONTACT + ["friction"]), "tools.friction"),  # the effect without friction
+    (cup(supports={"right": "clamped"}), "supports.right"),
+    (cup(supports={"top": "simply_supported"}), "supports.top"),
+    (cup(geometry={"region": "full"}), "supports.left"),  # every side of a full blank is outer
+])
+def test_tools_errors_name_the_field(data, field):
+    with pytest.raises(InputError) as err:
+        scene.from_dict(data)
+    assert err.value.field == field
+    assert str(err.value).startswith(field + ":")
+
+
+def test_tools_error_messages():
+    with pytest.raises(InputError, match="must fit in the die opening"):
+        scene.from_dict(cup(tools={"punch_half_width": 38.0}))
+    with pytest.raises(InputError, match="cannot pass"):
+        scene.from_dict(cup(tools={"die_half_width": 35.5}))
+    with pytest.raises(InputError, match="overlap the blank"):
+        scene.from_dict(cup(tools={"punch_gap": -0.1}))
+    with pytest.raises(InputError, match="does not reach the blank holder"):
+        scene.from_dict(cup(geometry={"lx": 80.0}))
+
+
+def test_square_cup_scene():
+    from shellform.contact.tools import square_cup_tools
+
+    s = scene.from_dict(cup(effects=CONTACT + ["friction"], tools={"friction": 0.144, "stroke": 15}))
+    assert s.nonlinear and s.tools.friction == 0.144 and s.tools.stroke == 15.0
+    assert s.tools.punch_half_width == 35.0 and s.tools.die_profile_radius == 5.0  # the defaults
+    tools = square_cup_tools(s.tools, s.material.thickness)
+    assert (tools["punch"].z_face, tools["die"].z_top) == (0.4, -0.4)
+    full = scene.from_dict(cup(geometry={"region": "full"}, supports={"left": "free", "bottom": "free"}))
+    assert full.tools == scene.ToolsSpec()
+    assert scene.from_dict({}).tools is None  # no [tools] table: no tools

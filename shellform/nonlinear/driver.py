@@ -79,6 +79,7 @@ class Increment:
     plastic_layers: int
     cutbacks: int
     seconds: dict = field(default_factory=dict)
+    contact: dict = field(default_factory=dict)  # contact passes, set changes (contact driver)
 
 
 class Driver:
@@ -125,9 +126,9 @@ class Driver:
     # -- residual and tangent ----------------------------------------------------------------
     def _set_dirichlet(self, lam):
         """g = lam qbar on the Dirichlet dofs; returns the largest jump |g - q| there."""
-        g = self.g
-        g[self.bc_dofs] = lam * self.prescribed.x.array[self.bc_dofs] if self.prescribed else 0.0
-        jump = np.abs(g[self.bc_dofs] - self.q.x.array[self.bc_dofs]).max() if self.bc_dofs.size else 0.0
+        g, d = self.g, self.bc_dofs
+        g[d] = lam * self.prescribed.x.array[d] if self.prescribed else 0.0
+        jump = np.abs(g[d] - self.q.x.array[d]).max() if d.size else 0.0
         return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
 
     def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
@@ -136,6 +137,7 @@ class Driver:
         self.q.x.scatter_forward()
         ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
         t0 = time.perf_counter()
+        self._element_arrays(tangent)
         with self.b.localForm() as bl:
             bl.set(0.0)
         fem_petsc.assemble_vector(self.b, m.forms.vector)
@@ -167,13 +169,28 @@ class Driver:
             ext = max(ext, abs(lam) * self.nodal.magnitude)
         return self.b.norm(), max(f_int, ext, self._floor / self.controls.rtol), ev
 
+    def _element_arrays(self, tangent: bool) -> None:
+        """Hook between the element loop and assembly (the contact driver rotates here)."""
+
+    def _correction(self) -> np.ndarray:
+        """The known correction dq_D on the Dirichlet dofs (zero elsewhere)."""
+        delta = np.zeros_like(self.q.x.array)
+        delta[self.bc_dofs] = self.g[self.bc_dofs] - self.q.x.array[self.bc_dofs]
+        return delta
+
+    def _increment_info(self) -> dict:
+        return {}
+
+    def _commit(self) -> None:
+        """Accept the increment's state."""
+        self.model.commit()
+
     def _solve(self, jump):
         """dq = -K^-1 R with dq_D = g - q_D (lifted: the free rows see -K_fD (g - q_D))."""
         t0 = time.perf_counter()
         self.b.scale(-1.0)
         if jump > 0:
-            delta = np.zeros_like(self.q.x.array)
-            delta[self.bc_dofs] = self.g[self.bc_dofs] - self.q.x.array[self.bc_dofs]
+            delta = self._correction()
             m = self.model
             m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, delta[m.unrolled_dofs])
             lift = fem_petsc.assemble_vector(m.forms.vector)
@@ -276,13 +293,13 @@ class Driver:
                         f"increment at lambda {self.lam:.6g} -> {lam:.6g} did not converge and the step "
                         f"fell below min_step {c.min_step:g}", path)
                 self._dlam_prev = None  # no extrapolation after a failure
-            self.model.commit()
+            self._commit()
             reversal = False
             x_prev = x_n
             self.lam = lam
             self._dlam_prev = dlam
             inc = Increment(len(self.history) + 1, lam, dlam, its, res, ev.plastic_layers, cutbacks,
-                            {"wall_s": time.perf_counter() - t0})
+                            {"wall_s": time.perf_counter() - t0}, self._increment_info())
             self.history.append(inc)
             if self.verbose:
                 say(f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "

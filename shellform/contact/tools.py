@@ -1,0 +1,157 @@
+"""Rigid analytic tools of the square-cup deep drawing: punch, die and blank holder.
+
+The blank's mid-surface starts in the plane z = 0, centred at the origin; every tool is
+symmetric about x = 0, y = 0 and the diagonal. The punch sits above the sheet and moves down,
+the die lies below it with a square opening, the blank holder presses the flange from above.
+
+Punch and die are Minkowski sums of a "core" with a ball of the profile radius r, so their
+signed distance is  d_core - r : exact outside the tool and for penetrations shallower than r
+(deeper points, inside the core, get -r). Each core is a product of a plan set and a vertical
+half-line, so  d_core = sqrt(d_plan^2 + d_z^2).  The plans are rounded squares
+(rounded_square_sdf). The normal is the gradient of the signed distance, computed
+analytically: the unit vector from the nearest tool point towards the point, the direction in
+which the tool pushes the sheet.
+
+``gap(x, offset, dz)`` is the signed distance minus ``offset`` (half the sheet thickness at the
+node: the sheet's surface lies that far from its mid-surface), with the tool moved by dz along
+z: > 0 clear, < 0 penetration. Units mm.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+DOWN = np.array([0.0, 0.0, -1.0])  # face normal of the punch and the blank holder
+UP = np.array([0.0, 0.0, 1.0])  # face normal of the die
+
+
+def rounded_square_sdf(x, y, a: float, rc: float):
+    """Signed distance to the rounded square |x|, |y| <= a with plan corner radius rc, and its
+    gradient (dsdx, dsdy).
+
+    q = (|x| - (a - rc), |y| - (a - rc)),  sdf = |max(q, 0)| + min(max(qx, qy), 0) - rc,
+    exact inside and outside. The gradient is max(q, 0)/|max(q, 0)| outside the square of
+    half-width a - rc, else the axis of the larger of qx, qy (ties: y), times sign(x), sign(y):
+    it is exactly 0 along x on x = 0 and along y on y = 0 (both 0 at the origin, where the
+    gradient is undefined).
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    qx, qy = np.abs(x) - (a - rc), np.abs(y) - (a - rc)
+    px, py = np.maximum(qx, 0.0), np.maximum(qy, 0.0)
+    r = np.sqrt(px * px + py * py)  # distance to the inner square of half-width a - rc
+    sdf = r + np.minimum(np.maximum(qx, qy), 0.0) - rc
+    out = r > 0.0
+    rs = np.where(out, r, 1.0)
+    gx = np.where(out, px / rs, qx > qy)  # d sdf / d|x|
+    gy = np.where(out, py / rs, qx <= qy)  # d sdf / d|y|
+    return sdf, gx * np.sign(x) + 0.0, gy * np.sign(y) + 0.0  # + 0.0: no -0.0
+
+
+def _points(x, offset):
+    x = np.asarray(x, dtype=float).reshape(-1, 3)
+    return x, np.broadcast_to(np.asarray(offset, dtype=float), x.shape[:1])
+
+
+@dataclass
+class Punch:
+    """Flat bottom at z_face, nose (profile) radius profile_radius, vertical wall at half-width
+    half_width with plan corner radius corner_radius >= profile_radius > 0.
+
+    Core: the rounded square (a - rp, rc - rp) in plan, z >= z_face + rp.
+    d_core = sqrt(max(s, 0)^2 + max(h, 0)^2),  s = its plan sdf,  h = z_face + rp - z.
+    """
+
+    half_width: float
+    corner_radius: float
+    profile_radius: float
+    z_face: float
+
+    def __post_init__(self):
+        if not 0 < self.profile_radius <= self.corner_radius <= self.half_width:
+            raise ValueError(f"punch: needs 0 < profile_radius <= corner_radius <= half_width, got {self}")
+
+    def gap(self, x, offset=0.0, dz: float = 0.0):
+        x, offset = _points(x, offset)
+        rp = self.profile_radius
+        s, sx, sy = rounded_square_sdf(x[:, 0], x[:, 1], self.half_width - rp, self.corner_radius - rp)
+        h = (self.z_face + dz + rp) - x[:, 2]  # height of the core's bottom above the point
+        sp, hp = np.maximum(s, 0.0), np.maximum(h, 0.0)
+        under, beside = s <= 0.0, (s > 0.0) & (h <= 0.0)  # under the flat face / beside the wall
+        nose = ~under & ~beside
+        d = np.where(under, hp, np.where(beside, sp, np.sqrt(sp * sp + hp * hp)))
+        n = np.tile(DOWN, (len(x), 1))  # under the face, and inside the core (d = 0)
+        n[beside] = np.stack([sx, sy, np.zeros_like(s)], axis=1)[beside]
+        # nose: grad d_core = (s+ grad s, -h+) / d_core
+        n[nose] = np.stack([sp * sx, sp * sy, -hp], axis=1)[nose] / d[nose, None]
+        return d - rp - offset, n + 0.0
+
+
+@dataclass
+class Die:
+    """Flat top at z_top, shoulder (profile) radius profile_radius > 0, opening with vertical
+    walls at half-width half_width and plan corner radius corner_radius >= 0.
+
+    O = rounded square (a + rd, rc + rd); core: plan outside O, z <= z_top - rd.
+    d_core = sqrt(max(-s, 0)^2 + max(h, 0)^2),  s = sdf of O,  h = z - (z_top - rd).
+    """
+
+    half_width: float
+    corner_radius: float
+    profile_radius: float
+    z_top: float
+
+    def __post_init__(self):
+        if not (self.profile_radius > 0 and 0 <= self.corner_radius <= self.half_width):
+            raise ValueError(f"die: needs profile_radius > 0, 0 <= corner_radius <= half_width, got {self}")
+
+    def gap(self, x, offset=0.0, dz: float = 0.0):
+        x, offset = _points(x, offset)
+        rd = self.profile_radius
+        s, sx, sy = rounded_square_sdf(x[:, 0], x[:, 1], self.half_width + rd, self.corner_radius + rd)
+        h = x[:, 2] - (self.z_top + dz - rd)  # height of the point above the core's top
+        e, hp = np.maximum(-s, 0.0), np.maximum(h, 0.0)  # e: plan depth into the opening
+        over, beside = s >= 0.0, (s < 0.0) & (h <= 0.0)  # over the flat top / beside the wall
+        shoulder = ~over & ~beside
+        d = np.where(over, hp, np.where(beside, e, np.sqrt(e * e + hp * hp)))
+        n = np.tile(UP, (len(x), 1))  # over the top, inside the core (d = 0), and where grad s = 0
+        plan = (sx != 0.0) | (sy != 0.0)  # grad s = 0 only at the opening's centre: no direction
+        wall, bend = beside & plan, shoulder & plan
+        n[wall] = np.stack([-sx, -sy, np.zeros_like(s)], axis=1)[wall]  # towards the opening's centre
+        # shoulder: grad d_core = (-e grad s, h+) / d_core
+        n[bend] = np.stack([-e * sx, -e * sy, hp], axis=1)[bend] / d[bend, None]
+        return d - rd - offset, n + 0.0
+
+
+@dataclass
+class BlankHolder:
+    """A flat face at z_face (its bottom) over the plan region outside O = rounded square
+    (inner_half_width, inner_corner_radius): the die's flat top. Signed distance z_face - z
+    there, +inf over the opening (the holder never reaches over it)."""
+
+    inner_half_width: float
+    inner_corner_radius: float
+    z_face: float
+
+    def __post_init__(self):
+        if not 0 <= self.inner_corner_radius <= self.inner_half_width:
+            raise ValueError(f"blank holder: needs 0 <= inner_corner_radius <= inner_half_width, got {self}")
+
+    def gap(self, x, offset=0.0, dz: float = 0.0):
+        x, offset = _points(x, offset)
+        s, _, _ = rounded_square_sdf(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)
+        sd = np.where(s >= 0.0, (self.z_face + dz) - x[:, 2], np.inf)
+        return sd - offset, np.tile(DOWN, (len(x), 1))
+
+
+def square_cup_tools(spec, thickness: float) -> dict:
+    """Punch, die and blank holder of a scene's ToolsSpec around a sheet of that thickness whose
+    mid-surface is z = 0: the die's top touches the sheet's lower surface, the holder rests on
+    its upper surface, the punch face lies spec.punch_gap above it."""
+    die = Die(spec.die_half_width, spec.die_corner_radius, spec.die_profile_radius, -thickness / 2)
+    rd = spec.die_profile_radius
+    return dict(
+        punch=Punch(spec.punch_half_width, spec.punch_corner_radius, spec.punch_profile_radius,
+                    thickness / 2 + spec.punch_gap),
+        die=die,
+        holder=BlankHolder(spec.die_half_width + rd, spec.die_corner_radius + rd, thickness / 2),
+    )
