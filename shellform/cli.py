@@ -20,6 +20,10 @@ def run_scene(path: Path, outdir: Path) -> dict:
 
     s = scene.load(path)
     outdir.mkdir(parents=True, exist_ok=True)
+    if s.tools is not None:
+        from shellform.contact import run as contact_run
+
+        return contact_run.run(s, outdir)
     if s.nonlinear:
         from shellform.nonlinear import run as nonlinear_run
 
@@ -61,7 +65,15 @@ def main(argv=None) -> int:
     try:
         if args.command == "run":
             summary = run_scene(args.scene, args.out)
-            if "reports" in summary:
+            if "draw_in_mm" in summary:
+                last = summary["draw_in_mm"][-1] if summary["draw_in_mm"] else {}
+                print(f"shellform: {summary['title']}: {summary['cells']} cells, stroke {summary['stroke_mm']:.2f} mm, "
+                      f"draw-in {last}, max thickness strain {summary['max_thickness_strain']:.4f}, "
+                      f"{summary['wall_time_s']['total']:.1f} s; results in {args.out}")
+                if summary["stopped"]:
+                    print(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
+                    return 3
+            elif "reports" in summary:
                 last = summary["reports"][-1] if summary["reports"] else {}
                 print(f"shellform: {summary['title']}: {summary['cells']} cells, {summary['increments']} "
                       f"increments, load factor {last.get('load_factor')}, w = {last.get('w')}, "

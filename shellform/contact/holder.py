@@ -30,30 +30,55 @@ def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:
 
 
 class ForceControlledHolder:
-    """Holder forces on the owned nodes whose plan position lies over the die's flat top."""
+    """Holder forces on the owned nodes whose plan position lies over the die's flat top.
 
-    def __init__(self, tool, force: float, stiffness: np.ndarray, comm):
+    Z is a Newton unknown beside the carrier (the driver's bordered solve, Sherman-Morrison):
+    the force balance  g(q, Z) = sum_i k_i max(top_i - Z, 0) - F = 0  is linearised as
+    sum_active k_i dw_i - (sum_active k_i) dZ = -g.  ``balance`` re-solves Z exactly for given
+    positions (at the start, and as a safeguard between contact passes).
+    """
+
+    def __init__(self, tool, force: float, stiffness: np.ndarray, comm, rtol: float = 1e-8):
         self.tool, self.force, self.k, self.comm = tool, float(force), np.asarray(stiffness), comm
+        self.rtol = rtol
         self.Z = tool.z_face
 
-    def forces(self, x: np.ndarray, half_thickness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Nodal forces along z on the sheet (<= 0) and their stiffness k_i where in contact."""
-        # tops relative to the holder's rest height: gap = Z0 - top (inf outside its plan region)
-        gap, _ = self.tool.gap(x, half_thickness, 0.0)
+    def _tops(self, x, half_thickness):
+        gap, _ = self.tool.gap(x, half_thickness, 0.0)  # gap = z_face - top (inf off the holder)
         under = np.isfinite(gap)
-        tops = self.tool.z_face - gap[under]
-        all_tops = np.concatenate(self.comm.allgather(tops))
-        all_k = np.concatenate(self.comm.allgather(self.k[under]))
+        return under, self.tool.z_face - gap[under]
+
+    def forces(self, x: np.ndarray, half_thickness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Nodal forces along z on the sheet (<= 0) at the holder height Z, and their stiffness."""
+        under, tops = self._tops(x, half_thickness)
         fz, kz = np.zeros(x.shape[0]), np.zeros(x.shape[0])
-        if all_tops.size == 0 or self.force <= 0:
-            self.Z = float(all_tops.max()) if all_tops.size else self.tool.z_face
-            return fz, kz
-        self.Z = holder_height(all_tops, all_k, self.force)
-        squeeze = np.maximum(tops - self.Z, 0.0)
         idx = np.flatnonzero(under)
+        squeeze = np.maximum(tops - self.Z, 0.0)
         fz[idx] = -self.k[idx] * squeeze
         kz[idx] = np.where(squeeze > 0, self.k[idx], 0.0)
         return fz, kz
+
+    def linearisation(self, x, half_thickness):
+        """(g, active node indices, their k): the force misfit and the nodes bearing the holder."""
+        under, tops = self._tops(x, half_thickness)
+        idx = np.flatnonzero(under)
+        squeeze = tops - self.Z
+        act = idx[squeeze > 0]
+        total = self.comm.allreduce(float(np.sum(self.k[idx] * np.maximum(squeeze, 0.0))), op=MPI.SUM)
+        return total - self.force, act, self.k[act]
+
+    def balance(self, x: np.ndarray, half_thickness: np.ndarray) -> bool:
+        """Move Z so that the forces at the positions x sum to F; False if they already did."""
+        under, tops = self._tops(x, half_thickness)
+        all_tops = np.concatenate(self.comm.allgather(tops))
+        all_k = np.concatenate(self.comm.allgather(self.k[under]))
+        if all_tops.size == 0:
+            return False
+        total = float(np.sum(all_k * np.maximum(all_tops - self.Z, 0.0)))
+        if abs(total - self.force) <= self.rtol * max(self.force, 1e-300):
+            return False
+        self.Z = holder_height(all_tops, all_k, self.force) if self.force > 0 else float(all_tops.max())
+        return True
 
     def total(self, fz: np.ndarray) -> float:
         return -self.comm.allreduce(float(fz.sum()), op=MPI.SUM)

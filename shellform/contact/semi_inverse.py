@@ -11,17 +11,18 @@ nodes split into free ones and nodes on a tool. A node on a tool is seen in its 
 Assembled as one DOLFINx system with the known components as Dirichlet rows (the lift is
 (27) exactly) and solved with PETSc; the contact forces are the residual's Dirichlet rows.
 
-Friction (Coulomb, mu): a sticking node also has its tangential increments known (it moves
-with the tool); its tangential force p_t is unknown. When |p_t| > mu p_n the node slips: its
-tangential components become free and carry the force mu p_n along -s/|s|, s its slip
-relative to the tool in this increment (p_n from the latest iterate: the friction magnitude
-is a fixed point of the Newton iteration). A slipping node whose slip reverses sticks again.
+Friction (Coulomb, mu) acts on every node on a tool, in the tangent plane, against its slip s
+relative to the tool in this increment:  f_t = -mu p_n s / max(|s|, eps),  so |f_t| <= mu p_n
+always; a node slips (|f_t| = mu p_n) once |s| > eps and sticks, held elastically, below it
+(eps = 1e-4 of the cell size by default: stick is resolved to a fraction of a micrometre).
+The force and its rate in s enter the residual and tangent; p_n comes from the latest iterate
+(the friction magnitude is a fixed point of the Newton iteration).
 
 The contact set is settled within the increment: Newton converges on a fixed set, then nodes
-that penetrate a tool by more than `penetration` join it, nodes whose normal force turned
-tensile leave it, and stick/slip is checked; the increment is repeated from there until
-nothing changes. A node may switch at most `max_toggles` times per increment (no chattering:
-it then stays where it is); a set that does not settle in `max_passes` cuts the increment back.
+that penetrate a tool by more than `penetration` join it and nodes whose normal force turned
+tensile leave it; the increment is repeated from there until nothing changes. A node may switch
+at most `max_toggles` times per increment (no chattering: it then stays where it is); a set
+that does not settle in `max_passes` cuts the increment back.
 
 The blank holder is force-controlled (holder.py): its height is the unknown that makes its
 contact forces sum to the prescribed force at every iterate.
@@ -48,17 +49,15 @@ class ContactControls:
     max_passes: int = 12  # contact-set updates per increment
     max_toggles: int = 2  # switches of one node per increment before it is frozen
     gap_tol: float = 0.0  # |known corrections| at convergence (0: 1e-3 penetration)
+    slip_regularization: float = 1e-4  # eps / cell size of the Coulomb force (see _slip_forces)
 
 
 class ContactState:
-    """Per owned node: the tool it lies on (or FREE), stick or slip, the stick anchor (position
-    relative to the tool), the friction direction and the normal force."""
+    """Per owned node: the tool it lies on (or FREE), its normal contact force, its switches in
+    this increment."""
 
     def __init__(self, n: int):
         self.tool = np.full(n, FREE, dtype=np.int8)
-        self.stick = np.zeros(n, dtype=bool)
-        self.anchor = np.zeros((n, 3))
-        self.direction = np.zeros((n, 3))
         self.pressure = np.zeros(n)
         self.toggles = np.zeros(n, dtype=np.int32)
 
@@ -83,6 +82,8 @@ class SemiInverseDriver(Driver):
                          verbose=verbose)
         self.support_dofs = self.bc_dofs.copy()  # supports and symmetry (prescribed values: lam qbar)
         self.controls.predictor = False  # extrapolation would push nodes through the tools
+        # an increment of a few contact passes is still an easy one
+        self.controls.easy_iterations = max(self.controls.easy_iterations, 2 * self.controls.max_iterations // 3)
         V = model.V
         imap = V.dofmap.index_map
         self.n_owned, self.n_local = imap.size_local, imap.size_local + imap.num_ghosts
@@ -97,6 +98,7 @@ class SemiInverseDriver(Driver):
         self.sym_fixed = sym.reshape(-1, BS)[: self.n_owned, :3]  # symmetry-fixed u, v, w (never w)
         # nodal fields shared with ghosts: frames (9 values = 3 x 3), known corrections, flags
         self._frame_fn, self._known_fn, self._flag_fn = fem.Function(V), fem.Function(V), fem.Function(V)
+        self._z_fn = fem.Function(V)  # K^-1 b of the holder's bordered step
         self.frames = np.tile(np.eye(3), (self.n_local, 1, 1))
         self.rotated = np.zeros(self.n_local, dtype=bool)
         area, e33 = self._nodal_areas_and_thickness_strain()
@@ -106,6 +108,7 @@ class SemiInverseDriver(Driver):
         if holder is not None:
             k = model.material[0] * area / model.thickness  # E A / t: through-thickness stiffness
             self.holder = ForceControlledHolder(holder, holder_force, k, model.mesh.comm)
+        self.holder_rtol = self.holder.rtol if self.holder is not None else 0.0
         self.state = ContactState(self.n_owned)
         self.committed = self.state.copy()
         self.x_n = self.X[: self.n_owned].copy()  # positions at the start of the increment
@@ -114,6 +117,7 @@ class SemiInverseDriver(Driver):
         self._kz_holder = np.zeros(self.n_owned)
         self._friction = np.zeros((self.n_owned, 3))
         self._slip_rate = np.zeros((self.n_owned, 2, 2))
+        self._slipping = np.zeros(self.n_owned, dtype=bool)
         self._passes = self._changes = self._frozen = 0
         self.times["contact_s"] = 0.0
         self.nodal = self  # the contact forces enter the residual through Driver's nodal hook
@@ -140,9 +144,10 @@ class SemiInverseDriver(Driver):
         for k, (gap, _) in enumerate(self._gaps(x, 0.0)):
             touch = (gap <= self.contact.penetration) & (s.tool == FREE)
             s.tool[touch] = k
-            s.anchor[touch] = x[touch]
-        s.stick[:] = (s.tool != FREE) & (self.mu > 0)
         self.committed = s.copy()
+        if self.holder is not None:
+            self.holder.balance(x, self.half_thickness)
+        self.committed_Z = self.holder.Z if self.holder is not None else 0.0
 
     def _nodal_areas_and_thickness_strain(self):
         """Tributary areas (a third of each cell) and their area-weighted thickness strain."""
@@ -173,11 +178,12 @@ class SemiInverseDriver(Driver):
         flags = np.zeros((n_own, BS))
         self._friction[:] = 0.0
         self._slip_rate[:] = 0.0
+        self._slipping[:] = False
         if self.holder is not None:
             self._fz_holder, self._kz_holder = self.holder.forces(x, self.half_thickness)
         for k in range(len(self.tools)):
             off = (s.tool == k) & ~np.isfinite(gaps[k][0])  # slid off the tool's extent
-            s.tool[off], s.stick[off], s.pressure[off] = FREE, False, 0.0
+            s.tool[off], s.pressure[off] = FREE, 0.0
             on = np.flatnonzero(s.tool == k)
             if on.size == 0:
                 continue
@@ -185,14 +191,12 @@ class SemiInverseDriver(Driver):
             frames[on] = nodal_frames(normal)
             known[on, 2] = -gap  # the normal correction that closes the gap
             flags[on, 2] = 1.0
-            stick = on[s.stick[on]]
-            if stick.size:  # tangential correction back to the anchor carried by the tool
-                d = s.anchor[stick] + self._offset(k, lam) - x[stick]
-                known[stick, :2] = np.einsum("nij,nj->ni", frames[stick, :2], d)
-                flags[stick, :2] = 1.0
-            slip = on[~s.stick[on]]
-            if slip.size and self.mu > 0:
-                self._friction[slip] = self._slip_forces(slip, k, lam, x, frames[slip])
+            if self.mu > 0:
+                shift = (lam - self.lam_n) * self.travel[k]  # the tool's travel in this increment
+                self._friction[on] = self._coulomb(on, shift, x, frames[on])
+        if self.mu > 0 and self.holder is not None:  # flange nodes the holder alone pinches
+            only = np.flatnonzero((s.tool == FREE) & (self._fz_holder < 0))
+            self._friction[only] = self._coulomb(only, 0.0, x, frames[only])
         flags[:, :3][self.sym_fixed] = 0.0  # already held by symmetry (a homogeneous condition)
         known[:, :3][self.sym_fixed] = 0.0
         # share with the ghosts
@@ -211,26 +215,28 @@ class SemiInverseDriver(Driver):
         jump = max(jump, np.abs(self.g[d] - self.q.x.array[d]).max(initial=0.0))
         return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
 
-    def _slip_forces(self, slip, k, lam, x, F):
-        """mu (p_n + p_holder) along the friction direction, in the tangent plane; the direction
-        opposes the slip s relative to tool k in this increment (kept while s ~ 0). Its rate,
-        d f / d s = -mu p / |s| (I - s s^T / |s|^2) in the tangent plane, enters the tangent (for
-        fixed p): the friction direction then converges with Newton's rate."""
+    def _coulomb(self, on, shift, x, F):
+        """Coulomb forces on the nodes `on` of a tool that moved by `shift` along z in this
+        increment: f = -mu (p_n + p_holder) s / max(|s|, eps),
+        and their rate df/ds in the tangent slots, -mu p / |s| (I - s s^T / |s|^2) when
+        slipping, -mu p / eps I when sticking (for fixed p)."""
         s = self.state
         n = F[:, 2]
-        rel = x[slip] - self.x_n[slip] - (self._offset(k, lam) - self._offset(k, self.lam_n))
-        st = rel - np.sum(rel * n, axis=1)[:, None] * n
+        rel = x[on] - self.x_n[on]
+        rel[:, 2] -= shift
+        st = rel - np.sum(rel * n, axis=1)[:, None] * n  # slip in the tangent plane
         size = np.linalg.norm(st, axis=1)
-        moving = size > 1e-9 * self.model.cell_size
-        s.direction[slip[moving]] = -st[moving] / size[moving, None]
-        d = s.direction[slip] - np.sum(s.direction[slip] * n, axis=1)[:, None] * n
-        dn = np.linalg.norm(d, axis=1)
-        d[dn > 0] /= dn[dn > 0, None]
-        p = np.maximum(s.pressure[slip], 0.0) - self._fz_holder[slip]  # both faces rub
-        d2 = np.einsum("nij,nj->ni", F[:, :2], d)  # the direction in the tangent slots
-        rate = np.where(moving, self.mu * p / np.where(moving, size, 1.0), 0.0)
-        self._slip_rate[slip] = rate[:, None, None] * (np.eye(2) - d2[:, :, None] * d2[:, None, :])
-        return self.mu * p[:, None] * d
+        eps = self.contact.slip_regularization * self.model.cell_size
+        slipping = size > eps
+        p = np.maximum(s.pressure[on], 0.0) - self._fz_holder[on]  # both faces rub on the flange
+        scale = self.mu * p / np.maximum(size, eps)
+        s2 = np.einsum("nij,nj->ni", F[:, :2], st) / np.maximum(size, eps)[:, None]
+        rate = scale[:, None, None] * (np.eye(2) - slipping[:, None, None] * s2[:, :, None] * s2[:, None, :])
+        held = self.sym_fixed[on, :2]  # a symmetry plane holds that slot: no rate there
+        rate[held[:, :, None] | held[:, None, :]] = 0.0
+        self._slip_rate[on] = rate
+        self._slipping[on] = slipping
+        return -scale[:, None] * st
 
     def _set_bcs(self, flag):
         V = self.model.V
@@ -276,6 +282,8 @@ class SemiInverseDriver(Driver):
     def _newton(self, lam, reversal=False):
         """Newton on the fixed contact set, then settle the set; repeat until it holds."""
         self.state = self.committed.copy()
+        if self.holder is not None:
+            self.holder.Z = self.committed_Z
         self._lam_trial = lam
         self._passes = self._changes = 0
         iterations, residuals, ev = 0, [], None
@@ -302,15 +310,67 @@ class SemiInverseDriver(Driver):
             if not np.isfinite(norm) or ev.failures:
                 return False, it, residuals, ev
             self._update_pressure()
-            if norm <= c.rtol * scale and jump <= self.contact.gap_tol:
+            misfit = self._holder_misfit()
+            if norm <= c.rtol * scale and jump <= self.contact.gap_tol and misfit <= self.holder_rtol:
                 return True, it, residuals, ev
             if it == c.max_iterations:
                 break
             if not self._solve(jump if jump > 0 else 0.0):
                 return False, it, residuals, ev
+            if self.holder is not None and self.holder.force > 0 and not self._holder_step():
+                return False, it, residuals, ev
             from_frames(self.dq.x.array, self.rotated, self.frames)
             self.q.x.array[:] += self.dq.x.array
         return False, c.max_iterations, residuals, ev
+
+    def _holder_misfit(self) -> float:
+        if self.holder is None or self.holder.force <= 0:
+            return 0.0
+        g, _, _ = self.holder.linearisation(self.positions(), self.half_thickness)
+        return abs(g) / self.holder.force
+
+    def _holder_step(self) -> bool:
+        """The bordered Newton step for the holder height Z. With b = dR/d(-Z) (k_i on the w rows
+        of the free nodes bearing the holder), y = the step just solved and z = K^-1 b:
+
+            dq = y + z dZ,   dZ = (g + b.y + sum_pinched k_i dw_i) / (c - b.z),   c = sum k_i
+
+        (the pinched nodes' dw_i are known: they lie on the die)."""
+        h = self.holder
+        g, act, k = h.linearisation(self.positions(), self.half_thickness)
+        comm = self.model.mesh.comm
+        c = comm.allreduce(float(k.sum()), op=MPI.SUM)
+        if c == 0.0:  # the holder touches nothing: lower it onto the highest top
+            h.balance(self.positions(), self.half_thickness)
+            return True
+        w = BS * act + 2
+        pinned = self._flag_fn.x.array[w] > 0.5
+        y = self.dq.x.array
+        by = float(np.sum(k[~pinned] * y[w[~pinned]]))
+        kp = float(np.sum(k[pinned] * self._known_fn.x.array[w[pinned]]))
+        bvec = self._z_fn.x.petsc_vec.duplicate()
+        bvec.set(0.0)
+        arr = bvec.getArray(readonly=False)
+        arr[w[~pinned]] = k[~pinned]
+        del arr
+        t0 = time.perf_counter()
+        self.ksp.solve(bvec, self._z_fn.x.petsc_vec)
+        self.times["solve_s"] += time.perf_counter() - t0
+        bvec.destroy()
+        if self.ksp.getConvergedReason() < 0:
+            return False
+        self._z_fn.x.scatter_forward()
+        z = self._z_fn.x.array
+        bz = float(np.sum(k[~pinned] * z[w[~pinned]]))
+        by, bz, kp = (comm.allreduce(v, op=MPI.SUM) for v in (by, bz, kp))
+        dZ = (g + by + kp) / (c - bz)
+        # a holder that lands on free flange nodes moves them by F / (sheet stiffness): go there
+        # in steps of at most a tenth of the thickness (the die catches them on the way)
+        limit = 0.1 * self.model.thickness
+        dZ = float(np.clip(dZ, -limit, limit))
+        self.dq.x.array[:] += dZ * z
+        h.Z += dZ
+        return bool(np.isfinite(dZ))
 
     def reactions(self) -> np.ndarray:
         """(n_owned, 3) residual on the u, v, w rows in the nodal frames (tool forces on constrained rows)."""
@@ -322,18 +382,16 @@ class SemiInverseDriver(Driver):
         s.pressure[on] = self.reactions()[on, 2]
 
     def _update_set(self, lam) -> int:
-        """Join penetrating nodes, release tensile ones, switch stick and slip; returns the
+        """Join penetrating nodes, release tensile ones, rebalance the holder; returns the
         number of changes on all ranks."""
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
-        r = self.reactions()
         changes = 0
         scale = max(self.model.mesh.comm.allreduce(float(np.abs(s.pressure).max(initial=0.0)), op=MPI.MAX), 1e-300)
         can = s.toggles < self.contact.max_toggles
         # tensile contact force: release
         release = (s.tool != FREE) & (s.pressure < -1e-8 * scale) & can
         s.tool[release] = FREE
-        s.stick[release] = False
         s.pressure[release] = 0.0
         s.toggles[release] += 1
         changes += int(release.sum())
@@ -343,38 +401,10 @@ class SemiInverseDriver(Driver):
         k = np.argmin(depth, axis=0)
         join = (s.tool == FREE) & (depth.min(axis=0) < -self.contact.penetration) & can & ~release
         s.tool[join] = k[join]
-        s.stick[join] = self.mu > 0
-        for kk in range(len(self.tools)):
-            j = join & (k == kk)
-            s.anchor[j] = x[j] - self._offset(kk, lam)
         s.toggles[join] += 1
         changes += int(join.sum())
-        if self.mu > 0:
-            on = s.tool != FREE
-            hold = np.where(on, -self._fz_holder, 0.0)
-            limit = self.mu * (np.maximum(s.pressure, 0.0) + hold)
-            free_t = ~self.sym_fixed[:, :2]
-            pt = np.where(free_t, r[:, :2], 0.0)
-            size = np.linalg.norm(pt, axis=1)
-            to_slip = on & s.stick & (size > limit * (1 + 1e-6) + 1e-12 * scale) & can
-            F = self.frames[: self.n_owned]
-            s.direction[to_slip] = np.einsum("nij,ni->nj", F[to_slip, :2], pt[to_slip]) / size[to_slip, None]
-            s.stick[to_slip] = False
-            s.toggles[to_slip] += 1
-            # a slipping node whose slip turned along its friction force sticks again
-            rel = x - self.x_n
-            for kk in range(len(self.tools)):
-                rel[s.tool == kk] -= self._offset(kk, lam) - self._offset(kk, self.lam_n)
-            c = self.committed
-            was_slipping = (c.tool != FREE) & ~c.stick
-            back = on & ~s.stick & was_slipping & ~to_slip & can
-            back &= np.sum(rel * c.direction, axis=1) > 1e-9 * self.model.cell_size
-            s.stick[back] = True
-            for kk in range(len(self.tools)):
-                j = back & (s.tool == kk)
-                s.anchor[j] = x[j] - self._offset(kk, lam)
-            s.toggles[back] += 1
-            changes += int(to_slip.sum() + back.sum())
+        if self.holder is not None and self.holder.balance(x, self.half_thickness):
+            changes += 1  # the holder moved to carry its force again: one more pass
         self._frozen = int((s.toggles >= self.contact.max_toggles).sum())
         self.times["contact_s"] += time.perf_counter() - t0
         return self.model.mesh.comm.allreduce(changes, op=MPI.SUM)
@@ -383,12 +413,10 @@ class SemiInverseDriver(Driver):
         super()._commit()
         s = self.state
         s.toggles[:] = 0
-        # stick anchors move on with the node (the tool carried it)
         x = self.positions()
-        for k in range(len(self.tools)):
-            j = (s.tool == k) & s.stick
-            s.anchor[j] = x[j] - self._offset(k, self._lam_trial)
         self.committed = s.copy()
+        if self.holder is not None:
+            self.committed_Z = self.holder.Z
         self.x_n = x
         self.lam_n = self._lam_trial
         if self.model.plastic:
