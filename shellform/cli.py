@@ -70,20 +70,17 @@ def main(argv=None) -> int:
                 print(f"shellform: {summary['title']}: {summary['cells']} cells, stroke {summary['stroke_mm']:.2f} mm, "
                       f"draw-in {last}, max thickness strain {summary['max_thickness_strain']:.4f}, "
                       f"{summary['wall_time_s']['total']:.1f} s; results in {args.out}")
-                if summary["stopped"]:
-                    print(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
-                    return 3
             elif "reports" in summary:
                 last = summary["reports"][-1] if summary["reports"] else {}
                 print(f"shellform: {summary['title']}: {summary['cells']} cells, {summary['increments']} "
                       f"increments, load factor {last.get('load_factor')}, w = {last.get('w')}, "
                       f"{summary['wall_time_s']:.2f} s; results in {args.out}")
-                if summary["stopped"]:
-                    print(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
-                    return 3
             else:
                 print(f"shellform: {summary['title']}: {summary['cells']} cells, w_center = "
                       f"{summary['w_center']}, {summary['wall_time_s']:.2f} s; results in {args.out}")
+            if summary.get("stopped"):
+                print(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
+                return 3
         else:
             import importlib
 
