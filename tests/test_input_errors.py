@@ -11,6 +11,14 @@ from shellform.errors import InputError
 from shellform.linear import parameters
 
 
+def assert_names_field(data: dict, field: str) -> None:
+    """The scene `data` is rejected with an InputError whose field (and message prefix) is `field`."""
+    with pytest.raises(InputError) as err:
+        scene.from_dict(data)
+    assert err.value.field == field
+    assert str(err.value).startswith(field + ":")
+
+
 @pytest.mark.parametrize("data, field", [
     ({"material": {"thickness": -0.1}}, "material.thickness"),
     ({"material": {"thickness": 0.0}}, "material.thickness"),
@@ -34,10 +42,7 @@ from shellform.linear import parameters
     ({"materials": {}}, "materials"),
 ])
 def test_scene_errors_name_the_field(data, field):
-    with pytest.raises(InputError) as err:
-        scene.from_dict(data)
-    assert err.value.field == field
-    assert str(err.value).startswith(field + ":")
+    assert_names_field(data, field)
 
 
 FULL = ["bending", "membrane"]
@@ -90,10 +95,7 @@ POWER = {"hardening": "power", "yield_stress": 2.0e-3, "n": 5.0}
     ({"effects": FULL, "supports": {"right": "clamped_sliding"}}, "supports.right"),
 ])
 def test_nonlinear_scene_errors_name_the_field(data, field):
-    with pytest.raises(InputError) as err:
-        scene.from_dict(data)
-    assert err.value.field == field
-    assert str(err.value).startswith(field + ":")
+    assert_names_field(data, field)
 
 
 def test_plasticity_without_a_curve_says_which_curves():
@@ -202,10 +204,7 @@ def cup(effects=CONTACT, tools=None, geometry=None, supports=None, thickness=0.8
     (cup(geometry={"region": "full"}), "supports.left"),  # every side of a full blank is outer
 ])
 def test_tools_errors_name_the_field(data, field):
-    with pytest.raises(InputError) as err:
-        scene.from_dict(data)
-    assert err.value.field == field
-    assert str(err.value).startswith(field + ":")
+    assert_names_field(data, field)
 
 
 def test_tools_error_messages():

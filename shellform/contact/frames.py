@@ -70,13 +70,6 @@ def rotate_cell_arrays(dofs, rotated, frames, vectors, matrices, tangent):
                     matrices[c, j, r0 + i] = tmp[i]
 
 
-def to_frames(array: np.ndarray, rotated: np.ndarray, frames: np.ndarray) -> None:
-    """In place on a blocked carrier array: (u, v, w) -> F (u, v, w) on the rotated blocks."""
-    d = array.reshape(-1, BS)
-    idx = np.flatnonzero(rotated[: d.shape[0]])
-    d[idx, :3] = np.einsum("nij,nj->ni", frames[idx], d[idx, :3])
-
-
 def from_frames(array: np.ndarray, rotated: np.ndarray, frames: np.ndarray) -> None:
     """In place: F (u, v, w) -> (u, v, w) = F^T (rotated values) on the rotated blocks."""
     d = array.reshape(-1, BS)

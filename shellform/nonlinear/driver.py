@@ -124,9 +124,9 @@ class Driver:
         self._floor = 0.0
 
     # -- residual and tangent ----------------------------------------------------------------
-    def _set_dirichlet(self, lam):
-        """g = lam qbar on the Dirichlet dofs; returns the largest jump |g - q| there."""
-        g, d = self.g, self.bc_dofs
+    def _set_dirichlet(self, lam, dofs=None):
+        """g = lam qbar on the Dirichlet dofs (or on `dofs`); returns the largest jump |g - q| there."""
+        g, d = self.g, self.bc_dofs if dofs is None else dofs
         g[d] = lam * self.prescribed.x.array[d] if self.prescribed else 0.0
         jump = np.abs(g[d] - self.q.x.array[d]).max() if d.size else 0.0
         return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
