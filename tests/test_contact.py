@@ -122,12 +122,11 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
     assert abs(forces[-1]) < 1e-6 * max(abs(f) for f in forces)
 
 
-def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
-    """A strip pinched between a flat die and a flat force-controlled holder (F = 1 kN) is
-    pulled 2 mm at one end: once it slides, the pull equals mu times the sum of the normal
-    forces on both faces (to 1e-8) and 2 mu F (to 1e-4); the holder's forces sum to F at every
-    increment, and no tangential force exceeds mu times its normal force."""
-    t, mu, F = 1.0, 0.15, 1000.0
+def _strip(mu=0.15, F=1000.0, t=1.0, friction_rtol=1e-10, **controls):
+    """A 100 x 20 strip pinched over |x| <= 40 between a flat die and a flat holder pressing with
+    F; its right end is pulled by lambda * 2 mm along x."""
+    from shellform.contact.semi_inverse import ContactControls
+
     rect = rectangle(MPI.COMM_WORLD, 100.0, 20.0, region="full", n=10)
     model = SheetModel(rect.mesh, Hill79Material(E=210000.0, nu=0.3).pack(), t, ("geometric_nonlinearity",))
     die, holder = FlatTool(-t / 2, 40.0, sign=1.0), FlatTool(t / 2, 40.0, sign=-1.0)
@@ -139,46 +138,173 @@ def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
         dofs = fem.locate_dofs_topological(V.sub(k), 1, right)
         qbar.x.array[dofs] = value
         bcs.append(fem.dirichletbc(np.float64(0), dofs, V.sub(k)))
+    contact = ContactControls(penetration=1e-3 * t, friction_rtol=friction_rtol)
     d = SemiInverseDriver(model, bcs, [die], [0.0], friction=mu, holder=holder, holder_force=F, prescribed=qbar,
-                          controls=Controls(initial_step=0.1, rtol=1e-10, max_iterations=25), verbose=False)
+                          contact=contact, controls=Controls(**{"initial_step": 0.1, "rtol": 1e-10,
+                                                                "max_iterations": 25, **controls}), verbose=False)
+    return rect, d
+
+
+def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
+    """A strip pinched between a flat die and a flat holder (F = 1 kN) is pulled 2 mm at one
+    end: once it slides, the pull equals mu times the sum of the normal forces on both faces
+    (to 1e-8) and 2 mu F (to 1e-4); the holder's nodal forces sum to F at every increment, every
+    node under it stays pinched, and no tangential force exceeds mu times its normal force."""
+    mu, F = 0.15, 1000.0
+    rect, d = _strip(mu, F)
     comm = MPI.COMM_WORLD
 
     def check(dr):
-        assert abs(dr.holder.total(dr._fz_holder) - F) <= 1e-7 * F
-        on = dr.state.tool == 0
-        p = np.maximum(dr.state.pressure, 0.0) - dr._fz_holder
-        ft = np.linalg.norm(dr._friction[:, :2], axis=1)
-        # the magnitude uses p of the previous iterate (a fixed point converged with Newton)
-        assert np.all(ft <= mu * p * (1 + 1e-6) + 1e-9)
-        assert np.all(p[on] >= 0)
+        assert abs(dr.holder.total(dr.state.holder_face) - F) <= 1e-9 * F
+        under = dr.holder.under(dr.positions())
+        assert np.array_equal(dr.pinched, under)  # no free node under the closed holder
+        p = dr.state.pressure + dr.state.holder_face
+        ft = np.linalg.norm(dr._friction, axis=1)
+        assert np.all(ft <= mu * p * (1 + 1e-8) + 1e-9)
+        assert np.all(dr.state.pressure[under] >= 0)
 
     d.run(1.0, on_increment=check)
     pull = _side_sum(d, rect, ("right",), 0)
-    normal = comm.allreduce(float((np.maximum(d.state.pressure, 0.0) - d._fz_holder).sum()), op=MPI.SUM)
+    normal = comm.allreduce(float((d.state.pressure + d.state.holder_face).sum()), op=MPI.SUM)
     assert abs(pull - mu * normal) <= 1e-8 * mu * normal
     assert abs(pull - 2 * mu * F) <= 1e-4 * 2 * mu * F
     assert np.all(d._slipping[d.state.tool == 0])  # the whole strip slides on the die
 
 
-def test_short_square_cup_draw():
-    """The square-cup scene on a coarse quarter blank, 1 mm of stroke: the holder's forces sum
-    to 19.6 kN at every increment, no node penetrates a tool by more than 1 % of the thickness,
-    the contact set settles within each increment and the punch force grows."""
+def test_slip_reversal_converges_without_friction_flips():
+    """The strip pulled 1 mm, then pushed back 0.5 mm. A node's friction force never jumps
+    from one side of the Coulomb cone to the other between Newton iterates (both at >= half the
+    limit mu p), except once, in the first correction of the increment where the slip reverses
+    (the return mapping goes through stick; and from rest, in the first increment, in the first
+    two corrections); every Newton pass ends superlinearly; after the
+    reversal the whole strip slides the other way with the pull reversed."""
+    mu, F = 0.15, 1000.0
+    rect, d = _strip(mu, F, initial_step=0.05, max_step=0.05)
+    sides, log = [], []
+    constraints = d._constraints
+
+    def record(lam):
+        jump = constraints(lam)
+        limit = mu * (d.state.pressure + d.state.holder_face)
+        f = d._friction[:, 0]
+        sides.append(np.sign(f) * (np.abs(f) >= 0.5 * limit) * (limit > 0))
+        return jump
+
+    d._constraints = record
+
+    def check(dr):
+        s = np.array(sides)
+        jumps = s[1:] * s[:-1] < 0  # (iterate pairs, nodes): the force crossed the cone
+        log.append((int(jumps.sum(axis=0).max()), int(jumps[1:].sum()), [list(r) for r in dr.pass_residuals]))
+        sides.clear()
+
+    d.run(0.5, on_increment=check)
+    pull_forward = _side_sum(d, rect, ("right",), 0)
+    n_forward = len(log)
+    d.run(0.25, on_increment=check)
+    pull_back = _side_sum(d, rect, ("right",), 0)
+    # from rest (the first increment) every node starts sticking with no force: one crossing
+    # is allowed there in its first two corrections
+    assert all(per_node <= 1 for per_node, _, _ in log) and log[0][1] <= 1, [e[:2] for e in log]
+    assert all(late == 0 for _, late, _ in log[1:]), [e[:2] for e in log]
+    assert log[n_forward][0] == 1  # the reversal: one crossing, in the first correction
+    assert all(e[0] == 0 for i, e in enumerate(log) if i not in (0, n_forward))
+    assert pull_forward == pytest.approx(2 * mu * F, rel=1e-4)
+    assert pull_back == pytest.approx(-2 * mu * F, rel=1e-4)
+    assert np.all(d._slipping[d.state.tool == 0]) and np.all(d._friction[d.state.tool == 0, 0] > 0)
+    tol = d.controls.rtol * d._scale  # Newton's tolerance: below it, round-off
+    for _, _, passes in log:  # superlinear tails: above the tolerance, the last reduction is the
+        for r in passes:      # best of the pass and at least 1e-2
+            above = np.array([v for v in r[int(np.argmax(r)):] if v > tol])
+            ratios = above[1:] / above[:-1]
+            assert ratios.size == 0 or ratios[-1] <= 1e-2, r
+            assert ratios.size < 2 or ratios[-1] < ratios[-2], r
+
+
+def _cup(n=8, **tools):
     s = scene.load(ROOT / "demos" / "square_cup.toml")
-    s.mesh.n = 8
+    s.mesh.n = n
+    for k, v in tools.items():
+        setattr(s.tools, k, v)
+    return s
+
+
+def test_short_square_cup_draw():
+    """The square-cup scene on a coarse quarter blank, 3 mm of stroke: at every increment the
+    holder's nodal forces sum to 19.6 kN and no node takes more than 10 % of it, the tools' forces
+    balance (to 1e-6 of the punch force), no flange node under the closed holder is free, no node
+    penetrates a tool by more than 1 % of the thickness and the contact settles; the punch force
+    grows."""
+    s = _cup()
     p = DrawingProblem.from_scene(s, verbose=False)
     forces = []
 
     def check(d):
-        assert abs(p.holder_force() - s.tools.blank_holder_force) <= 1e-6 * s.tools.blank_holder_force
+        assert abs(p.holder_force() - s.tools.blank_holder_force) <= 1e-9 * s.tools.blank_holder_force
+        assert p.holder_share() <= 0.1
+        assert p.force_balance() <= 1e-6
+        assert p.free_under_holder() == 0 and d.state.closed[0]
         assert p.max_penetration() <= 0.01 * s.material.thickness
         assert d.history[-1].contact["passes"] < d.contact.max_passes
         forces.append(p.punch_force())
 
-    p.driver.run(1.0 / s.tools.stroke, on_increment=check)
+    p.driver.run(3.0 / s.tools.stroke, on_increment=check)
     assert forces[-1] > forces[0] > 0
+    assert np.all(np.diff(forces) > 0)
     c = p.in_contact()
-    assert c["punch"] > 0 and c["die"] > 0 and c["free"] > 0
+    assert c["punch"] > 0 and c["pinched"] > 0 and c["free"] > 0
+
+
+@pytest.mark.parametrize("force", [0.0, 4.0])
+def test_cup_without_a_holder_force_draws(force):
+    """BHF = 0 (no holder) and 4 N (a holder that the flange lifts): the cup draws its first
+    millimetre, the holder open, with the tools in balance and no penetration."""
+    s = _cup(blank_holder_force=force)
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(1.0 / s.tools.stroke)
+    d = p.driver
+    assert p.stroke == pytest.approx(1.0)
+    assert not d.state.closed[0] and p.free_under_holder() == 0
+    assert p.holder_force() == pytest.approx(force, abs=1e-9)
+    assert p.force_balance() <= 1e-6
+    assert p.max_penetration() <= 0.01 * s.material.thickness
+    assert p.punch_force() > 0
+
+
+def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
+    """A run whose Newton breaks down (here: forced past 0.5 mm, leaving a wild iterate behind)
+    stops with its cause, and summary.json reports the last converged state: the stroke, punch
+    force and draw-in of the last line of force_stroke.csv, not of the failed iterate."""
+    import csv
+    import json
+
+    from shellform.contact import run as contact_run
+
+    original = SemiInverseDriver._newton_fixed_set
+
+    def breaks_down(self, lam):
+        if lam * 30.0 <= 0.5 + 1e-9:
+            return original(self, lam)
+        self.q.x.array[:] += 5.0  # a diverged iterate: its reactions must not be reported
+        self._constraints(lam)
+        self.residual(lam, tangent=False)
+        self._cause = "forced by the test"
+        return False, 1, [1e9], None
+
+    monkeypatch.setattr(SemiInverseDriver, "_newton_fixed_set", breaks_down)
+    s = _cup()
+    s.process.initial_step = s.process.max_step = 0.25 / 30.0
+    summary = contact_run.run(s, tmp_path)
+    assert "forced by the test" in summary["stopped"]
+    rows = list(csv.DictReader(open(tmp_path / "force_stroke.csv")))
+    last = rows[-1]
+    assert summary["stroke_mm"] == pytest.approx(0.5) == pytest.approx(float(last["stroke_mm"]))
+    force = summary["punch_force_kN"][-1]
+    assert force["stroke_mm"] == pytest.approx(0.5)
+    assert force["force"] == pytest.approx(float(last["punch_force_kN"]), rel=1e-5) and force["force"] > 0
+    assert abs(summary["draw_in_mm"][-1]["DD"]) < 0.1
+    assert json.loads((tmp_path / "summary.json").read_text())["stopped"] == summary["stopped"]
+    assert (tmp_path / "last_converged.rank0.npz").exists()
 
 
 @pytest.mark.parametrize("bad", [

@@ -1,19 +1,32 @@
-"""The blank holder under force control: its height Z is an unknown fixed by its force.
+"""The blank holder under force control: it pinches the flange onto the die's flat top.
 
-The rigid holder rests on the flange over the die's flat top. Between two rigid tools the
-sheet's only compliance is through its thickness, so a node whose top surface z_i + t_i/2 rises
-above Z is squeezed by the through-thickness stiffness of its tributary area,
+Between the rigid die and the rigid holder, a flange node is *pinched*: its normal position is
+known (it lies on the die) whatever the sign of its net normal force R0 (die minus holder).
+The shell carries no through-thickness strain, so the two faces' forces are known only through
+their difference R0 and the holder's total F; their split is a modelling choice, the *squeeze*
+s_i >= 0 with  sum_i (s_i + max(-R0_i, 0)) = F :
 
-    p_i = k_i max(z_i + t_i/2 - Z, 0),   k_i = E A_i / t_i,
+    die face     d_i = s_i + max(R0_i, 0)
+    holder face  h_i = s_i + max(-R0_i, 0)        sum_i h_i = F,  friction pressure d_i + h_i
 
-and Z solves  sum_i p_i(Z) = F  (the prescribed force): a piecewise-linear decreasing function
-of Z, solved exactly by sorting the tops. The holder therefore bears on the thickest part of the
-flange, as a rigid holder does. The squeeze is micrometres (E A/t ~ 1e6 N/mm per node), far
-below the thickness change that redistributes it.
+The squeeze left to spread is S = F - sum_i max(-R0_i, 0). ``spread`` says how:
+- "area" (default): s_i = S A_i / sum A (tributary areas), the uniform flange pressure of a
+  holder whose own compliance and the sheet's absorb the flange's thickness differences. On a
+  nodal mesh the rigid law below puts the whole force on 2 to 4 of the thickest nodes, which a
+  real holder (elastic, on a sheet whose thickness varies by micrometres between nodes early in
+  the stroke) does not do, and friction on those few nodes then drives the flange.
+- "rigid": the rigid holder on the thickest rim: s_i = k_i max(top_i - Z, 0) with the
+  through-thickness stiffness k_i = E A_i / t and Z fixed by sum s_i = S.
+
+The holder *opens* when the flange pushes it up harder than F holds it down (S < 0), and is
+open whenever F = 0. Open, it presses the flange under it with F spread by area as a load, and
+the nodes there are ordinary die contacts that leave the die when their force turns tensile.
 """
 
 import numpy as np
 from mpi4py import MPI
+
+SPREADS = ("area", "rigid")
 
 
 def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:
@@ -29,56 +42,56 @@ def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:
     return float(Z[j])
 
 
-class ForceControlledHolder:
-    """Holder forces on the owned nodes whose plan position lies over the die's flat top.
+class PinchingHolder:
+    """The holder's force F on the owned nodes under it (plan position over the die's flat top).
 
-    Z is a Newton unknown beside the carrier (the driver's bordered solve, Sherman-Morrison):
-    the force balance  g(q, Z) = sum_i k_i max(top_i - Z, 0) - F = 0  is linearised as
-    sum_active k_i dw_i - (sum_active k_i) dZ = -g.  ``balance`` re-solves Z exactly for given
-    positions (at the start, and as a safeguard between contact passes).
+    area: tributary areas of the owned nodes; stiffness: their E A / t (the "rigid" spread).
     """
 
-    def __init__(self, tool, force: float, stiffness: np.ndarray, comm, rtol: float = 1e-8):
-        self.tool, self.force, self.k, self.comm = tool, float(force), np.asarray(stiffness), comm
-        self.rtol = rtol
-        self.Z = tool.z_face
+    def __init__(self, tool, force: float, area: np.ndarray, stiffness: np.ndarray, comm, spread: str = "area"):
+        if spread not in SPREADS:
+            raise ValueError(f"holder spread must be one of {SPREADS}, got {spread!r}")
+        self.tool, self.force, self.comm, self.spread = tool, float(force), comm, spread
+        self.area, self.k = np.asarray(area, dtype=float), np.asarray(stiffness, dtype=float)
 
-    def _tops(self, x, half_thickness):
-        gap, _ = self.tool.gap(x, half_thickness, 0.0)  # gap = z_face - top (inf off the holder)
-        under = np.isfinite(gap)
-        return under, self.tool.z_face - gap[under]
+    def under(self, x: np.ndarray) -> np.ndarray:
+        """Nodes whose plan position lies under the holder's face."""
+        return np.isfinite(self.tool.gap(x, 0.0, 0.0)[0])
 
-    def forces(self, x: np.ndarray, half_thickness: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Nodal forces along z on the sheet (<= 0) at the holder height Z, and their stiffness."""
-        under, tops = self._tops(x, half_thickness)
-        fz, kz = np.zeros(x.shape[0]), np.zeros(x.shape[0])
-        idx = np.flatnonzero(under)
-        squeeze = np.maximum(tops - self.Z, 0.0)
-        fz[idx] = -self.k[idx] * squeeze
-        kz[idx] = np.where(squeeze > 0, self.k[idx], 0.0)
-        return fz, kz
+    def _sum(self, v) -> float:
+        return self.comm.allreduce(float(np.sum(v)), op=MPI.SUM)
 
-    def linearisation(self, x, half_thickness):
-        """(g, active node indices, their k): the force misfit and the nodes bearing the holder."""
-        under, tops = self._tops(x, half_thickness)
-        idx = np.flatnonzero(under)
-        squeeze = tops - self.Z
-        act = idx[squeeze > 0]
-        total = self.comm.allreduce(float(np.sum(self.k[idx] * np.maximum(squeeze, 0.0))), op=MPI.SUM)
-        return total - self.force, act, self.k[act]
+    def squeeze_left(self, pinched: np.ndarray, net: np.ndarray) -> float:
+        """S = F - sum over the pinched nodes of max(-R0, 0), all ranks (< 0: the holder lifts)."""
+        return self.force - self._sum(np.maximum(-net[pinched], 0.0))
 
-    def balance(self, x: np.ndarray, half_thickness: np.ndarray) -> bool:
-        """Move Z so that the forces at the positions x sum to F; False if they already did."""
-        under, tops = self._tops(x, half_thickness)
-        all_tops = np.concatenate(self.comm.allgather(tops))
-        all_k = np.concatenate(self.comm.allgather(self.k[under]))
-        if all_tops.size == 0:
-            return False
-        total = float(np.sum(all_k * np.maximum(all_tops - self.Z, 0.0)))
-        if abs(total - self.force) <= self.rtol * max(self.force, 1e-300):
-            return False
-        self.Z = holder_height(all_tops, all_k, self.force) if self.force > 0 else float(all_tops.max())
-        return True
+    def faces(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray):
+        """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed
+        holder, from their net normal forces R0 and their tops z + t/2 (the "rigid" spread)."""
+        S = max(self.squeeze_left(pinched, net), 0.0)
+        s = np.zeros(net.size)
+        if self.spread == "area":
+            total = self._sum(self.area[pinched])
+            if total > 0:
+                s[pinched] = S * self.area[pinched] / total
+        else:
+            all_tops = np.concatenate(self.comm.allgather(tops[pinched]))
+            all_k = np.concatenate(self.comm.allgather(self.k[pinched]))
+            if all_tops.size:
+                Z = holder_height(all_tops, all_k, S)
+                s[pinched] = self.k[pinched] * np.maximum(tops[pinched] - Z, 0.0)
+        d = np.where(pinched, s + np.maximum(net, 0.0), 0.0)
+        h = np.where(pinched, s + np.maximum(-net, 0.0), 0.0)
+        return d, h
 
-    def total(self, fz: np.ndarray) -> float:
-        return -self.comm.allreduce(float(fz.sum()), op=MPI.SUM)
+    def load(self, under: np.ndarray) -> np.ndarray:
+        """An open holder's force on the nodes under it, F spread by area (>= 0, pointing down)."""
+        total = self._sum(self.area[under])
+        h = np.zeros(under.size)
+        if total > 0:
+            h[under] = self.force * self.area[under] / total
+        return h
+
+    def total(self, h: np.ndarray) -> float:
+        """The holder's force on the sheet, all ranks."""
+        return self._sum(h)

@@ -55,7 +55,9 @@ class DrawingProblem:
 
     def tool_force(self, tool: int) -> np.ndarray:
         """Force of a tool on the sheet (x, y, z), whole blank: contact reactions of its nodes
-        rotated back from their frames, plus their friction forces."""
+        rotated back from their frames, plus their friction forces. On the die this includes
+        the nodes the closed holder pinches (their net force, die minus holder, and the
+        friction of both faces)."""
         d = self.driver
         on = d.state.tool == tool
         r = d.reactions()[on]
@@ -71,8 +73,34 @@ class DrawingProblem:
         return -float(self.tool_force(PUNCH)[2])
 
     def holder_force(self) -> float:
+        """The sum of the holder's nodal forces on the sheet (N, pressing down), whole blank."""
         d = self.driver
-        return self.symmetry * d.holder.total(d._fz_holder) if d.holder is not None else 0.0
+        return self.symmetry * d.holder.total(d.state.holder_face) if d.holder is not None else 0.0
+
+    def holder_share(self) -> float:
+        """The largest force one node takes from the holder, as a fraction of the holder's force."""
+        d = self.driver
+        if d.holder is None or d.holder.force <= 0:
+            return 0.0
+        return d.model.mesh.comm.allreduce(float(d.state.holder_face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
+
+    def holder_height(self) -> float:
+        """The holder's face: the highest top z + t/2 of the sheet under it (mm)."""
+        d = self.driver
+        if d.holder is None:
+            return float("nan")
+        x = d.positions()
+        under = d.holder.under(x)
+        top = float((x[under, 2] + d.half_thickness[under]).max(initial=-np.inf))
+        return d.model.mesh.comm.allreduce(top, op=MPI.MAX)
+
+    def force_balance(self) -> float:
+        """|sum of the tools' z-forces on the sheet| / punch force: the sheet's equilibrium
+        along z (the symmetry planes carry no z-force)."""
+        d = self.driver
+        fz = sum(float(self.tool_force(k)[2]) for k in range(len(d.tools)))
+        fz += self.symmetry * d.model.mesh.comm.allreduce(float(d.holder_load().sum()), op=MPI.SUM)
+        return abs(fz) / max(abs(self.punch_force()), 1e-300)
 
     def max_penetration(self) -> float:
         """The deepest penetration of any node into any tool (>= 0), all ranks."""
@@ -90,7 +118,16 @@ class DrawingProblem:
         return d.X[: d.n_owned, :2], d.positions(), e33
 
     def in_contact(self) -> dict:
-        """Nodes on the punch, on the die and on neither (all ranks)."""
+        """Nodes on the punch, on the die (of which pinched by the holder) and on neither (all ranks)."""
         on = self.driver.count_in_contact()
         total = self.model.V.dofmap.index_map.size_global
-        return {"punch": on[f"tool{PUNCH}"], "die": on[f"tool{DIE}"], "free": total - sum(on.values())}
+        return {"punch": on[f"tool{PUNCH}"], "die": on[f"tool{DIE}"], "pinched": on["pinched"],
+                "free": total - on[f"tool{PUNCH}"] - on[f"tool{DIE}"]}
+
+    def free_under_holder(self) -> int:
+        """Nodes under the closed holder that are not pinched (all ranks; 0 when it is open)."""
+        d = self.driver
+        if d.holder is None or not d.state.closed[0]:
+            return 0
+        loose = d.holder.under(d.positions()) & ~d.pinched
+        return d.model.mesh.comm.allreduce(int(loose.sum()), op=MPI.SUM)

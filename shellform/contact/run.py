@@ -147,7 +147,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
     def on_increment(d):
         h = d.history[-1]
         curve.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
-                      "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": d.holder.Z,
+                      "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
                       "max_penetration_mm": p.max_penetration(), "iterations": h.iterations,
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
 

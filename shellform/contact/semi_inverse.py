@@ -11,21 +11,30 @@ nodes split into free ones and nodes on a tool. A node on a tool is seen in its 
 Assembled as one DOLFINx system with the known components as Dirichlet rows (the lift is
 (27) exactly) and solved with PETSc; the contact forces are the residual's Dirichlet rows.
 
-Friction (Coulomb, mu) acts on every node on a tool, in the tangent plane, against its slip s
-relative to the tool in this increment:  f_t = -mu p_n s / max(|s|, eps),  so |f_t| <= mu p_n
-always; a node slips (|f_t| = mu p_n) once |s| > eps and sticks, held elastically, below it
-(eps = 1e-4 of the cell size by default: stick is resolved to a fraction of a micrometre).
-The force and its rate in s enter the residual and tangent; p_n comes from the latest iterate
-(the friction magnitude is a fixed point of the Newton iteration).
+The blank holder pinches the flange onto the die (holder.py): a node under the closed holder
+stays on the die whatever the sign of its net force; it leaves the pinch when it is drawn off
+the die's flat top, or when the holder opens.
 
-The contact set is settled within the increment: Newton converges on a fixed set, then nodes
-that penetrate a tool by more than `penetration` join it and nodes whose normal force turned
-tensile leave it; the increment is repeated from there until nothing changes. A node may switch
-at most `max_toggles` times per increment (no chattering: it then stays where it is); a set
-that does not settle in `max_passes` cuts the increment back.
+Friction (Coulomb, mu) is integrated as a return mapping, like non-associated plasticity, on
+every node on a tool and under the holder. With the node's slip increment ds relative to the
+tool (tangential part), the tangential force f_n of the last increment (history) and the stick
+stiffness k_t:
 
-The blank holder is force-controlled (holder.py): its height is the unknown that makes its
-contact forces sum to the prescribed force at every iterate.
+    trial  f* = f_n - k_t ds,   |f*| <= mu p: stick, f = f*,   dR/ds = k_t I
+                               |f*| >  mu p: slip,  f = mu p f*/|f*|,
+                                                    dR/ds = k_t (mu p/|f*|) (I - m m^T),  m = f*/|f*|
+
+k_t = stick_stiffness E A_i / h per node (a penalty of E/h per unit area, the scaling of an
+optimal contact penalty; elastic stick slips are then micrometres). The normal force p
+(both faces of a pinched node) is held fixed within a contact pass, so the tangent above is
+exact there and Newton converges quadratically; p is then updated from the reactions, and the
+passes repeat until p and the contact set hold (an outer, augmentation-like loop).
+
+Newton is globalised: each correction is first limited so that no node moves by more than
+`trust` thicknesses, then a line search on the energy slope dq . R(q + alpha dq) shortens it
+where it overshoots. The contact set is settled between passes: nodes that penetrate a tool by
+more than `penetration` join it, nodes (not pinched) whose normal force turned tensile leave it;
+a node may switch at most `max_toggles` times per increment (no chattering).
 """
 
 import time
@@ -37,29 +46,40 @@ from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
-from shellform.contact.holder import ForceControlledHolder
+from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver
 
 FREE = -1
+import os
+_DEBUG = bool(os.environ.get('SF_DEBUG'))
 
 
 @dataclass
 class ContactControls:
     penetration: float  # a free node may penetrate a tool by at most this much (length)
-    max_passes: int = 12  # contact-set updates per increment
-    max_toggles: int = 2  # switches of one node per increment before it is frozen
+    max_passes: int = 12  # contact passes (set and normal-force updates) per increment
+    max_toggles: int = 2  # switches of one node (or of the holder) per increment before it is frozen
     gap_tol: float = 0.0  # |known corrections| at convergence (0: 1e-3 penetration)
-    slip_regularization: float = 1e-4  # eps / cell size of the Coulomb force (see _coulomb)
+    stick_stiffness: float = 1.0  # k_t = stick_stiffness E A_i / h
+    friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
+    trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
+    holder_spread: str = "area"  # "area" or "rigid" (holder.py)
 
 
 class ContactState:
-    """Per owned node: the tool it lies on (or FREE), its normal contact force, its switches in
-    this increment."""
+    """Per owned node: the tool it lies on (or FREE), the normal force of that tool's face and
+    of the holder's face (held fixed within a pass), the tangential friction force of the last
+    converged increment (global x, y, z), the node's switches in this increment; and whether
+    the holder is closed."""
 
     def __init__(self, n: int):
         self.tool = np.full(n, FREE, dtype=np.int8)
         self.pressure = np.zeros(n)
+        self.holder_face = np.zeros(n)
+        self.friction = np.zeros((n, 3))
         self.toggles = np.zeros(n, dtype=np.int32)
+        self.closed = np.zeros(1, dtype=bool)
+        self.holder_toggles = np.zeros(1, dtype=np.int32)
 
     def copy(self):
         c = ContactState(self.tool.size)
@@ -69,15 +89,16 @@ class ContactState:
 
 
 class SemiInverseDriver(Driver):
-    """Punch displacement control with rigid tools, Coulomb friction and a force-controlled holder.
+    """Punch displacement control with rigid tools, Coulomb friction and a pinching holder.
 
     tools: list of rigid tools with ``gap(x, offset, dz) -> (gap, normal)`` in contact order
     (e.g. punch, die); ``travel[k]`` is tool k's z-travel at lambda = 1 (punch: -stroke);
-    holder: a BlankHolder tool (or None) with its force; friction: mu.
+    holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool `die`
+    (default: the last tool); friction: mu.
     """
 
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
-                 prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True):
+                 prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None):
         super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,
                          verbose=verbose)
         self.support_dofs = self.bc_dofs.copy()  # supports and symmetry (prescribed values: lam qbar)
@@ -88,6 +109,7 @@ class SemiInverseDriver(Driver):
         imap = V.dofmap.index_map
         self.n_owned, self.n_local = imap.size_local, imap.size_local + imap.num_ghosts
         self.tools, self.travel, self.mu = list(tools), np.asarray(travel, dtype=float), float(friction)
+        self.die = len(self.tools) - 1 if die is None else int(die)
         self.contact = contact or ContactControls(penetration=1e-3 * model.thickness)
         if not self.contact.gap_tol:
             self.contact.gap_tol = 1e-3 * self.contact.penetration
@@ -98,26 +120,28 @@ class SemiInverseDriver(Driver):
         self.sym_fixed = sym.reshape(-1, BS)[: self.n_owned, :3]  # symmetry-fixed u, v, w (never w)
         # nodal fields shared with ghosts: frames (9 values = 3 x 3), known corrections, flags
         self._frame_fn, self._known_fn, self._flag_fn = fem.Function(V), fem.Function(V), fem.Function(V)
-        self._z_fn = fem.Function(V)  # K^-1 b of the holder's bordered step
-        self._b_holder = self._z_fn.x.petsc_vec.duplicate()  # its b
         self.frames = np.tile(np.eye(3), (self.n_local, 1, 1))
         self.rotated = np.zeros(self.n_local, dtype=bool)
-        area, e33 = self._nodal_areas_and_thickness_strain()
+        self.area, e33 = self._nodal_areas_and_thickness_strain()
         self.half_thickness = 0.5 * model.thickness * np.exp(e33)
+        E = model.material[0]
+        self.k_stick = self.contact.stick_stiffness * E * self.area / model.cell_size
         self.holder = None
         if holder is not None:
-            k = model.material[0] * area / model.thickness  # E A / t: through-thickness stiffness
-            self.holder = ForceControlledHolder(holder, holder_force, k, model.mesh.comm)
-        self.state = ContactState(self.n_owned)
-        self.committed = self.state.copy()
-        self.x_n = self.X[: self.n_owned].copy()  # positions at the start of the increment
+            self.holder = PinchingHolder(holder, holder_force, self.area, E * self.area / model.thickness,
+                                         model.mesh.comm, self.contact.holder_spread)
+        n = self.n_owned
+        self.state = ContactState(n)
+        self.x_n = self.X[:n].copy()  # positions at the start of the increment
         self.lam_n = 0.0
-        self._fz_holder = np.zeros(self.n_owned)
-        self._kz_holder = np.zeros(self.n_owned)
-        self._friction = np.zeros((self.n_owned, 3))
-        self._slip_rate = np.zeros((self.n_owned, 2, 2))
-        self._slipping = np.zeros(self.n_owned, dtype=bool)
+        self.pinched = np.zeros(n, dtype=bool)
+        self._friction = np.zeros((n, 3))  # tangential force of the current iterate (global)
+        self._rate = np.zeros((n, 2, 2))  # its stiffness in the frame's tangent slots
+        self._slipping = np.zeros(n, dtype=bool)
         self._passes = self._changes = self._frozen = 0
+        self._scale = 0.0
+        self.line_search_factors: list[float] = []  # alpha of every accepted Newton step (this increment)
+        self.pass_residuals: list[list[float]] = []
         self.times["contact_s"] = 0.0
         self.nodal = self  # the contact forces enter the residual through Driver's nodal hook
         self.magnitude = 0.0
@@ -133,20 +157,18 @@ class SemiInverseDriver(Driver):
         h = self.half_thickness
         return [tool.gap(x, h, lam * dz) for tool, dz in zip(self.tools, self.travel)]
 
-    def _offset(self, k, lam):
-        return np.array([0.0, 0.0, lam * self.travel[k]])
-
     def _initial_set(self):
-        """Nodes touching a tool at the start (gap within the penetration tolerance)."""
+        """Nodes touching a tool at the start (gap within the penetration tolerance); the holder
+        closes on the flange when it has a force."""
         x = self.positions()
         s = self.state
         for k, (gap, _) in enumerate(self._gaps(x, 0.0)):
             touch = (gap <= self.contact.penetration) & (s.tool == FREE)
             s.tool[touch] = k
-        self.committed = s.copy()
         if self.holder is not None:
-            self.holder.balance(x, self.half_thickness)
-        self.committed_Z = self.holder.Z if self.holder is not None else 0.0
+            s.closed[0] = self.holder.force > 0
+            self._holder_faces(x, np.zeros(self.n_owned))
+        self.committed = s.copy()
 
     def _nodal_areas_and_thickness_strain(self):
         """Tributary areas (a third of each cell) and their area-weighted thickness strain."""
@@ -164,10 +186,45 @@ class SemiInverseDriver(Driver):
         area = arr[: self.n_owned, 0].copy()
         return area, arr[: self.n_owned, 1] / area
 
+    # -- the holder ----------------------------------------------------------------------------
+    def _holder_faces(self, x, net):
+        """Set the pinched nodes and the frozen face forces of the holder (and of the die under
+        it) from the nodes' net normal forces `net` (die minus holder)."""
+        s, h = self.state, self.holder
+        under = h.under(x)
+        self.pinched = s.closed[0] & under & (s.tool == self.die)
+        if s.closed[0]:
+            tops = x[:, 2] + self.half_thickness
+            d, s.holder_face = h.faces(self.pinched, net, tops)
+            s.pressure[self.pinched] = d[self.pinched]
+        else:
+            s.holder_face = h.load(under)
+
+    def _update_holder(self, x, net) -> int:
+        """Open the holder if the flange lifts it (the squeeze left is negative), close it again
+        once the flange under it lies on the die; then its face forces. Returns the changes."""
+        s, h = self.state, self.holder
+        comm = self.model.mesh.comm
+        changes = 0
+        if s.holder_toggles[0] < self.contact.max_toggles:
+            under = h.under(x)
+            if s.closed[0] and h.squeeze_left(self.pinched, net) < 0:
+                s.closed[0] = False
+                changes = 1
+            elif not s.closed[0] and h.force > 0:
+                off_die = comm.allreduce(int(np.sum(under & (s.tool != self.die))), op=MPI.SUM)
+                lifting = h.squeeze_left(under, net - s.holder_face)  # the load is in the residual
+                if off_die == 0 and lifting >= 0:
+                    s.closed[0] = True
+                    changes = 1
+            s.holder_toggles[0] += changes
+        self._holder_faces(x, net)
+        return changes
+
     # -- constraints of one iterate -----------------------------------------------------------
     def _constraints(self, lam):
-        """Frames, known corrections and Dirichlet rows of the current contact set; friction and
-        holder forces at the current iterate."""
+        """Frames, known corrections and Dirichlet rows of the current contact set; friction
+        forces at the current iterate."""
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
         gaps = self._gaps(x, lam)
@@ -175,11 +232,7 @@ class SemiInverseDriver(Driver):
         frames = np.tile(np.eye(3), (n_own, 1, 1))
         known = np.zeros((n_own, BS))
         flags = np.zeros((n_own, BS))
-        self._friction[:] = 0.0
-        self._slip_rate[:] = 0.0
-        self._slipping[:] = False
-        if self.holder is not None:
-            self._fz_holder, self._kz_holder = self.holder.forces(x, self.half_thickness)
+        shift = np.zeros(n_own)  # z-travel of each node's tool in this increment
         for k in range(len(self.tools)):
             off = (s.tool == k) & ~np.isfinite(gaps[k][0])  # slid off the tool's extent
             s.tool[off], s.pressure[off] = FREE, 0.0
@@ -190,12 +243,13 @@ class SemiInverseDriver(Driver):
             frames[on] = nodal_frames(normal)
             known[on, 2] = -gap  # the normal correction that closes the gap
             flags[on, 2] = 1.0
-            if self.mu > 0:
-                shift = (lam - self.lam_n) * self.travel[k]  # the tool's travel in this increment
-                self._friction[on] = self._coulomb(on, shift, x, frames[on])
-        if self.mu > 0 and self.holder is not None:  # flange nodes the holder alone pinches
-            only = np.flatnonzero((s.tool == FREE) & (self._fz_holder < 0))
-            self._friction[only] = self._coulomb(only, 0.0, x, frames[only])
+            shift[on] = (lam - self.lam_n) * self.travel[k]
+        self._friction[:] = 0.0
+        self._rate[:] = 0.0
+        self._slipping[:] = False
+        if self.mu > 0:
+            rub = np.flatnonzero((s.tool != FREE) | (s.holder_face > 0))
+            self._coulomb(rub, shift[rub], x, frames[rub])
         flags[:, :3][self.sym_fixed] = 0.0  # already held by symmetry (a homogeneous condition)
         known[:, :3][self.sym_fixed] = 0.0
         # share with the ghosts
@@ -211,28 +265,29 @@ class SemiInverseDriver(Driver):
         jump = self.model.mesh.comm.allreduce(float(np.abs(known).max(initial=0.0)), op=MPI.MAX)
         return max(jump, self._set_dirichlet(lam, self.support_dofs))  # supports: g = lam qbar
 
-    def _coulomb(self, on, shift, x, F):
-        """Coulomb forces on the nodes `on` of a tool that moved by `shift` along z in this
-        increment: f = -mu (p_n + p_holder) s / max(|s|, eps),
-        and their rate df/ds in the tangent slots, -mu p / |s| (I - s s^T / |s|^2) when
-        slipping, -mu p / eps I when sticking (for fixed p)."""
+    def _coulomb(self, idx, shift, x, F):
+        """The return mapping of Coulomb friction on the nodes idx (tangent planes from their
+        frames F, tools moved by `shift` along z in this increment); sets their force and its
+        stiffness in the tangent slots (module docstring)."""
         s = self.state
         n = F[:, 2]
-        rel = x[on] - self.x_n[on]
-        rel[:, 2] -= shift
-        st = rel - np.sum(rel * n, axis=1)[:, None] * n  # slip in the tangent plane
-        size = np.linalg.norm(st, axis=1)
-        eps = self.contact.slip_regularization * self.model.cell_size
-        slipping = size > eps
-        p = np.maximum(s.pressure[on], 0.0) - self._fz_holder[on]  # both faces rub on the flange
-        scale = self.mu * p / np.maximum(size, eps)
-        s2 = np.einsum("nij,nj->ni", F[:, :2], st) / np.maximum(size, eps)[:, None]
-        rate = scale[:, None, None] * (np.eye(2) - slipping[:, None, None] * s2[:, :, None] * s2[:, None, :])
-        held = self.sym_fixed[on, :2]  # a symmetry plane holds that slot: no rate there
+        ds = x[idx] - self.x_n[idx]
+        ds[:, 2] -= shift
+        ds -= np.sum(ds * n, axis=1)[:, None] * n  # tangential slip increment
+        f_old = s.friction[idx] - np.sum(s.friction[idx] * n, axis=1)[:, None] * n
+        k = self.k_stick[idx]
+        trial = f_old - k[:, None] * ds
+        size = np.linalg.norm(trial, axis=1)
+        limit = self.mu * (s.pressure[idx] + s.holder_face[idx])
+        slip = size > (1 - 1e-6) * limit  # on the cone (a node that slipped): keeps slipping, slip tangent
+        ratio = np.where(slip, limit / np.maximum(size, 1e-300), 1.0)
+        m2 = np.einsum("nij,nj->ni", F[:, :2], trial) / np.maximum(size, 1e-300)[:, None]
+        rate = (k * ratio)[:, None, None] * (np.eye(2) - slip[:, None, None] * m2[:, :, None] * m2[:, None, :])
+        held = self.sym_fixed[idx, :2]  # a symmetry plane holds that slot: no rate there
         rate[held[:, :, None] | held[:, None, :]] = 0.0
-        self._slip_rate[on] = rate
-        self._slipping[on] = slipping
-        return -scale[:, None] * st
+        self._friction[idx] = ratio[:, None] * trial
+        self._rate[idx] = rate
+        self._slipping[idx] = slip
 
     def _set_bcs(self, flag):
         V = self.model.V
@@ -258,173 +313,207 @@ class SemiInverseDriver(Driver):
         delta[d] = self.g[d] - self.q.x.array[d]
         return delta
 
+    def holder_load(self) -> np.ndarray:
+        """The open holder's force on the nodes under it along z (<= 0); zero when it is closed
+        (then the net force of a pinched node is its die reaction)."""
+        if self.holder is None or self.state.closed[0]:
+            return np.zeros(self.n_owned)
+        return -self.state.holder_face
+
     def add(self, lam, x, R, K=None):
-        """Driver's nodal hook: R -= friction and holder forces (in the nodal frames); K += the
-        holder's squeeze stiffness on free w rows and the slip rate of the friction force."""
+        """Driver's nodal hook: R -= friction and open-holder forces (in the nodal frames);
+        K += the friction's stiffness in the tangent slots."""
         f = self._friction.copy()
-        f[:, 2] += self._fz_holder
+        f[:, 2] += self.holder_load()
         f = np.einsum("nij,nj->ni", self.frames[: self.n_owned], f)  # identity off the tools
         R[: self.n_owned * BS].reshape(-1, BS)[:, :3] -= f
-        if K is not None and self.holder is not None:
-            free = np.flatnonzero((self._kz_holder > 0) & ~self.rotated[: self.n_owned])
-            for b in free:
-                K.setValuesLocal([BS * b + 2], [BS * b + 2], [[self._kz_holder[b]]], addv=True)
         if K is not None and self.mu > 0:
-            for b in np.flatnonzero(np.abs(self._slip_rate).max(axis=(1, 2)) > 0):
+            for b in np.flatnonzero(np.abs(self._rate).max(axis=(1, 2)) > 0):
                 rows = [BS * b, BS * b + 1]
-                K.setValuesLocal(rows, rows, self._slip_rate[b], addv=True)
+                K.setValuesLocal(rows, rows, self._rate[b], addv=True)
 
     # -- one increment --------------------------------------------------------------------------
     def _newton(self, lam, reversal=False):
-        """Newton on the fixed contact set, then settle the set; repeat until it holds."""
+        """Newton on a fixed contact set and fixed normal forces, then update both; repeat
+        until they hold."""
         self.state = self.committed.copy()
-        if self.holder is not None:
-            self.holder.Z = self.committed_Z
         self._lam_trial = lam
         self._passes = self._changes = 0
+        self.line_search_factors = []
+        self.pass_residuals = []  # |R| of every iterate, one list per pass (this increment)
         iterations, residuals, ev = 0, [], None
+        changes, dp = 0, 0.0
         for _ in range(self.contact.max_passes):
             self._passes += 1
             ok, its, res, ev = self._newton_fixed_set(lam)
             iterations += its
             residuals += res
+            self.pass_residuals.append(res)
             if not ok:
                 return False, iterations, residuals, ev
-            changes = self._update_set(lam)
+            changes, dp, pn = self._update_pass(lam)
             self._changes += changes
-            if changes == 0:
+            if changes == 0 and dp <= self.contact.friction_rtol * pn:
                 return True, iterations, residuals, ev
+        self._cause = (f"the contact did not settle in {self.contact.max_passes} passes (last pass: {changes} "
+                       f"set changes, friction change {dp:.3g} N)")
         return False, iterations, residuals, ev
 
     def _newton_fixed_set(self, lam):
         c = self.controls
-        residuals = []
+        jump = self._constraints(lam)
+        norm, scale, ev = self.residual(lam, tangent=True)
+        residuals = [norm]
         for it in range(c.max_iterations + 1):
-            jump = self._constraints(lam)
-            norm, scale, ev = self.residual(lam, tangent=True)
-            residuals.append(norm)
-            if not np.isfinite(norm) or ev.failures:
+            if not np.isfinite(norm) or ev.failed:
+                self._cause = ev.cause() or "the residual is not finite"
                 return False, it, residuals, ev
-            self._update_pressure()
-            if norm <= c.rtol * scale and jump <= self.contact.gap_tol and self._holder_balanced():
+            self._scale = scale
+            if _DEBUG and self._lam_trial >= float(os.environ.get('SF_DEBUG_LAM', '0')):
+                self._debug(norm, scale, jump)
+            if norm <= c.rtol * scale and jump <= self.contact.gap_tol:
                 return True, it, residuals, ev
             if it == c.max_iterations:
                 break
-            if not self._solve(jump if jump > 0 else 0.0):
+            R0 = self.b.copy()
+            ok = self._solve(jump if jump > 0 else 0.0)
+            if not ok:
+                R0.destroy()
+                self._cause = "the linear solve failed (singular tangent or a non-finite correction)"
                 return False, it, residuals, ev
-            if self.holder is not None and self.holder.force > 0 and not self._holder_step():
-                return False, it, residuals, ev
+            s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) < 0: the energy slope (frame coordinates)
+            R0.destroy()
             from_frames(self.dq.x.array, self.rotated, self.frames)
-            self.q.x.array[:] += self.dq.x.array
+            ok, norm, scale, ev, jump = self._line_search(lam, s0 if jump <= self.contact.gap_tol else None)
+            if not ok:
+                return False, it + 1, residuals, ev
+            residuals.append(norm)
+        self._cause = f"no convergence in {c.max_iterations} iterations on a fixed contact set"
         return False, c.max_iterations, residuals, ev
 
-    def _holder_balanced(self) -> bool:
-        """The holder's forces sum to its force (to its rtol), or there is no holder force."""
-        h = self.holder
-        if h is None or h.force <= 0:
-            return True
-        g, _, _ = h.linearisation(self.positions(), self.half_thickness)
-        return abs(g) <= h.rtol * h.force
+    def _line_search(self, lam, s0):
+        """q += alpha dq, alpha first limited by the trust region (no node moves more than
+        `trust` thicknesses), then shortened by secant steps where the energy slope
+        dq . R(q + alpha dq) says the step overshoots (as the Driver's line search). A step
+        that moves nodes onto the tools (known corrections, s0 None) is a linear prediction of
+        the free rows' response, R_free(q + alpha dq) ~ (1 - alpha) R_free(q): the slope says
+        nothing of it, so it is only kept within the trust region and the material's reach."""
+        c, comm = self.controls, self.model.mesh.comm
+        n = self.n_owned
+        dq = self.dq.x.array.copy()
+        move = np.linalg.norm(dq.reshape(-1, BS)[:n, :3], axis=1).max(initial=0.0)
+        move = comm.allreduce(float(move), op=MPI.MAX)
+        alpha = min(1.0, self.contact.trust * self.model.thickness / max(move, 1e-300))
+        x0 = self.q.x.array.copy()
+        norm = scale = ev = jump = None
+        for _ in range(c.line_search + 1):
+            self.q.x.array[:] = x0 + alpha * dq
+            jump = self._constraints(lam)
+            norm, scale, ev = self.residual(lam, tangent=True)
+            if not np.isfinite(norm) or ev.failed:
+                alpha *= 0.5  # outside the material's reach: shorten
+                continue
+            s1 = self._global_slope(dq) if s0 is not None else 0.0
+            if _DEBUG:
+                print(f"    ls alpha {alpha:.3g} move {move:.3g} |R| {norm:.3e} scale {scale:.3e} s0 {s0 or 0:.3e} s1 {s1:.3e} jump {jump:.2e}")
+            if s0 is None or s1 <= abs(s0) or s0 >= 0:  # not past the energy minimum along dq by much
+                self.line_search_factors.append(alpha)
+                return True, norm, scale, ev, jump
+            alpha *= max(0.1, min(0.5, s0 / (s0 - s1)))  # secant towards dq . R = 0
+        self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
+        return False, norm, scale, ev, jump
 
-    def _holder_step(self) -> bool:
-        """The bordered Newton step for the holder height Z. With b = dR/d(-Z) (k_i on the w rows
-        of the free nodes bearing the holder), y = the step just solved and z = K^-1 b:
+    def _debug(self, norm, scale, jump):
+        R = self.b.getArray(readonly=True).reshape(-1, BS)
+        r = np.linalg.norm(R[:, :3], axis=1)
+        x = self.positions()
+        s = self.state
+        print(f"  it |R| {norm:.3e} / {scale:.3e} jump {jump:.2e}")
+        for i in np.argsort(-r)[:3]:
+            print(f"     node {i} X {self.X[i, :2].round(2)} x {x[i].round(3)} tool {s.tool[i]} pinched {self.pinched[i]} "
+                  f"R {R[i, :3].round(2)} slopes {R[i, 3:].round(1)} p {s.pressure[i]:.1f} h {s.holder_face[i]:.1f} "
+                  f"f {self._friction[i].round(2)} slip {self._slipping[i]} frame_n {self.frames[i, 2].round(3)}")
 
-            dq = y + z dZ,   dZ = (g + b.y + sum_pinched k_i dw_i) / (c - b.z),   c = sum k_i
-
-        (the pinched nodes' dw_i are known: they lie on the die)."""
-        h = self.holder
-        g, act, k = h.linearisation(self.positions(), self.half_thickness)
-        comm = self.model.mesh.comm
-        c = comm.allreduce(float(k.sum()), op=MPI.SUM)
-        if c == 0.0:  # the holder touches nothing: lower it onto the highest top
-            h.balance(self.positions(), self.half_thickness)
-            return True
-        w = BS * act + 2
-        pinned = self._flag_fn.x.array[w] > 0.5
-        y = self.dq.x.array
-        by = float(np.sum(k[~pinned] * y[w[~pinned]]))
-        kp = float(np.sum(k[pinned] * self._known_fn.x.array[w[pinned]]))
-        bvec = self._b_holder
-        bvec.set(0.0)
-        arr = bvec.getArray(readonly=False)
-        arr[w[~pinned]] = k[~pinned]
-        del arr
-        t0 = time.perf_counter()
-        self.ksp.solve(bvec, self._z_fn.x.petsc_vec)
-        self.times["solve_s"] += time.perf_counter() - t0
-        if self.ksp.getConvergedReason() < 0:
-            return False
-        self._z_fn.x.scatter_forward()
-        z = self._z_fn.x.array
-        bz = float(np.sum(k[~pinned] * z[w[~pinned]]))
-        by, bz, kp = (comm.allreduce(v, op=MPI.SUM) for v in (by, bz, kp))
-        dZ = (g + by + kp) / (c - bz)
-        # a holder that lands on free flange nodes moves them by F / (sheet stiffness): go there
-        # in steps of at most a tenth of the thickness (the die catches them on the way)
-        limit = 0.1 * self.model.thickness
-        dZ = float(np.clip(dZ, -limit, limit))
-        self.dq.x.array[:] += dZ * z
-        h.Z += dZ
-        return bool(np.isfinite(dZ))
+    def _global_slope(self, dq) -> float:
+        """dq . R over all ranks, with R (free rows, nodal frames) rotated back to x, y, z."""
+        R = self.b.getArray(readonly=True).copy()
+        from_frames(R, self.rotated, self.frames)
+        return self.model.mesh.comm.allreduce(float(np.dot(dq[: R.size], R)), op=MPI.SUM)
 
     def reactions(self) -> np.ndarray:
         """(n_owned, 3) residual on the u, v, w rows in the nodal frames (tool forces on constrained rows)."""
         return self.residual_full[: self.n_owned * BS].reshape(-1, BS)[:, :3]
 
-    def _update_pressure(self):
-        s = self.state
-        on = s.tool != FREE
-        s.pressure[on] = self.reactions()[on, 2]
-
-    def _update_set(self, lam) -> int:
-        """Join penetrating nodes, release tensile ones, rebalance the holder; returns the
-        number of changes on all ranks."""
+    def _update_pass(self, lam):
+        """After a converged pass: normal forces from the reactions, the holder's faces, release
+        of tensile nodes (not pinched), join of penetrating ones. Returns (set changes on all
+        ranks, |mu dp|, |mu p|)."""
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
+        comm = self.model.mesh.comm
+        p_old = s.pressure + s.holder_face
+        on = s.tool != FREE
+        net = np.where(on, self.reactions()[:, 2], 0.0)
+        s.pressure = np.maximum(net, 0.0)
         changes = 0
-        scale = max(self.model.mesh.comm.allreduce(float(np.abs(s.pressure).max(initial=0.0)), op=MPI.MAX), 1e-300)
+        if self.holder is not None:
+            self.pinched = s.closed[0] & self.holder.under(x) & (s.tool == self.die)
+            changes = self._update_holder(x, net)
+        scale = max(comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
         can = s.toggles < self.contact.max_toggles
-        # tensile contact force: release
-        release = (s.tool != FREE) & (s.pressure < -1e-8 * scale) & can
-        s.tool[release] = FREE
-        s.pressure[release] = 0.0
-        s.toggles[release] += 1
-        changes += int(release.sum())
-        # penetration of a free node: join the deepest tool
+        release = on & ~self.pinched & (net < -1e-8 * scale) & can
         gaps = self._gaps(x, lam)
         depth = np.stack([g for g, _ in gaps])  # (tools, nodes)
-        k = np.argmin(depth, axis=0)
-        join = (s.tool == FREE) & (depth.min(axis=0) < -self.contact.penetration) & can & ~release
-        s.tool[join] = k[join]
-        s.toggles[join] += 1
-        changes += int(join.sum())
-        if self.holder is not None and self.holder.balance(x, self.half_thickness):
-            changes += 1  # the holder moved to carry its force again: one more pass
+        deepest = np.argmin(depth, axis=0)
+        if self.holder is not None and s.closed[0]:  # the closed holder pinches what comes under it
+            enters = self.holder.under(x) & ~on
+            deepest[enters] = self.die
+        else:
+            enters = np.zeros_like(on)
+        join = ~on & ((depth.min(axis=0) < -self.contact.penetration) | enters) & can
+        s.tool[release] = FREE
+        s.tool[join] = deepest[join]
+        switched = release | join
+        s.pressure[switched] = 0.0
+        s.friction[switched] = 0.0  # a new contact starts without friction history
+        s.toggles[switched] += 1
+        changes += int(switched.sum())
         self._frozen = int((s.toggles >= self.contact.max_toggles).sum())
+        dp = np.sqrt(comm.allreduce(float(np.sum((s.pressure + s.holder_face - p_old) ** 2)), op=MPI.SUM))
+        pn = np.sqrt(comm.allreduce(float(np.sum((s.pressure + s.holder_face) ** 2)), op=MPI.SUM))
         self.times["contact_s"] += time.perf_counter() - t0
-        return self.model.mesh.comm.allreduce(changes, op=MPI.SUM)
+        return comm.allreduce(changes, op=MPI.SUM), self.mu * dp, self.mu * pn
 
     def _commit(self):
         super()._commit()
         s = self.state
         s.toggles[:] = 0
-        x = self.positions()
+        s.holder_toggles[:] = 0
+        s.friction = self._friction.copy()
         self.committed = s.copy()
-        if self.holder is not None:
-            self.committed_Z = self.holder.Z
-        self.x_n = x
+        self.x_n = self.positions()
         self.lam_n = self._lam_trial
         if self.model.plastic:
             _, e33 = self._nodal_areas_and_thickness_strain()
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
 
+    def _restore_converged(self):
+        """The committed contact state and its forces (a stop reports the last converged state)."""
+        self.state = self.committed.copy()
+        self._lam_trial = self.lam_n
+        self._constraints(self.lam)
+        self.residual(self.lam, tangent=False)
+
     def _increment_info(self):
+        alphas = self.line_search_factors
         return {"passes": self._passes, "set_changes": self._changes, "frozen": self._frozen,
-                "in_contact": self.count_in_contact()}
+                "in_contact": self.count_in_contact(), "min_line_search": min(alphas) if alphas else 1.0,
+                "holder_closed": bool(self.state.closed[0])}
 
     def count_in_contact(self) -> dict:
-        """Nodes on each tool, all ranks: {"tool0": ..., "tool1": ...}."""
+        """Nodes on each tool and pinched by the holder, all ranks: {"tool0": ..., "pinched": ...}."""
         comm = self.model.mesh.comm
-        return {f"tool{k}": comm.allreduce(int((self.state.tool == k).sum()), op=MPI.SUM)
-                for k in range(len(self.tools))}
+        counts = {f"tool{k}": comm.allreduce(int((self.state.tool == k).sum()), op=MPI.SUM)
+                  for k in range(len(self.tools))}
+        counts["pinched"] = comm.allreduce(int(self.pinched.sum()), op=MPI.SUM)
+        return counts

@@ -122,6 +122,7 @@ class Driver:
         self._dlam_prev = None
         self._direction = None
         self._floor = 0.0
+        self._cause = ""  # why the last Newton attempt failed, in words
 
     # -- residual and tangent ----------------------------------------------------------------
     def _set_dirichlet(self, lam, dofs=None):
@@ -185,6 +186,12 @@ class Driver:
         """Accept the increment's state."""
         self.model.commit()
 
+    def _restore_converged(self) -> None:
+        """Before a stop: make every derived quantity (residual, reactions) that of the last
+        converged state, which q already holds, so that what is reported is that state."""
+        self._set_dirichlet(self.lam)
+        self.residual(self.lam, tangent=False)
+
     def _solve(self, jump):
         """dq = -K^-1 R with dq_D = g - q_D (lifted: the free rows see -K_fD (g - q_D))."""
         t0 = time.perf_counter()
@@ -217,7 +224,8 @@ class Driver:
         norm, scale, ev = self.residual(lam, tangent=True, elastic_tangent=reversal)
         residuals, step = [norm], np.inf
         for it in range(1, c.max_iterations + 1):
-            if not np.isfinite(norm) or ev.failures:
+            if not np.isfinite(norm) or ev.failed:
+                self._cause = ev.cause() or "the residual is not finite"
                 return False, it, residuals, ev
             if norm <= c.rtol * scale and jump == 0:
                 return True, it - 1, residuals, ev
@@ -227,6 +235,7 @@ class Driver:
             ok = self._solve(jump)
             if not ok:
                 R0.destroy()
+                self._cause = "the linear solve failed (singular tangent or a non-finite correction)"
                 return False, it, residuals, ev
             x0 = self.q.x.array.copy()
             s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) = -dq . K dq < 0: the energy slope
@@ -234,7 +243,7 @@ class Driver:
             for _ in range(c.line_search + 1):
                 self.q.x.array[:] = x0 + alpha * self.dq.x.array
                 trial, scale, ev = self.residual(lam, tangent=True)
-                if not np.isfinite(trial) or ev.failures:
+                if not np.isfinite(trial) or ev.failed:
                     alpha *= 0.5  # outside the material's reach: shorten
                     continue
                 s1 = self.dq.x.petsc_vec.dot(self.b)
@@ -244,6 +253,7 @@ class Driver:
                 alpha *= max(0.1, min(0.5, s0 / (s0 - s1)))  # secant towards dq . R = 0
             R0.destroy()
             if not accepted:
+                self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
                 return False, it, residuals, ev
             if alpha < 1.0 and jump > 0:
                 self.q.x.array[self.bc_dofs] = self.g[self.bc_dofs]  # the prescribed values
@@ -253,6 +263,8 @@ class Driver:
             step = alpha * np.abs(self.dq.x.array).max()
             residuals.append(norm)
         converged = np.isfinite(norm) and norm <= c.rtol * scale
+        if not converged:
+            self._cause = f"no convergence in {c.max_iterations} iterations"
         return converged, c.max_iterations, residuals, ev
 
     def _predict(self, dlam, x_n, x_prev):
@@ -285,13 +297,13 @@ class Driver:
                 dlam *= c.cut
                 if self.verbose:
                     say(f"  cut back: lambda {lam:.6g} failed after {its} iterations "
-                        f"(|R| {res[-1]:.3e}{', return mapping failed' if ev.failures else ''}); "
-                        f"retry with dlambda {dlam:.3g}")
+                        f"(|R| {res[-1]:.3e}: {self._cause}); retry with dlambda {dlam:.3g}")
                 if dlam < c.min_step:
+                    self._restore_converged()
                     path = self.save_checkpoint()
                     raise ConvergenceFailure(
-                        f"increment at lambda {self.lam:.6g} -> {lam:.6g} did not converge and the step "
-                        f"fell below min_step {c.min_step:g}", path)
+                        f"increment at lambda {self.lam:.6g} -> {lam:.6g} did not converge ({self._cause}) and "
+                        f"the step fell below min_step {c.min_step:g}", path)
                 self._dlam_prev = None  # no extrapolation after a failure
             self._commit()
             reversal = False

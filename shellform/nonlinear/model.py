@@ -31,6 +31,20 @@ class Evaluation:
     failures: int  # layers whose return mapping did not converge
     element_s: float  # kinematics and element tensors (FFCx kernels, maps)
     constitutive_s: float  # the section update
+    guard: int = 0  # section points past the strain guard (non-finite or > 1000 % strain)
+
+    @property
+    def failed(self) -> bool:
+        return bool(self.failures or self.guard)
+
+    def cause(self) -> str:
+        """What stopped the material update, in words ('' if nothing did)."""
+        words = []
+        if self.guard:
+            words.append(f"strain guard: {self.guard} section points past 1000 % strain or not finite")
+        if self.failures:
+            words.append(f"return mapping failed in {self.failures} layers")
+        return "; ".join(words)
 
 
 class SheetModel:
@@ -91,14 +105,14 @@ class SheetModel:
         k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.z,
                       self.strain)
         t1 = time.perf_counter()
-        nplastic, nfail = section_update(self.strain, self.material, self.thickness, self.plastic, self.zeta,
+        nplastic, nfail, nguard = section_update(self.strain, self.material, self.thickness, self.plastic, self.zeta,
                                          self.wz, self.ep_n, self.p_n, self.ep, self.p, self.resultants,
                                          self.tangents, elastic_tangent)
         t2 = time.perf_counter()
         k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.z, self.resultants,
                       self.tangents, tangent, self.forms.vectors, self.forms.matrices)
         t3 = time.perf_counter()
-        return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1)
+        return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard))
 
     def commit(self) -> None:
         """Accept the trial material state (an increment converged)."""
