@@ -44,12 +44,13 @@ import numpy as np
 from dolfinx import fem, la
 from mpi4py import MPI
 
-from shellform.assembly.sheet_element import BS
+from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
 from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver
 
 FREE = -1
+W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
 import os
 _DEBUG = bool(os.environ.get('SF_DEBUG'))
 
@@ -102,7 +103,6 @@ class SemiInverseDriver(Driver):
         super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,
                          verbose=verbose)
         self.support_dofs = self.bc_dofs.copy()  # supports and symmetry (prescribed values: lam qbar)
-        self.controls.predictor = False  # extrapolation would push nodes through the tools
         # an increment of a few contact passes is still an easy one
         self.controls.easy_iterations = max(self.controls.easy_iterations, 2 * self.controls.max_iterations // 3)
         V = model.V
@@ -117,7 +117,8 @@ class SemiInverseDriver(Driver):
         self.symmetry_bcs = list(bcs)
         sym = np.zeros(self.n_local * BS, dtype=bool)
         sym[self.bc_dofs] = True
-        self.sym_fixed = sym.reshape(-1, BS)[: self.n_owned, :3]  # symmetry-fixed u, v, w (never w)
+        self.sym_all = sym.reshape(-1, BS)[: self.n_owned]  # carrier values fixed by symmetry
+        self.sym_fixed = self.sym_all[:, :3]  # of u, v, w (never w)
         # nodal fields shared with ghosts: frames (9 values = 3 x 3), known corrections, flags
         self._frame_fn, self._known_fn, self._flag_fn = fem.Function(V), fem.Function(V), fem.Function(V)
         self.frames = np.tile(np.eye(3), (self.n_local, 1, 1))
@@ -135,6 +136,7 @@ class SemiInverseDriver(Driver):
         self.x_n = self.X[:n].copy()  # positions at the start of the increment
         self.lam_n = 0.0
         self.pinched = np.zeros(n, dtype=bool)
+        self._previous = None  # the committed state before the last (the predictor's)
         self._friction = np.zeros((n, 3))  # tangential force of the current iterate (global)
         self._rate = np.zeros((n, 2, 2))  # its stiffness in the frame's tangent slots
         self._slipping = np.zeros(n, dtype=bool)
@@ -244,14 +246,18 @@ class SemiInverseDriver(Driver):
             known[on, 2] = -gap  # the normal correction that closes the gap
             flags[on, 2] = 1.0
             shift[on] = (lam - self.lam_n) * self.travel[k]
+        # the closed holder holds the flange flat: the pinched nodes' slopes of w are known too
+        slopes = self.q.x.array.reshape(-1, BS)[:n_own, W_SLOPES]
+        known[self.pinched, W_SLOPES.start:W_SLOPES.stop] = -slopes[self.pinched]
+        flags[self.pinched, W_SLOPES.start:W_SLOPES.stop] = 1.0
         self._friction[:] = 0.0
         self._rate[:] = 0.0
         self._slipping[:] = False
         if self.mu > 0:
             rub = np.flatnonzero((s.tool != FREE) | (s.holder_face > 0))
             self._coulomb(rub, shift[rub], x, frames[rub])
-        flags[:, :3][self.sym_fixed] = 0.0  # already held by symmetry (a homogeneous condition)
-        known[:, :3][self.sym_fixed] = 0.0
+        flags[self.sym_all] = 0.0  # already held by symmetry (a homogeneous condition)
+        known[self.sym_all] = 0.0
         # share with the ghosts
         for fn, values in ((self._frame_fn, frames.reshape(n_own, 9)), (self._known_fn, known),
                            (self._flag_fn, flags)):
@@ -293,7 +299,7 @@ class SemiInverseDriver(Driver):
         V = self.model.V
         bcs = list(self.symmetry_bcs)
         dofs = [self.symmetry_bcs[i].dof_indices()[0] for i in range(len(self.symmetry_bcs))]
-        for slot in range(3):
+        for slot in range(BS):
             blocks = np.flatnonzero(flag[:, slot] > 0.5)
             if blocks.size:
                 d = (BS * blocks + slot).astype(np.int32)
@@ -338,6 +344,7 @@ class SemiInverseDriver(Driver):
         until they hold."""
         self.state = self.committed.copy()
         self._lam_trial = lam
+        self._extrapolate_normal_forces(lam)
         self._passes = self._changes = 0
         self.line_search_factors = []
         self.pass_residuals = []  # |R| of every iterate, one list per pass (this increment)
@@ -352,12 +359,26 @@ class SemiInverseDriver(Driver):
             if not ok:
                 return False, iterations, residuals, ev
             changes, dp, pn = self._update_pass(lam)
+            if _DEBUG:
+                print(f"   pass {self._passes}: its {its} changes {changes} dp {dp:.3e} pn {pn:.3e} res {res[0]:.3e}->{res[-1]:.3e}")
             self._changes += changes
             if changes == 0 and dp <= self.contact.friction_rtol * pn:
                 return True, iterations, residuals, ev
         self._cause = (f"the contact did not settle in {self.contact.max_passes} passes (last pass: {changes} "
                        f"set changes, friction change {dp:.3g} N)")
         return False, iterations, residuals, ev
+
+    def _extrapolate_normal_forces(self, lam):
+        """With the predictor: the friction's normal forces of the first pass extrapolated from
+        the last two increments, as the carrier is (nodes on the same tool in both)."""
+        prev = self._previous
+        if not (self.controls.predictor and self._dlam_prev and prev is not None):
+            return
+        s, ratio = self.state, (lam - self.lam_n) / (self.lam_n - prev["lam"])
+        same = s.tool == prev["tool"]
+        for name in ("pressure", "holder_face"):
+            now = getattr(s, name)
+            now[same] = np.maximum(now[same] + ratio * (now[same] - prev[name][same]), 0.0)
 
     def _newton_fixed_set(self, lam):
         c = self.controls
@@ -384,18 +405,18 @@ class SemiInverseDriver(Driver):
             s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) < 0: the energy slope (frame coordinates)
             R0.destroy()
             from_frames(self.dq.x.array, self.rotated, self.frames)
-            ok, norm, scale, ev, jump = self._line_search(lam, s0 if jump <= self.contact.gap_tol else None)
+            ok, norm, scale, ev, jump = self._line_search(lam, s0, jump)
             if not ok:
                 return False, it + 1, residuals, ev
             residuals.append(norm)
         self._cause = f"no convergence in {c.max_iterations} iterations on a fixed contact set"
         return False, c.max_iterations, residuals, ev
 
-    def _line_search(self, lam, s0):
+    def _line_search(self, lam, s0, jump):
         """q += alpha dq, alpha first limited by the trust region (no node moves more than
         `trust` thicknesses), then shortened by secant steps where the energy slope
         dq . R(q + alpha dq) says the step overshoots (as the Driver's line search). A step
-        that moves nodes onto the tools (known corrections, s0 None) is a linear prediction of
+        that mostly moves nodes onto the tools (known corrections above 1 % of it) is a linear prediction of
         the free rows' response, R_free(q + alpha dq) ~ (1 - alpha) R_free(q): the slope says
         nothing of it, so it is only kept within the trust region and the material's reach."""
         c, comm = self.controls, self.model.mesh.comm
@@ -404,6 +425,8 @@ class SemiInverseDriver(Driver):
         move = np.linalg.norm(dq.reshape(-1, BS)[:n, :3], axis=1).max(initial=0.0)
         move = comm.allreduce(float(move), op=MPI.MAX)
         alpha = min(1.0, self.contact.trust * self.model.thickness / max(move, 1e-300))
+        if jump > max(self.contact.gap_tol, 1e-2 * move):
+            s0 = None  # the step mostly moves nodes onto the tools
         x0 = self.q.x.array.copy()
         norm = scale = ev = jump = None
         for _ in range(c.line_search + 1):
@@ -490,6 +513,8 @@ class SemiInverseDriver(Driver):
         s.toggles[:] = 0
         s.holder_toggles[:] = 0
         s.friction = self._friction.copy()
+        c = self.committed
+        self._previous = {"lam": self.lam_n, "tool": c.tool, "pressure": c.pressure, "holder_face": c.holder_face}
         self.committed = s.copy()
         self.x_n = self.positions()
         self.lam_n = self._lam_trial
