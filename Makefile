@@ -3,7 +3,7 @@
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-OUT    ?= results/square_plate
+OUT    ?= results/square_cup
 NPROC  ?= 2
 
 .PHONY: demo test venv clean bench docs
@@ -20,8 +20,8 @@ $(STAMP): pyproject.toml scripts/find-python.sh
 	@touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/shellform study plate --out $(OUT)
-	@echo "shellform: table (CSV) and error-against-time plot in $(OUT)"
+	$(VENV)/bin/shellform run demos/square_cup.toml --out $(OUT)
+	@echo "shellform: summary.json, force_stroke.csv/.png, thickness_diagonal.csv, thickness_transverse.csv, cup.png in $(OUT)"
 
 test: $(STAMP)
 	$(PY) -m pytest -q tests

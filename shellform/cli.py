@@ -1,8 +1,10 @@
 """The ``shellform`` command.
 
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
+                                            (--trace: a tool scene logs every contact iterate)
     shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
-                                            against time), assembly, newton (benchmarks)
+                                            against time), assembly, newton (benchmarks), cup-hard
+                                            (the square cup's hard cases)
 """
 
 import argparse
@@ -13,7 +15,7 @@ from pathlib import Path
 from shellform.errors import InputError
 
 
-def run_scene(path: Path, outdir: Path) -> dict:
+def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
     from mpi4py import MPI
 
     from shellform import linear, output, scene
@@ -23,7 +25,7 @@ def run_scene(path: Path, outdir: Path) -> dict:
     if s.tools is not None:
         from shellform.contact import run as contact_run
 
-        return contact_run.run(s, outdir)
+        return contact_run.run(s, outdir, trace=trace)
     if s.nonlinear:
         from shellform.nonlinear import run as nonlinear_run
 
@@ -44,7 +46,7 @@ def run_scene(path: Path, outdir: Path) -> dict:
     return summary
 
 
-STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "assembly", "newton"]
+STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "assembly", "newton", "cup-hard", "cup-mesh"]
 
 
 def main(argv=None) -> int:
@@ -54,6 +56,8 @@ def main(argv=None) -> int:
     p_run = sub.add_parser("run", help="solve a scene file")
     p_run.add_argument("scene", type=Path)
     p_run.add_argument("--out", type=Path, required=True)
+    p_run.add_argument("--trace", action="store_true",
+                       help="tool scenes: log every contact pass, Newton step and iterate (diagnosis)")
     p_study = sub.add_parser("study", help="run a convergence study")
     p_study.add_argument("name", choices=STUDIES)
     p_study.add_argument("--out", type=Path, required=True)
@@ -64,7 +68,7 @@ def main(argv=None) -> int:
 
     try:
         if args.command == "run":
-            summary = run_scene(args.scene, args.out)
+            summary = run_scene(args.scene, args.out, trace=args.trace)
             if "draw_in_mm" in summary:
                 last = summary["draw_in_mm"][-1] if summary["draw_in_mm"] else {}
                 print(f"shellform: {summary['title']}: {summary['cells']} cells, stroke {summary['stroke_mm']:.2f} mm, "
@@ -84,7 +88,7 @@ def main(argv=None) -> int:
         else:
             import importlib
 
-            study = importlib.import_module(f"shellform.studies.{args.name}")
+            study = importlib.import_module(f"shellform.studies.{args.name.replace('-', '_')}")
             kwargs = {"levels": study.QUICK_LEVELS} if args.quick and hasattr(study, "QUICK_LEVELS") else {}
             study.run(args.out, **kwargs)
     except InputError as err:

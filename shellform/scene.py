@@ -19,6 +19,7 @@ from pathlib import Path
 from forms.functional import EFFECTS, NONLINEAR_EFFECTS
 from shellform.errors import InputError
 
+SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
 CONTACT_EFFECTS = ("contact", "friction")  # the rigid tools of [tools] (shellform/contact/)
 
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
@@ -129,6 +130,7 @@ class ToolsSpec:
     blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
     friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
     stroke: float = 30.0  # punch travel, mm
+    holder_spread: str = "area"  # how the closed holder spreads its force: "area" or "rigid" (contact/holder.py)
 
 
 @dataclass
@@ -409,9 +411,11 @@ def _validate_tools(s: Scene) -> None:
         _require("contact" not in s.effects, "tools", "the effect 'contact' needs a [tools] table")
         return
     _require("contact" in s.effects, "effects", "a [tools] table needs the effect 'contact'")
+    _require(t.holder_spread in SPREADS, "tools.holder_spread", f"must be one of {SPREADS}, got {t.holder_spread!r}")
     for f in fields(ToolsSpec):
         v = getattr(t, f.name)
-        _require(math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
+        if f.name != "holder_spread":
+            _require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
     for name in ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "stroke"):
         v = getattr(t, name)
         _require(v > 0, f"tools.{name}", f"must be > 0, got {v}")

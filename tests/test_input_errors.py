@@ -177,6 +177,8 @@ def cup(effects=CONTACT, tools=None, geometry=None, supports=None, thickness=0.8
     ({**cup(), "tools": 35.0}, "tools"),
     (cup(tools={"punch_radius": 8.0}), "tools.punch_radius"),
     (cup(tools={"stroke": "deep"}), "tools.stroke"),
+    (cup(tools={"holder_spread": "thickest"}), "tools.holder_spread"),
+    (cup(tools={"holder_spread": 1.0}), "tools.holder_spread"),
     (cup(tools={"stroke": 0.0}), "tools.stroke"),
     (cup(tools={"stroke": float("inf")}), "tools.stroke"),
     (cup(tools={"punch_half_width": float("nan")}), "tools.punch_half_width"),

@@ -71,3 +71,43 @@ def test_nonlinear_two_ranks_match_serial(tmp_path):
     parallel = on_two_ranks(tmp_path, NONLINEAR)
     assert parallel["levy"] == pytest.approx(levy.solve(8, loads=[95.0])[-1]["w_over_h"], rel=1e-8)
     assert parallel["plastic"] == pytest.approx(plastic.solve(8, 5)["P_max_over_PL"], rel=1e-8)
+
+
+CUP = """
+import json, shellform
+from mpi4py import MPI
+from shellform import scene
+from shellform.contact.problem import DrawingProblem
+from shellform.contact.run import draw_in, _peak_thinning
+s = scene.load("demos/square_cup.toml")
+s.mesh.n = 8
+p = DrawingProblem.from_scene(s, verbose=False)
+p.driver.run(1.5 / s.tools.stroke)
+out = {"force": p.punch_force(), "DD": draw_in(p)["DD"], "e33": _peak_thinning(p)["max_thickness_strain"],
+       "holder": p.holder_force(), "pinched": p.in_contact()["pinched"], "increments": len(p.driver.history)}
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps(out))
+"""
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_short_cup_two_ranks_match_serial(tmp_path):
+    """The square cup (8 x 8 quarter blank, friction and the pinching holder) drawn 1.5 mm on two
+    ranks: the same punch force, draw-in and thinning as serial to the solver tolerance, the
+    same contact set and increments."""
+    import runpy
+
+    root = Path(__file__).resolve().parents[1]
+    parallel = on_two_ranks(tmp_path, CUP.replace("demos/", f"{root}/demos/"))
+    serial = {}
+    source = CUP.replace("demos/", f"{root}/demos/").replace('print("RESULT " + json.dumps(out))', "RESULT.update(out)")
+    runpy.run_path(_write(tmp_path / "serial.py", source), init_globals={"RESULT": serial})
+    assert parallel["increments"] == serial["increments"] and parallel["pinched"] == serial["pinched"]
+    for key in ("force", "DD", "e33", "holder"):
+        assert parallel[key] == pytest.approx(serial[key], rel=1e-6, abs=1e-9), key
+
+
+def _write(path, text):
+    path.write_text(text)
+    return str(path)

@@ -26,7 +26,7 @@ the nodes there are ordinary die contacts that leave the die when their force tu
 import numpy as np
 from mpi4py import MPI
 
-SPREADS = ("area", "rigid")
+from shellform.scene import SPREADS
 
 
 def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:

@@ -30,7 +30,7 @@ class DrawingProblem:
     symmetry: int  # 4 for a quarter blank, 1 for the whole blank
 
     @classmethod
-    def from_scene(cls, s: Scene, comm=MPI.COMM_WORLD, checkpoint_dir=None, verbose=True):
+    def from_scene(cls, s: Scene, comm=MPI.COMM_WORLD, checkpoint_dir=None, verbose=True, trace=False):
         g, m, pr, t = s.geometry, s.mesh, s.process, s.tools
         rect = rectangle(comm, g.lx, g.ly, region=g.region, kind=m.kind, n=m.n, diagonal=m.diagonal,
                          refine=m.refine)
@@ -44,7 +44,7 @@ class DrawingProblem:
         mu = t.friction if "friction" in s.effects else 0.0
         driver = SemiInverseDriver(
             model, bcs, [tools["punch"], tools["die"]], [-t.stroke, 0.0], friction=mu, holder=tools["holder"],
-            holder_force=t.blank_holder_force / symmetry, contact=ContactControls(1e-2 * s.material.thickness),
+            holder_force=t.blank_holder_force / symmetry, contact=ContactControls(1e-2 * s.material.thickness, holder_spread=t.holder_spread, trace=trace),
             controls=controls, checkpoint_dir=checkpoint_dir, verbose=verbose)
         return cls(s, rect, model, driver, symmetry)
 

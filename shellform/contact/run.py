@@ -113,7 +113,9 @@ def _plot_force(path: Path, rows: list[dict], title: str) -> None:
 
 
 def _png(path: Path, p: DrawingProblem, title: str) -> None:
-    """The drawn cup (true scale) coloured by the nodal thickness strain; serial runs only."""
+    """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
+    an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
+    strain; serial runs only."""
     mesh = p.model.mesh
     if mesh.comm.size > 1:
         return
@@ -127,19 +129,26 @@ def _png(path: Path, p: DrawingProblem, title: str) -> None:
     e33 = np.zeros(x.shape[0])
     e33[: d.n_owned] = p.nodal_values()[2]
     grid.point_data["thickness strain"] = e33
-    pl = pyvista.Plotter(off_screen=True, window_size=(900, 700))
-    pl.add_mesh(grid, scalars="thickness strain", show_edges=True, cmap="coolwarm")
+    if p.symmetry == 4:  # the quarter and its mirror images in x = 0, y = 0 and both
+        parts = [grid, grid.reflect((1, 0, 0), point=(0, 0, 0))]
+        parts += [g.reflect((0, 1, 0), point=(0, 0, 0)) for g in parts]
+        grid = parts[0].merge(parts[1:])
+    pl = pyvista.Plotter(off_screen=True, window_size=(1000, 800))
+    pl.add_mesh(grid, scalars="thickness strain", show_edges=True, cmap="coolwarm", edge_color="#555555",
+                line_width=0.5, scalar_bar_args={"title": "thickness strain"})
     pl.add_text(title, font_size=10)
     pl.view_isometric()
+    pl.camera.elevation = 15.0
     pl.screenshot(str(path))
     pl.close()
 
 
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
+    """Draw the scene's cup; trace: log every contact pass, Newton step and iterate."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir)
+    p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
     setup_s = time.perf_counter() - t0
     series = _Series(p, outdir / "cup.bp") if s.output.vtx else None
     curve, reports, stopped = [], [], None

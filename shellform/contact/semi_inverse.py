@@ -48,11 +48,10 @@ from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
 from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver
+from shellform.studies.common import say
 
 FREE = -1
 W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
-import os
-_DEBUG = bool(os.environ.get('SF_DEBUG'))
 
 
 @dataclass
@@ -65,6 +64,7 @@ class ContactControls:
     friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
     holder_spread: str = "area"  # "area" or "rigid" (holder.py)
+    trace: bool = False  # log every pass, step and iterate (the nodes with the largest residual)
 
 
 class ContactState:
@@ -359,8 +359,9 @@ class SemiInverseDriver(Driver):
             if not ok:
                 return False, iterations, residuals, ev
             changes, dp, pn = self._update_pass(lam)
-            if _DEBUG:
-                print(f"   pass {self._passes}: its {its} changes {changes} dp {dp:.3e} pn {pn:.3e} res {res[0]:.3e}->{res[-1]:.3e}")
+            if self.contact.trace:
+                say(f"    pass {self._passes}: {its} iterations, |R| {res[0]:.3e} -> {res[-1]:.3e}, {changes} set "
+                    f"changes, friction change |mu dp| {dp:.3e} of |mu p| {pn:.3e}")
             self._changes += changes
             if changes == 0 and dp <= self.contact.friction_rtol * pn:
                 return True, iterations, residuals, ev
@@ -390,8 +391,8 @@ class SemiInverseDriver(Driver):
                 self._cause = ev.cause() or "the residual is not finite"
                 return False, it, residuals, ev
             self._scale = scale
-            if _DEBUG and self._lam_trial >= float(os.environ.get('SF_DEBUG_LAM', '0')):
-                self._debug(norm, scale, jump)
+            if self.contact.trace:
+                self._trace_iterate(norm, scale, jump)
             if norm <= c.rtol * scale and jump <= self.contact.gap_tol:
                 return True, it, residuals, ev
             if it == c.max_iterations:
@@ -437,8 +438,9 @@ class SemiInverseDriver(Driver):
                 alpha *= 0.5  # outside the material's reach: shorten
                 continue
             s1 = self._global_slope(dq) if s0 is not None else 0.0
-            if _DEBUG:
-                print(f"    ls alpha {alpha:.3g} move {move:.3g} |R| {norm:.3e} scale {scale:.3e} s0 {s0 or 0:.3e} s1 {s1:.3e} jump {jump:.2e}")
+            if self.contact.trace:
+                say(f"      step: alpha {alpha:.3g} of a largest nodal move {move:.3g}, |R| {norm:.3e}, energy slope "
+                    f"{s0 or 0:.3e} -> {s1:.3e}, known corrections {jump:.2e}")
             if s0 is None or s1 <= abs(s0) or s0 >= 0:  # not past the energy minimum along dq by much
                 self.line_search_factors.append(alpha)
                 return True, norm, scale, ev, jump
@@ -446,16 +448,17 @@ class SemiInverseDriver(Driver):
         self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
         return False, norm, scale, ev, jump
 
-    def _debug(self, norm, scale, jump):
+    def _trace_iterate(self, norm, scale, jump):
+        """The three owned nodes with the largest residual of this iterate, and what holds them."""
         R = self.b.getArray(readonly=True).reshape(-1, BS)
-        r = np.linalg.norm(R[:, :3], axis=1)
-        x = self.positions()
-        s = self.state
-        print(f"  it |R| {norm:.3e} / {scale:.3e} jump {jump:.2e}")
+        r = np.linalg.norm(R, axis=1)
+        x, s = self.positions(), self.state
+        say(f"    iterate: |R| {norm:.3e} of {scale:.3e}, known corrections {jump:.2e}")
         for i in np.argsort(-r)[:3]:
-            print(f"     node {i} X {self.X[i, :2].round(2)} x {x[i].round(3)} tool {s.tool[i]} pinched {self.pinched[i]} "
-                  f"R {R[i, :3].round(2)} slopes {R[i, 3:].round(1)} p {s.pressure[i]:.1f} h {s.holder_face[i]:.1f} "
-                  f"f {self._friction[i].round(2)} slip {self._slipping[i]} frame_n {self.frames[i, 2].round(3)}")
+            say(f"      node {i} at {self.X[i, :2].round(2)} -> {x[i].round(3)}: tool {s.tool[i]}, pinched {self.pinched[i]}, "
+                f"normal {self.frames[i, 2].round(3)}, R (u, v, w) {R[i, :3].round(2)}, R (slopes) {R[i, 3:].round(1)}, "
+                f"tool face {s.pressure[i]:.1f} N, holder face {s.holder_face[i]:.1f} N, friction "
+                f"{self._friction[i].round(2)} ({'slip' if self._slipping[i] else 'stick'})")
 
     def _global_slope(self, dq) -> float:
         """dq . R over all ranks, with R (free rows, nodal frames) rotated back to x, y, z."""

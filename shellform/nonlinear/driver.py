@@ -281,6 +281,7 @@ class Driver:
         self._direction = direction
         dlam = min(c.initial_step, abs(target - self.lam))
         x_prev = self.q.x.array.copy()
+        self._dlam_prev = None  # nothing to extrapolate from at a new target
         while abs(target - self.lam) > 1e-14:
             dlam = min(dlam, abs(target - self.lam))
             x_n = self.q.x.array.copy()
