@@ -208,25 +208,28 @@ class SheetKernels:
         scratch = self._scratch()
         ffi = _ffi
 
-        @numba.njit
+        @numba.njit(parallel=True)
         def loop(cells, cells_coords, dofs, x, P, consts, z_out, e_out):
-            """z = Q q and the section strains e at the quadrature points of every cell."""
-            Q = np.zeros((nz, NDOF))
-            q = np.empty(NDOF)
-            c, local, perm = scratch(consts)
-            for k in range(cells.size):
-                cidx = cells[k]
-                coords = cells_coords[cidx]
-                build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
-                for v in range(3):
-                    for b in range(9):
-                        q[9 * v + b] = x[9 * dofs[cidx, v] + b]
-                z_out[k, :] = Q @ q
-                e = e_out[k].ravel()
-                e[:] = 0.0
-                strain(ffi.from_buffer(e), ffi.from_buffer(z_out[k]), ffi.from_buffer(c),
-                       ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
-                       empty_void_pointer())
+            """z = Q q and the section strains e at the quadrature points of every cell (the
+            cells dealt out to the threads, each with its own buffers)."""
+            nt = numba.get_num_threads()
+            for t in numba.prange(nt):
+                Q = np.zeros((nz, NDOF))
+                q = np.empty(NDOF)
+                c, local, perm = scratch(consts)
+                for k in range(t, cells.size, nt):
+                    cidx = cells[k]
+                    coords = cells_coords[cidx]
+                    build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
+                    for v in range(3):
+                        for b in range(9):
+                            q[9 * v + b] = x[9 * dofs[cidx, v] + b]
+                    z_out[k, :] = Q @ q
+                    e = e_out[k].ravel()
+                    e[:] = 0.0
+                    strain(ffi.from_buffer(e), ffi.from_buffer(z_out[k]), ffi.from_buffer(c),
+                           ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
+                           empty_void_pointer())
 
         return loop
 
@@ -249,29 +252,32 @@ class SheetKernels:
             if offsets[2] >= 0:
                 w[offsets[2]: offsets[2] + 36 * nqp] = D
 
-        @numba.njit
+        @numba.njit(parallel=True)
         def loop(cells, cells_coords, P, consts, z, S, D, want_tangent, R_out, K_out):
-            """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell."""
-            Q = np.zeros((nz, NDOF))
-            w = np.zeros(nz + 42 * nqp)
-            rz = np.zeros(nz)
-            Kz = np.zeros((nz, nz))
-            c, local, perm = scratch(consts)
-            for k in range(cells.size):
-                cidx = cells[k]
-                coords = cells_coords[cidx]
-                build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
-                pack(w, fo, z[k], S[k].ravel(), D[k].ravel())
-                rz[:] = 0.0
-                force(ffi.from_buffer(rz), ffi.from_buffer(w), ffi.from_buffer(c), ffi.from_buffer(coords),
-                      ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
-                R_out[k, :] = Q.T @ rz
-                if want_tangent:
-                    pack(w, to, z[k], S[k].ravel(), D[k].ravel())
-                    Kz[:, :] = 0.0
-                    tangent(ffi.from_buffer(Kz), ffi.from_buffer(w), ffi.from_buffer(c),
-                            ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
-                            empty_void_pointer())
-                    K_out[k, :, :] = Q.T @ (Kz @ Q)
+            """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out
+            to the threads, each with its own buffers)."""
+            nt = numba.get_num_threads()
+            for t in numba.prange(nt):
+                Q = np.zeros((nz, NDOF))
+                w = np.zeros(nz + 42 * nqp)
+                rz = np.zeros(nz)
+                Kz = np.zeros((nz, nz))
+                c, local, perm = scratch(consts)
+                for k in range(t, cells.size, nt):
+                    cidx = cells[k]
+                    coords = cells_coords[cidx]
+                    build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
+                    pack(w, fo, z[k], S[k].ravel(), D[k].ravel())
+                    rz[:] = 0.0
+                    force(ffi.from_buffer(rz), ffi.from_buffer(w), ffi.from_buffer(c), ffi.from_buffer(coords),
+                          ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
+                    R_out[k, :] = Q.T @ rz
+                    if want_tangent:
+                        pack(w, to, z[k], S[k].ravel(), D[k].ravel())
+                        Kz[:, :] = 0.0
+                        tangent(ffi.from_buffer(Kz), ffi.from_buffer(w), ffi.from_buffer(c),
+                                ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
+                                empty_void_pointer())
+                        K_out[k, :, :] = Q.T @ (Kz @ Q)
 
         return loop

@@ -18,12 +18,12 @@ import numpy as np
 from shellform.material import section
 
 
-@numba.njit  # not cached: numba would not see edits of section.py
+@numba.njit(parallel=True)  # not cached: numba would not see edits of section.py
 def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D, elastic_tangent=False):
     nplastic, nfail, nguard = 0, 0, 0
-    Sg = np.zeros(6)
-    Dg = np.zeros((6, 6))
-    for c in range(e.shape[0]):
+    for c in numba.prange(e.shape[0]):  # cells are independent: threads share them
+        Sg = np.zeros(6)
+        Dg = np.zeros((6, 6))
         for g in range(e.shape[1]):
             em = e[c, g, :3].copy()
             k = e[c, g, 3:].copy()

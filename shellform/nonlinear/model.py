@@ -10,6 +10,7 @@ point and thickness layer) is committed only when an increment converges.
 import time
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
@@ -18,7 +19,7 @@ from shellform.assembly.kernels import check_mesh
 from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly.sheet_kernels import SheetKernels
-from shellform.material import section
+from shellform.material import hill79, section
 from shellform.material.update import section_update
 from shellform.nonlinear.assemble import CellArrayForms
 
@@ -47,6 +48,20 @@ class Evaluation:
         return "; ".join(words)
 
 
+def use_cores(comm) -> int:
+    """Threads of the element and material loops on this rank: the cores this process may run
+    on, shared by the ranks on its node (at most NUMBA_NUM_THREADS); returns the number set."""
+    import os
+
+    local = comm.Split_type(MPI.COMM_TYPE_SHARED)
+    ranks = local.size
+    local.Free()
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    n = max(1, min(numba.config.NUMBA_NUM_THREADS, cores // ranks))
+    numba.set_num_threads(n)
+    return n
+
+
 class SheetModel:
     """Mesh, effects, material and state of the nonlinear sheet."""
 
@@ -57,6 +72,7 @@ class SheetModel:
         check_mesh(mesh)
         if not (np.isfinite(thickness) and thickness > 0):
             raise InputError("material.thickness", f"must be > 0, got {thickness}")
+        self.threads = use_cores(mesh.comm)
         self.mesh, self.effects = mesh, tuple(effects)
         self.nonlinear = "geometric_nonlinearity" in self.effects
         self.plastic = "plasticity" in self.effects
@@ -123,16 +139,22 @@ class SheetModel:
     def cell_fields(self) -> dict[str, np.ndarray]:
         """Per owned cell, averaged over its quadrature points: equivalent plastic strain
         (max over the layers) and thickness strain of the mid-surface (mean over the layers)."""
-        from shellform.material import hill79
-
         peq = self.p_n.max(axis=2).mean(axis=1)
-        e33 = np.zeros(self.num_cells)
-        for c in range(self.num_cells):
-            acc = 0.0
-            for g in range(self.nqp):
-                em = self.strain[c, g, :3]
-                for k in range(self.zeta.size):
-                    layer = em + self.zeta[k] * self.thickness * self.strain[c, g, 3:]
-                    acc += self.wz[k] * hill79.thickness_strain(layer, self.ep_n[c, g, k], self.material)
-            e33[c] = acc / self.nqp
+        e33 = _mean_thickness_strain(self.strain, self.ep_n, self.material, self.zeta, self.wz, self.thickness)
         return {"equivalent_plastic_strain": peq, "thickness_strain": e33}
+
+
+@numba.njit(cache=True)
+def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
+    """Per cell: the thickness strain of every layer (hill79.thickness_strain) at strains
+    e_m + zeta t k, weighted through the thickness and averaged over the quadrature points."""
+    ncells, nqp = strain.shape[0], strain.shape[1]
+    e33 = np.zeros(ncells)
+    for c in range(ncells):
+        acc = 0.0
+        for g in range(nqp):
+            for k in range(zeta.size):
+                layer = strain[c, g, :3] + zeta[k] * thickness * strain[c, g, 3:]
+                acc += wz[k] * hill79.thickness_strain(layer, ep[c, g, k], mat)
+        e33[c] = acc / nqp
+    return e33
