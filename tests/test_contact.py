@@ -271,6 +271,29 @@ def test_cup_without_a_holder_force_draws(force):
     assert p.punch_force() > 0
 
 
+@pytest.mark.parametrize("case", ["mu 0.3", "10x increment", "die radius 2 mm"])
+def test_hard_cup_cases_draw(case):
+    """Hard cases of the cup (the full-stroke table: shellform study cup-hard) on the coarse mesh
+    for 3 mm: three times the friction; increments of ten times the scene's largest (2.4 mm), cut
+    back by the driver where they fail; a die shoulder of 2 mm, a quarter of a cell. Each reaches
+    3 mm with the tools in balance, the flange pinched and no penetration."""
+    s = _cup()
+    big = 10 * s.process.max_step
+    changes = {"mu 0.3": ("tools", "friction", 0.3), "die radius 2 mm": ("tools", "die_profile_radius", 2.0),
+               "10x increment": ("process", "max_step", big)}[case]
+    setattr(getattr(s, changes[0]), changes[1], changes[2])
+    if case == "10x increment":
+        s.process.initial_step = big
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(3.0 / s.tools.stroke)
+    assert p.stroke == pytest.approx(3.0)
+    assert p.force_balance() <= 1e-6 and p.free_under_holder() == 0
+    assert p.max_penetration() <= 0.01 * s.material.thickness
+    assert p.punch_force() > 0
+    if case == "10x increment":  # it took the big steps (cut back where it had to)
+        assert len(p.driver.history) <= 2 + sum(h.cutbacks for h in p.driver.history)
+
+
 def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
     """A run whose Newton breaks down (here: forced past 0.5 mm, leaving a wild iterate behind)
     stops with its cause, and summary.json reports the last converged state: the stroke, punch

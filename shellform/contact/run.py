@@ -137,8 +137,8 @@ def _png(path: Path, p: DrawingProblem, title: str) -> None:
     pl.add_mesh(grid, scalars="thickness strain", show_edges=True, cmap="coolwarm", edge_color="#555555",
                 line_width=0.5, scalar_bar_args={"title": "thickness strain"})
     pl.add_text(title, font_size=10)
-    pl.view_isometric()
-    pl.camera.elevation = 15.0
+    L = max(p.scene.geometry.lx, p.scene.geometry.ly)
+    pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
     pl.screenshot(str(path))
     pl.close()
 
