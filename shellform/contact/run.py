@@ -3,8 +3,12 @@
 Writes into the output folder (forces and draw-in for the whole blank):
     summary.json             stroke_mm, draw_in_mm (DX, DY, DD) and punch_force_kN at every
                              reported stroke; max_thickness_strain and where; increments,
-                             Newton iterations, contact passes; wall_time_s and its split
-    force_stroke.csv, .png   punch force, holder force and height, penetration per increment
+                             Newton iterations, contact passes; wall_time_s and its split;
+                             over_the_stroke: the worst penetration, z-balance, holder share
+                             and count of free nodes under the closed holder
+    force_stroke.csv, .png   per increment: punch force, holder force, height and largest nodal
+                             share, the tools' z-balance, penetration, free nodes under the
+                             closed holder, iterations, smallest line-search factor, contacts
     thickness_diagonal.csv   initial distance from the centre along x = y, thickness strain
     thickness_transverse.csv the same along the transverse centre line y = 0
     cup.bp                   VTX time series (displacement, thickness strain) at the reports
@@ -28,6 +32,10 @@ from shellform.contact.problem import DrawingProblem
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.scene import Scene
 from shellform.studies.common import say, write_csv
+
+
+# worst values over all increments, in summary.json: the balances and the pinch
+CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
 
 
 def _gather(comm, *arrays):
@@ -157,7 +165,9 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
         h = d.history[-1]
         curve.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
                       "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
-                      "max_penetration_mm": p.max_penetration(), "iterations": h.iterations,
+                      "max_penetration_mm": p.max_penetration(), "force_balance": p.force_balance(),
+                      "holder_largest_share": p.holder_share(), "free_under_closed_holder": p.free_under_holder(),
+                      "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
 
     def report():
@@ -195,6 +205,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
+        "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
     }
     output.write_json(outdir / "summary.json", summary)
     return summary
