@@ -27,8 +27,9 @@ stiffness k_t:
 k_t = stick_stiffness E A_i / h per node (a penalty of E/h per unit area, the scaling of an
 optimal contact penalty; elastic stick slips are then micrometres). The normal force p
 (both faces of a pinched node) is held fixed within a contact pass, so the tangent above is
-exact there and Newton converges quadratically; p is then updated from the reactions, and the
-passes repeat until p and the contact set hold (an outer, augmentation-like loop).
+exact there and Newton converges quadratically; p is then updated from the reactions (with
+Aitken's relaxation), and the passes repeat until p and the contact set hold (an outer,
+augmentation-like loop).
 
 Newton is globalised: each correction is first limited so that no node moves by more than
 `trust` thicknesses, then a line search on the energy slope dq . R(q + alpha dq) shortens it
@@ -69,7 +70,8 @@ class ContactControls:
 
 class ContactState:
     """Per owned node: the tool it lies on (or FREE), the normal force of that tool's face and
-    of the holder's face (held fixed within a pass), the tangential friction force of the last
+    of the holder's face, the normal force friction uses (held fixed within a pass; the faces'
+    sum, relaxed between passes), the tangential friction force of the last
     converged increment (global x, y, z), the node's switches in this increment; and whether
     the holder is closed."""
 
@@ -77,6 +79,7 @@ class ContactState:
         self.tool = np.full(n, FREE, dtype=np.int8)
         self.pressure = np.zeros(n)
         self.holder_face = np.zeros(n)
+        self.normal = np.zeros(n)  # the normal force friction uses in this pass (both faces)
         self.friction = np.zeros((n, 3))
         self.toggles = np.zeros(n, dtype=np.int32)
         self.closed = np.zeros(1, dtype=bool)
@@ -137,6 +140,7 @@ class SemiInverseDriver(Driver):
         self.lam_n = 0.0
         self.pinched = np.zeros(n, dtype=bool)
         self._previous = None  # the committed state before the last (the predictor's)
+        self._r_prev, self._omega = None, 1.0
         self._friction = np.zeros((n, 3))  # tangential force of the current iterate (global)
         self._rate = np.zeros((n, 2, 2))  # its stiffness in the frame's tangent slots
         self._slipping = np.zeros(n, dtype=bool)
@@ -169,7 +173,9 @@ class SemiInverseDriver(Driver):
             s.tool[touch] = k
         if self.holder is not None:
             s.closed[0] = self.holder.force > 0
+            self._pinch(x, grow=False)
             self._holder_faces(x, np.zeros(self.n_owned))
+        s.normal = s.pressure + s.holder_face
         self.committed = s.copy()
 
     def _nodal_areas_and_thickness_strain(self):
@@ -189,12 +195,21 @@ class SemiInverseDriver(Driver):
         return area, arr[: self.n_owned, 1] / area
 
     # -- the holder ----------------------------------------------------------------------------
+    def _pinch(self, x, grow: bool):
+        """The pinched nodes: on the die, under the closed holder at positions x. Within an
+        increment the set only grows (nodes drawn under the holder are pinched at once); a node
+        drawn out from under it leaves at the next increment, so that a node at the holder's edge
+        cannot switch between pinched and free from one pass to the next."""
+        s = self.state
+        now = s.closed[0] & self.holder.under(x) & (s.tool == self.die)
+        self.pinched = (self.pinched | now) if grow else now
+        self.pinched &= s.closed[0] & (s.tool == self.die)
+
     def _holder_faces(self, x, net):
-        """Set the pinched nodes and the frozen face forces of the holder (and of the die under
-        it) from the nodes' net normal forces `net` (die minus holder)."""
+        """The frozen face forces of the holder (and of the die under it) from the nodes' net
+        normal forces `net` (die minus holder)."""
         s, h = self.state, self.holder
         under = h.under(x)
-        self.pinched = s.closed[0] & under & (s.tool == self.die)
         if s.closed[0]:
             tops = x[:, 2] + self.half_thickness
             d, s.holder_face = h.faces(self.pinched, net, tops)
@@ -220,6 +235,7 @@ class SemiInverseDriver(Driver):
                     s.closed[0] = True
                     changes = 1
             s.holder_toggles[0] += changes
+        self._pinch(x, grow=True)
         self._holder_faces(x, net)
         return changes
 
@@ -237,7 +253,7 @@ class SemiInverseDriver(Driver):
         shift = np.zeros(n_own)  # z-travel of each node's tool in this increment
         for k in range(len(self.tools)):
             off = (s.tool == k) & ~np.isfinite(gaps[k][0])  # slid off the tool's extent
-            s.tool[off], s.pressure[off] = FREE, 0.0
+            s.tool[off], s.pressure[off], s.normal[off] = FREE, 0.0, s.holder_face[off]
             on = np.flatnonzero(s.tool == k)
             if on.size == 0:
                 continue
@@ -254,7 +270,7 @@ class SemiInverseDriver(Driver):
         self._rate[:] = 0.0
         self._slipping[:] = False
         if self.mu > 0:
-            rub = np.flatnonzero((s.tool != FREE) | (s.holder_face > 0))
+            rub = np.flatnonzero((s.tool != FREE) | (s.normal > 0))
             self._coulomb(rub, shift[rub], x, frames[rub])
         flags[self.sym_all] = 0.0  # already held by symmetry (a homogeneous condition)
         known[self.sym_all] = 0.0
@@ -284,7 +300,7 @@ class SemiInverseDriver(Driver):
         k = self.k_stick[idx]
         trial = f_old - k[:, None] * ds
         size = np.linalg.norm(trial, axis=1)
-        limit = self.mu * (s.pressure[idx] + s.holder_face[idx])
+        limit = self.mu * s.normal[idx]
         slip = size > (1 - 1e-6) * limit  # on the cone (a node that slipped): keeps slipping, slip tangent
         ratio = np.where(slip, limit / np.maximum(size, 1e-300), 1.0)
         m2 = np.einsum("nij,nj->ni", F[:, :2], trial) / np.maximum(size, 1e-300)[:, None]
@@ -344,10 +360,13 @@ class SemiInverseDriver(Driver):
         until they hold."""
         self.state = self.committed.copy()
         self._lam_trial = lam
+        if self.holder is not None:
+            self._pinch(self.x_n, grow=False)
         self._extrapolate_normal_forces(lam)
         self._passes = self._changes = 0
         self.line_search_factors = []
         self.pass_residuals = []  # |R| of every iterate, one list per pass (this increment)
+        self._r_prev, self._omega = None, 1.0  # Aitken's memory of the normal-force updates
         iterations, residuals, ev = 0, [], None
         changes, dp = 0, 0.0
         for _ in range(self.contact.max_passes):
@@ -377,9 +396,7 @@ class SemiInverseDriver(Driver):
             return
         s, ratio = self.state, (lam - self.lam_n) / (self.lam_n - prev["lam"])
         same = s.tool == prev["tool"]
-        for name in ("pressure", "holder_face"):
-            now = getattr(s, name)
-            now[same] = np.maximum(now[same] + ratio * (now[same] - prev[name][same]), 0.0)
+        s.normal[same] = np.maximum(s.normal[same] + ratio * (s.normal[same] - prev["normal"][same]), 0.0)
 
     def _newton_fixed_set(self, lam):
         c = self.controls
@@ -457,7 +474,8 @@ class SemiInverseDriver(Driver):
         for i in np.argsort(-r)[:3]:
             say(f"      node {i} at {self.X[i, :2].round(2)} -> {x[i].round(3)}: tool {s.tool[i]}, pinched {self.pinched[i]}, "
                 f"normal {self.frames[i, 2].round(3)}, R (u, v, w) {R[i, :3].round(2)}, R (slopes) {R[i, 3:].round(1)}, "
-                f"tool face {s.pressure[i]:.1f} N, holder face {s.holder_face[i]:.1f} N, friction "
+                f"tool face {s.pressure[i]:.1f} N, holder face {s.holder_face[i]:.1f} N, friction normal "
+                f"{s.normal[i]:.1f} N, friction "
                 f"{self._friction[i].round(2)} ({'slip' if self._slipping[i] else 'stick'})")
 
     def _global_slope(self, dq) -> float:
@@ -477,13 +495,12 @@ class SemiInverseDriver(Driver):
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
         comm = self.model.mesh.comm
-        p_old = s.pressure + s.holder_face
         on = s.tool != FREE
         net = np.where(on, self.reactions()[:, 2], 0.0)
         s.pressure = np.maximum(net, 0.0)
         changes = 0
         if self.holder is not None:
-            self.pinched = s.closed[0] & self.holder.under(x) & (s.tool == self.die)
+            self._pinch(x, grow=True)
             changes = self._update_holder(x, net)
         scale = max(comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
         can = s.toggles < self.contact.max_toggles
@@ -499,16 +516,42 @@ class SemiInverseDriver(Driver):
         join = ~on & ((depth.min(axis=0) < -self.contact.penetration) | enters) & can
         s.tool[release] = FREE
         s.tool[join] = deepest[join]
+        if self.holder is not None:
+            self._pinch(x, grow=True)  # the nodes drawn under the closed holder
         switched = release | join
         s.pressure[switched] = 0.0
         s.friction[switched] = 0.0  # a new contact starts without friction history
         s.toggles[switched] += 1
         changes += int(switched.sum())
         self._frozen = int((s.toggles >= self.contact.max_toggles).sum())
-        dp = np.sqrt(comm.allreduce(float(np.sum((s.pressure + s.holder_face - p_old) ** 2)), op=MPI.SUM))
-        pn = np.sqrt(comm.allreduce(float(np.sum((s.pressure + s.holder_face) ** 2)), op=MPI.SUM))
+        changes = comm.allreduce(changes, op=MPI.SUM)
+        dp, pn = self._relax_normal(changes)
         self.times["contact_s"] += time.perf_counter() - t0
-        return comm.allreduce(changes, op=MPI.SUM), self.mu * dp, self.mu * pn
+        return changes, self.mu * dp, self.mu * pn
+
+    def _relax_normal(self, changes):
+        """The friction's normal force for the next pass from the faces' new sum p~: the fixed
+        point p = p~(p) relaxed with Aitken's factor (Irons and Tuck), r = p~ - p,
+        omega_k = -omega_k-1 r_k-1 . (r_k - r_k-1) / |r_k - r_k-1|^2 in [0.2, 1.5]: it damps a
+        cycling p (a node whose faces swap) and speeds a slow one. Returns (|r|, |p~|)."""
+        s, comm = self.state, self.model.mesh.comm
+        target = s.pressure + s.holder_face
+        r = target - s.normal
+        dot = lambda a, b: comm.allreduce(float(np.dot(a, b)), op=MPI.SUM)  # noqa: E731
+        omega = 1.0
+        if changes == 0 and self._r_prev is not None:
+            dr = r - self._r_prev
+            dd = dot(dr, dr)
+            if dd > 0:
+                omega = float(np.clip(-self._omega * dot(self._r_prev, dr) / dd, 0.2, 1.5))
+        if self.contact.trace and r.size:
+            i = int(np.argmax(np.abs(r)))
+            say(f"    normal force: omega {omega:.3g}; largest change at node {i} ({self.X[i, :2].round(2)}, tool "
+                f"{s.tool[i]}, pinched {self.pinched[i]}): {s.normal[i]:.1f} -> {target[i]:.1f} N")
+        self._r_prev, self._omega = (r, omega) if changes == 0 else (None, 1.0)
+        s.normal = np.maximum(s.normal + omega * r, 0.0)
+        s.normal[s.tool == FREE] = s.holder_face[s.tool == FREE]  # off the tools: the holder's load only
+        return np.sqrt(dot(r, r)), np.sqrt(dot(target, target))
 
     def _commit(self):
         super()._commit()
@@ -517,7 +560,7 @@ class SemiInverseDriver(Driver):
         s.holder_toggles[:] = 0
         s.friction = self._friction.copy()
         c = self.committed
-        self._previous = {"lam": self.lam_n, "tool": c.tool, "pressure": c.pressure, "holder_face": c.holder_face}
+        self._previous = {"lam": self.lam_n, "tool": c.tool, "normal": c.normal}
         self.committed = s.copy()
         self.x_n = self.positions()
         self.lam_n = self._lam_trial
@@ -529,6 +572,8 @@ class SemiInverseDriver(Driver):
         """The committed contact state and its forces (a stop reports the last converged state)."""
         self.state = self.committed.copy()
         self._lam_trial = self.lam_n
+        if self.holder is not None:
+            self._pinch(self.x_n, grow=False)
         self._constraints(self.lam)
         self.residual(self.lam, tangent=False)
 
