@@ -1,6 +1,7 @@
 """The mixed semi-inverse contact: nodal frames, equilibrium with a rigid punch, release on
-unloading, Coulomb friction between flat tools, the force-controlled blank holder, and a
-short square-cup draw (penetration, holder equilibrium, contact set settling)."""
+unloading, the pinching holder and Coulomb friction as a return mapping between flat tools (the
+clamping force, a slip reversal), the square cup drawn a few millimetres (balances, the pinch,
+penetration; BHF 0 and 4 N; hard cases), and the report of a stopped run."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 

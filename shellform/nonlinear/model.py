@@ -48,18 +48,20 @@ class Evaluation:
         return "; ".join(words)
 
 
-def use_cores(comm) -> int:
+CELLS_PER_THREAD = 256  # below this many cells a thread costs more to start than it saves
+
+
+def use_cores(comm, num_cells: int) -> int:
     """Threads of the element and material loops on this rank: the cores this process may run
-    on, shared by the ranks on its node (at most NUMBA_NUM_THREADS); returns the number set."""
+    on, shared by the ranks on its node (at most NUMBA_NUM_THREADS), and no more than one per
+    CELLS_PER_THREAD cells."""
     import os
 
     local = comm.Split_type(MPI.COMM_TYPE_SHARED)
     ranks = local.size
     local.Free()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    n = max(1, min(numba.config.NUMBA_NUM_THREADS, cores // ranks))
-    numba.set_num_threads(n)
-    return n
+    return max(1, min(numba.config.NUMBA_NUM_THREADS, cores // ranks, num_cells // CELLS_PER_THREAD))
 
 
 class SheetModel:
@@ -72,7 +74,6 @@ class SheetModel:
         check_mesh(mesh)
         if not (np.isfinite(thickness) and thickness > 0):
             raise InputError("material.thickness", f"must be > 0, got {thickness}")
-        self.threads = use_cores(mesh.comm)
         self.mesh, self.effects = mesh, tuple(effects)
         self.nonlinear = "geometric_nonlinearity" in self.effects
         self.plastic = "plasticity" in self.effects
@@ -85,6 +86,7 @@ class SheetModel:
         tdim = mesh.topology.dim
         self.num_cells = mesh.topology.index_map(tdim).size_local
         self.cells = np.arange(self.num_cells, dtype=np.int32)
+        self.threads = use_cores(mesh.comm, self.num_cells)
         self.dofs = np.ascontiguousarray(self.V.dofmap.list[: self.num_cells], dtype=np.int32)
         self.unrolled_dofs = (BS * self.dofs[:, :, None] + np.arange(BS)).reshape(self.num_cells, NDOF)
         g = mesh.geometry
@@ -117,6 +119,7 @@ class SheetModel:
     def evaluate(self, q: fem.Function, tangent: bool = True, elastic_tangent: bool = False) -> Evaluation:
         """Element forces (and tangents) at the carrier state q, into the copy forms."""
         k = self.kernels
+        numba.set_num_threads(self.threads)
         t0 = time.perf_counter()
         k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.z,
                       self.strain)
