@@ -48,7 +48,7 @@ from mpi4py import MPI
 from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
 from shellform.contact.holder import PinchingHolder
-from shellform.nonlinear.driver import Driver
+from shellform.nonlinear.driver import Driver, shorten
 from shellform.studies.common import say
 
 FREE = -1
@@ -173,8 +173,9 @@ class SemiInverseDriver(Driver):
             s.tool[touch] = k
         if self.holder is not None:
             s.closed[0] = self.holder.force > 0
-            self._pinch(x, grow=False)
-            self._holder_faces(x, np.zeros(self.n_owned))
+            under = self.holder.under(x)
+            self._pinch(under, grow=False)
+            self._holder_faces(x, under, np.zeros(self.n_owned))
         s.normal = s.pressure + s.holder_face
         self.committed = s.copy()
 
@@ -195,21 +196,20 @@ class SemiInverseDriver(Driver):
         return area, arr[: self.n_owned, 1] / area
 
     # -- the holder ----------------------------------------------------------------------------
-    def _pinch(self, x, grow: bool):
-        """The pinched nodes: on the die, under the closed holder at positions x. Within an
+    def _pinch(self, under, grow: bool):
+        """The pinched nodes: on the die, under the closed holder (mask `under`). Within an
         increment the set only grows (nodes drawn under the holder are pinched at once); a node
         drawn out from under it leaves at the next increment, so that a node at the holder's edge
         cannot switch between pinched and free from one pass to the next."""
         s = self.state
-        now = s.closed[0] & self.holder.under(x) & (s.tool == self.die)
+        now = s.closed[0] & under & (s.tool == self.die)
         self.pinched = (self.pinched | now) if grow else now
         self.pinched &= s.closed[0] & (s.tool == self.die)
 
-    def _holder_faces(self, x, net):
+    def _holder_faces(self, x, under, net):
         """The frozen face forces of the holder (and of the die under it) from the nodes' net
-        normal forces `net` (die minus holder)."""
+        normal forces `net` (die minus holder), at positions x with `under` the holder."""
         s, h = self.state, self.holder
-        under = h.under(x)
         if s.closed[0]:
             tops = x[:, 2] + self.half_thickness
             d, s.holder_face = h.faces(self.pinched, net, tops)
@@ -217,14 +217,13 @@ class SemiInverseDriver(Driver):
         else:
             s.holder_face = h.load(under)
 
-    def _update_holder(self, x, net) -> int:
+    def _update_holder(self, x, under, net) -> int:
         """Open the holder if the flange lifts it (the squeeze left is negative), close it again
         once the flange under it lies on the die; then its face forces. Returns the changes."""
         s, h = self.state, self.holder
         comm = self.model.mesh.comm
         changes = 0
         if s.holder_toggles[0] < self.contact.max_toggles:
-            under = h.under(x)
             if s.closed[0] and h.squeeze_left(self.pinched, net) < 0:
                 s.closed[0] = False
                 changes = 1
@@ -235,8 +234,8 @@ class SemiInverseDriver(Driver):
                     s.closed[0] = True
                     changes = 1
             s.holder_toggles[0] += changes
-        self._pinch(x, grow=True)
-        self._holder_faces(x, net)
+        self._pinch(under, grow=True)
+        self._holder_faces(x, under, net)
         return changes
 
     # -- constraints of one iterate -----------------------------------------------------------
@@ -361,7 +360,7 @@ class SemiInverseDriver(Driver):
         self.state = self.committed.copy()
         self._lam_trial = lam
         if self.holder is not None:
-            self._pinch(self.x_n, grow=False)
+            self._pinch(self.holder.under(self.x_n), grow=False)
         self._extrapolate_normal_forces(lam)
         self._passes = self._changes = 0
         self.line_search_factors = []
@@ -458,10 +457,11 @@ class SemiInverseDriver(Driver):
             if self.contact.trace:
                 say(f"      step: alpha {alpha:.3g} of a largest nodal move {move:.3g}, |R| {norm:.3e}, energy slope "
                     f"{s0 or 0:.3e} -> {s1:.3e}, known corrections {jump:.2e}")
-            if s0 is None or s1 <= abs(s0) or s0 >= 0:  # not past the energy minimum along dq by much
+            shorter = None if s0 is None else shorten(alpha, s0, s1)
+            if shorter is None:
                 self.line_search_factors.append(alpha)
                 return True, norm, scale, ev, jump
-            alpha *= max(0.1, min(0.5, s0 / (s0 - s1)))  # secant towards dq . R = 0
+            alpha = shorter
         self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
         return False, norm, scale, ev, jump
 
@@ -499,25 +499,23 @@ class SemiInverseDriver(Driver):
         net = np.where(on, self.reactions()[:, 2], 0.0)
         s.pressure = np.maximum(net, 0.0)
         changes = 0
+        under = self.holder.under(x) if self.holder is not None else np.zeros(self.n_owned, dtype=bool)
         if self.holder is not None:
-            self._pinch(x, grow=True)
-            changes = self._update_holder(x, net)
+            self._pinch(under, grow=True)
+            changes = self._update_holder(x, under, net)
         scale = max(comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
         can = s.toggles < self.contact.max_toggles
         release = on & ~self.pinched & (net < -1e-8 * scale) & can
         gaps = self._gaps(x, lam)
         depth = np.stack([g for g, _ in gaps])  # (tools, nodes)
         deepest = np.argmin(depth, axis=0)
-        if self.holder is not None and s.closed[0]:  # the closed holder pinches what comes under it
-            enters = self.holder.under(x) & ~on
-            deepest[enters] = self.die
-        else:
-            enters = np.zeros_like(on)
+        enters = under & ~on & s.closed[0]  # the closed holder pinches what comes under it
+        deepest[enters] = self.die
         join = ~on & ((depth.min(axis=0) < -self.contact.penetration) | enters) & can
         s.tool[release] = FREE
         s.tool[join] = deepest[join]
         if self.holder is not None:
-            self._pinch(x, grow=True)  # the nodes drawn under the closed holder
+            self._pinch(under, grow=True)  # the nodes drawn under the closed holder
         switched = release | join
         s.pressure[switched] = 0.0
         s.friction[switched] = 0.0  # a new contact starts without friction history
@@ -573,7 +571,7 @@ class SemiInverseDriver(Driver):
         self.state = self.committed.copy()
         self._lam_trial = self.lam_n
         if self.holder is not None:
-            self._pinch(self.x_n, grow=False)
+            self._pinch(self.holder.under(self.x_n), grow=False)
         self._constraints(self.lam)
         self.residual(self.lam, tangent=False)
 

@@ -44,6 +44,15 @@ class ConvergenceFailure(RuntimeError):
         self.checkpoint = checkpoint
 
 
+def shorten(alpha: float, s0: float, s1: float) -> float | None:
+    """The line search on the energy slope s(alpha) = dq . R(q + alpha dq): None where alpha is
+    kept (s1 <= |s0|, not past the energy minimum along dq by much, or no descent s0 >= 0), else
+    a shorter alpha by a secant step towards s = 0, by a factor in [0.1, 0.5]."""
+    if s1 <= abs(s0) or s0 >= 0:
+        return None
+    return alpha * max(0.1, min(0.5, s0 / (s0 - s1)))
+
+
 @dataclass
 class Controls:
     initial_step: float = 0.1  # first dlambda
@@ -246,11 +255,11 @@ class Driver:
                 if not np.isfinite(trial) or ev.failed:
                     alpha *= 0.5  # outside the material's reach: shorten
                     continue
-                s1 = self.dq.x.petsc_vec.dot(self.b)
-                if s1 <= abs(s0) or s0 >= 0:  # not past the energy minimum along dq by much
+                shorter = shorten(alpha, s0, self.dq.x.petsc_vec.dot(self.b))
+                if shorter is None:
                     accepted = True
                     break
-                alpha *= max(0.1, min(0.5, s0 / (s0 - s1)))  # secant towards dq . R = 0
+                alpha = shorter
             R0.destroy()
             if not accepted:
                 self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
