@@ -9,7 +9,7 @@ integral is in string_net.
 
 import ufl
 
-from forms import strains
+from shellform.forms import strains
 
 
 def membrane_constraint(N, eps_p, u, w, kappa0=None):

@@ -10,15 +10,18 @@ Effects of the nonlinear sheet (forms.nonlinear, shellform.nonlinear):
 - ``geometric_nonlinearity``  exact (total-Lagrangian Kirchhoff-Love) membrane and bending strains
 - ``plasticity``              elastic-plastic layers through the thickness (Hill 1979)
 - ``anisotropy``              r != 1 or m != 2 in the Hill 1979 yield function (needs plasticity)
+- ``finite_strain``           the layers in logarithmic strains, a thinning lever arm (needs
+                              plasticity and geometric_nonlinearity)
 """
 
 import ufl
 
-from forms import assumed_strain, bending, loads, membrane, string_net
-from forms.fields import HybridFields, ShellParameters
+from shellform.forms import assumed_strain, bending, loads, membrane, string_net
+from shellform.forms.fields import HybridFields, ShellParameters
 
-EFFECTS = ("bending", "membrane", "shallow_curvature", "geometric_nonlinearity", "plasticity", "anisotropy")
-NONLINEAR_EFFECTS = ("geometric_nonlinearity", "plasticity", "anisotropy")
+EFFECTS = ("bending", "membrane", "shallow_curvature", "geometric_nonlinearity", "plasticity", "anisotropy",
+           "finite_strain")
+NONLINEAR_EFFECTS = ("geometric_nonlinearity", "plasticity", "anisotropy", "finite_strain")
 
 
 def strain_energy(f: HybridFields, p: ShellParameters, effects) -> ufl.Form | None:

@@ -33,7 +33,7 @@ supplies at the quadrature points (shellform.material), conjugate to the strain 
 
 import ufl
 
-from forms import string_net
+from shellform.forms import string_net
 
 
 def reference_surface(x, kappa0=None):

@@ -3,8 +3,10 @@
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
                                             (--trace: a tool scene logs every contact iterate)
     shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
-                                            against time), assembly, newton (benchmarks), cup-hard
-                                            (the square cup's hard cases)
+                                            against time), strip (finite-strain plasticity against
+                                            closed forms), assembly, newton (benchmarks), cup-hard
+                                            (the square cup's hard cases), cup-mesh (its meshes),
+                                            cup-strain (before and after finite strains)
 """
 
 import argparse
@@ -46,7 +48,8 @@ def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
     return summary
 
 
-STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "assembly", "newton", "cup-hard", "cup-mesh"]
+STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
+           "cup-strain"]
 
 
 def main(argv=None) -> int:

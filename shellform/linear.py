@@ -13,7 +13,7 @@ from dolfinx import fem, la
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from forms.fields import ShellParameters
+from shellform.forms.fields import ShellParameters
 from shellform import loads, supports
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.assembly.kernels import HybridShellForms

@@ -16,7 +16,7 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from forms.functional import EFFECTS, NONLINEAR_EFFECTS
+from shellform.forms.functional import EFFECTS, NONLINEAR_EFFECTS
 from shellform.errors import InputError
 
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
@@ -315,6 +315,9 @@ def _validate_effects(s: Scene) -> None:
                      f"{e!r} is an effect of the nonlinear sheet, a full shell: switch on 'bending' and 'membrane'")
     _require("anisotropy" not in s.effects or "plasticity" in s.effects, "effects",
              "'anisotropy' shapes the yield function: it needs 'plasticity'")
+    _require("finite_strain" not in s.effects or
+             ("plasticity" in s.effects and "geometric_nonlinearity" in s.effects), "effects",
+             "'finite_strain' (logarithmic strains, thinning) needs 'plasticity' and 'geometric_nonlinearity'")
     _require("friction" not in s.effects or "contact" in s.effects, "effects",
              "'friction' acts at the contact with the tools: it needs 'contact'")
     _require("contact" not in s.effects or "geometric_nonlinearity" in s.effects, "effects",

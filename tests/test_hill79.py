@@ -267,8 +267,8 @@ def section(em, k, t, nz, mat, ep_n=None, p_n=None):
     ep_n = np.zeros((nz, 3)) if ep_n is None else ep_n
     p_n = np.zeros(nz) if p_n is None else p_n
     S, D, ep_new, p_new = np.zeros(6), np.zeros((6, 6)), np.zeros((nz, 3)), np.zeros(nz)
-    nplastic = section_response(np.asarray(em, float), np.asarray(k, float), t, zeta, wz,
-                                ep_n, p_n, mat, S, D, ep_new, p_new)
+    nplastic, _ = section_response(np.asarray(em, float), np.asarray(k, float), t, t, zeta, wz,
+                                   ep_n, p_n, mat, False, False, S, D, ep_new, p_new)
     return S, D, nplastic, ep_new, p_new
 
 

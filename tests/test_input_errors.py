@@ -55,6 +55,8 @@ POWER = {"hardening": "power", "yield_stress": 2.0e-3, "n": 5.0}
     ({"effects": FULL + ["hyperelasticity"]}, "effects"),
     ({"effects": ["membrane", "geometric_nonlinearity"]}, "effects"),  # the sheet is a full shell
     ({"effects": SHEET + ["anisotropy"]}, "effects"),  # anisotropy without plasticity
+    ({"effects": SHEET + ["finite_strain"]}, "effects"),  # logarithmic strains of no plastic layers
+    ({"effects": FULL + ["plasticity", "finite_strain"], "material": POWER}, "effects"),  # no large displacements
     ({"effects": PLASTIC}, "material.hardening"),  # plasticity without a curve
     ({"effects": SHEET, "material": POWER}, "material.hardening"),  # a curve without plasticity
     ({"effects": PLASTIC + ["anisotropy"], "material": {**POWER, "r": 0.0}}, "material.r"),

@@ -21,7 +21,7 @@ from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
-from forms.fields import ShellParameters
+from shellform.forms.fields import ShellParameters
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.assembly.kernels import HybridShellForms
 

@@ -125,13 +125,15 @@ def test_rigid_rotation_is_strain_free():
     assert np.abs(strains[0][:, :, 3]).max() > 0.1  # the state is really bent
 
 
-@pytest.mark.parametrize("plastic", [False, True])
+@pytest.mark.parametrize("plastic", [False, True, "finite_strain"])
 def test_consistent_tangent(plastic):
     """The assembled tangent equals a central difference of the assembled residual (Levy plate
-    at P = 95, elastic, and an elastic-plastic variant with yielding layers)."""
+    at P = 95, elastic, and elastic-plastic variants with yielding layers, small and finite
+    strain)."""
     kw = {}
     if plastic:
-        kw = dict(effects=NL + ("plasticity",), material=Hill79Material(
+        extra = ("finite_strain",) if plastic == "finite_strain" else ()
+        kw = dict(effects=NL + ("plasticity",) + extra, material=Hill79Material(
             E=1.0, nu=levy.NU, hardening="swift", K=1e-3, eps0=1e-3, n=0.2))
     p = levy.problem(4, controls=Controls(initial_step=0.05, max_step=0.1), **kw)
     d = p.driver

@@ -49,8 +49,8 @@ def test_vlasov_and_donnell_theories_agree_closely(overkill):
 
 DONNELL = """
 import json, ufl, shellform
-import forms.strains
-forms.strains.bending_interior = lambda u, kappa0: ufl.zero((2, 2))  # Donnell: f^b = -grad grad w
+import shellform.forms.strains
+shellform.forms.strains.bending_interior = lambda u, kappa0: ufl.zero((2, 2))  # Donnell: f^b = -grad grad w
 from shellform.studies import shell
 print(json.dumps([shell.coefficient(5.0, n) for n in (12, 24, 48)], default=float))
 """

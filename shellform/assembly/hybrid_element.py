@@ -38,7 +38,7 @@ class HybridElement:
     offsets: dict[str, slice] = field(init=False)
 
     def __post_init__(self):
-        from forms.functional import EFFECTS
+        from shellform.forms.functional import EFFECTS
 
         self.effects = tuple(e for e in EFFECTS if e in self.effects)  # canonical order
         has_m, has_b = "membrane" in self.effects, "bending" in self.effects

@@ -24,8 +24,8 @@ from dolfinx.fem import IntegralType, form_cpp_class
 from dolfinx.mesh import CellType
 from dolfinx.jit import ffcx_jit
 
-from forms import functional
-from forms.fields import HybridFields, ShellParameters
+from shellform.forms import functional
+from shellform.forms.fields import HybridFields, ShellParameters
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.errors import InputError

@@ -24,7 +24,7 @@ import numpy as np
 import ufl
 from dolfinx.jit import ffcx_jit
 
-from forms import kirchhoff_love as kl
+from shellform.forms import kirchhoff_love as kl
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.kernels import reference_fields
 from shellform.assembly.sheet_element import NDOF, SheetElement, build_q

@@ -2,7 +2,8 @@
 
 Writes into the output folder (forces and draw-in for the whole blank):
     summary.json             stroke_mm, draw_in_mm (DX, DY, DD) and punch_force_kN at every
-                             reported stroke; max_thickness_strain and where; increments,
+                             reported stroke; max_thickness_strain and where; the sheet's
+                             volume change (V - V0)/V0 (elastic only, with finite strains); increments,
                              Newton iterations, contact passes; wall_time_s and its split;
                              over_the_stroke: the worst penetration, z-balance, holder share
                              and count of free nodes under the closed holder
@@ -172,7 +173,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
 
     def report():
         reports.append({"stroke_mm": p.stroke, "draw_in_mm": draw_in(p), "punch_force_kN": p.punch_force() / 1e3,
-                        **_peak_thinning(p)})
+                        **_peak_thinning(p), "volume_change": p.model.volume_change()})
         if series is not None:
             series.write(p.stroke)
 

@@ -570,6 +570,7 @@ class SemiInverseDriver(Driver):
         """The committed contact state and its forces (a stop reports the last converged state)."""
         self.state = self.committed.copy()
         self._lam_trial = self.lam_n
+        self.model.converged_lever()
         if self.holder is not None:
             self._pinch(self.holder.under(self.x_n), grow=False)
         self._constraints(self.lam)

@@ -1,12 +1,16 @@
 """Through-thickness integration of a shell section: stress resultants and their tangent.
 
-Layer strain e(z) = em + z k, z = zeta t, zeta in [-1/2, 1/2]; em = (e11, e22, g12) membrane
-strain, k = (k11, k22, 2 k12) curvature. With the Gauss rule (zeta_i, w_i), sum w_i = 1:
+Layer strain e(z) = em + z k, z = zeta h, zeta in [-1/2, 1/2]; em = (e11, e22, g12) membrane
+strain, k = (k11, k22, 2 k12) curvature, h the lever arm: the current thickness (t at small
+strain, t lambda3 with finite strains, lambda3 of the last converged state). With the Gauss rule
+(zeta_i, w_i), sum w_i = 1, and t the initial thickness (the layers' volume per unit blank area):
 
     N = t sum w s,   M = t sum w z s,
     D = [[A, B], [B, Dd]],  A = t sum w Dt,  B = t sum w z Dt,  Dd = t sum w z^2 Dt,
 
-Dt the consistent tangent of the layer. nz >= 2 points integrate the elastic section exactly.
+s the layer's stress conjugate to e (S of Green-Lagrange; with finite strains P^T T from the
+logarithmic-space stress T), Dt its consistent tangent. nz >= 2 points integrate the elastic
+section exactly.
 """
 
 import numpy as np
@@ -14,6 +18,7 @@ from numba import njit
 
 from shellform.errors import InputError
 from shellform.material import E_, NU_
+from shellform.material import hencky
 from shellform.material.hill79 import _return_core
 
 
@@ -26,59 +31,88 @@ def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 @njit(cache=True)
-def section_response(em, k, t, zeta, wz, ep_n, p_n, mat, S, D, ep_new, p_new):
-    """Resultants S = (N, M) (6) and section tangent D (6x6) of the layered section; writes the
-    layers' new plastic strains ep_new (nz, 3) and p_new (nz,). Returns the number of plastic
-    layers, or -1 if any layer's local Newton failed."""
+def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
+    """One layer at section strain e = (E11, E22, 2 E12): stress s conjugate to e, tangent Dt,
+    new plastic strain; returns (p_new, status, e33). w: scratch (3, 16).
+    Small strain: the return mapping on e. Finite strain: on the Hencky strain eps(e), then
+    s = P^T T and Dt = P^T (dT/deps) P + L(T) (shellform.material.hencky). e33 is the layer's
+    thickness strain, logarithmic when finite. elastic_tangent: dT/deps is the elastic C
+    (the unloading predictor)."""
+    eps, W = w[0, :3], w[1]
+    P = w[2, :9].reshape((3, 3))
+    if finite:
+        if not hencky.log_strain(e, eps, P, W):
+            return p_n, -1, 0.0
+    else:
+        eps[:] = e
+    (t0, t1, t2, d00, d01, d02, d11, d12, d22, q0, q1, q2, p, st) = _return_core(
+        eps[0], eps[1], eps[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat)
+    ep_new[0], ep_new[1], ep_new[2] = q0, q1, q2
+    nu = mat[NU_]
+    if elastic_tangent:
+        cE = mat[E_] / (1.0 - nu * nu)
+        d00, d01, d02, d11, d12, d22 = cE, cE * nu, 0.0, cE, 0.0, 0.5 * cE * (1.0 - nu)
+    if finite:
+        T = w[0, 3:6]
+        T[0], T[1], T[2] = t0, t1, t2
+        hencky.second_order(T, e[2], W, Dt)  # Dt = L(T), then + P^T Dl P
+        for a in range(3):
+            s[a] = P[0, a] * t0 + P[1, a] * t1 + P[2, a] * t2
+            y0 = d00 * P[0, a] + d01 * P[1, a] + d02 * P[2, a]  # (Dl P)[:, a]
+            y1 = d01 * P[0, a] + d11 * P[1, a] + d12 * P[2, a]
+            y2 = d02 * P[0, a] + d12 * P[1, a] + d22 * P[2, a]
+            for b in range(3):
+                Dt[b, a] += P[0, b] * y0 + P[1, b] * y1 + P[2, b] * y2
+    else:
+        s[0], s[1], s[2] = t0, t1, t2
+        Dt[0, 0], Dt[0, 1], Dt[0, 2] = d00, d01, d02
+        Dt[1, 0], Dt[1, 1], Dt[1, 2] = d01, d11, d12
+        Dt[2, 0], Dt[2, 1], Dt[2, 2] = d02, d12, d22
+    e33 = -(q0 + q1) - nu / (1.0 - nu) * ((eps[0] - q0) + (eps[1] - q1))
+    return p, st, e33
+
+
+@njit(cache=True)
+def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_tangent,
+                     S, D, ep_new, p_new):
+    """Resultants S = (N, M) (6) and section tangent D (6x6) of the layered section of initial
+    thickness t whose layers sit at z = zeta * lever (lever: the current thickness, t at small
+    strain); writes the layers' new plastic strains ep_new (nz, 3) and p_new (nz,).
+    Returns (number of plastic layers or -1 if any layer failed, mean thickness strain)."""
     for i in range(6):
         S[i] = 0.0
         for j in range(6):
             D[i, j] = 0.0
     nplastic = 0
     failed = False
+    e33 = 0.0
+    s = np.zeros(3)
+    Dt = np.zeros((3, 3))
+    e = np.zeros(3)
+    w = np.zeros((3, 16))
     for i in range(zeta.shape[0]):
-        z = zeta[i] * t
-        (s0, s1, s2, d00, d01, d02, d11, d12, d22, q0, q1, q2, p, st) = _return_core(
-            em[0] + z * k[0], em[1] + z * k[1], em[2] + z * k[2],
-            ep_n[i, 0], ep_n[i, 1], ep_n[i, 2], p_n[i], mat)
-        ep_new[i, 0], ep_new[i, 1], ep_new[i, 2] = q0, q1, q2
+        z = zeta[i] * lever
+        for a in range(3):
+            e[a] = em[a] + z * k[a]
+        p, st, e33_i = _layer(e, ep_n[i], p_n[i], mat, finite, elastic_tangent, s, Dt, ep_new[i], w)
         p_new[i] = p
+        e33 += wz[i] * e33_i
         if st < 0:
             failed = True
         elif st == 1:
             nplastic += 1
-        c0 = t * wz[i]
-        c1 = c0 * z
-        c2 = c1 * z
-        S[0] += c0 * s0
-        S[1] += c0 * s1
-        S[2] += c0 * s2
-        S[3] += c1 * s0
-        S[4] += c1 * s1
-        S[5] += c1 * s2
-        for b, cb in ((0, c0), (3, c1)):  # A and B blocks (upper triangle), B below, then Dd
-            D[b + 0, 0] += cb * d00
-            D[b + 0, 1] += cb * d01
-            D[b + 0, 2] += cb * d02
-            D[b + 1, 1] += cb * d11
-            D[b + 1, 2] += cb * d12
-            D[b + 2, 2] += cb * d22
-        D[3, 3] += c2 * d00
-        D[3, 4] += c2 * d01
-        D[3, 5] += c2 * d02
-        D[4, 4] += c2 * d11
-        D[4, 5] += c2 * d12
-        D[5, 5] += c2 * d22
-    # symmetric completion from the upper triangles: A, Dd, B (rows 3..5, cols 0..2), then B^T
-    for i in range(3):
-        for j in range(i):
-            D[i, j] = D[j, i]
-            D[3 + i, 3 + j] = D[3 + j, 3 + i]
-            D[3 + i, j] = D[3 + j, i]
-    for i in range(3):
-        for j in range(3):
-            D[i, 3 + j] = D[3 + j, i]
-    return -1 if failed else nplastic
+        c0 = t * wz[i]  # layer volume per unit initial area: the initial thickness
+        for a in range(3):
+            S[a] += c0 * s[a]
+            S[3 + a] += c0 * z * s[a]
+            for b in range(3):
+                D[a, b] += c0 * Dt[a, b]
+                D[a, 3 + b] += c0 * z * Dt[a, b]
+                D[3 + a, 3 + b] += c0 * z * z * Dt[a, b]
+    for a in range(3):
+        for b in range(3):
+            D[3 + a, b] = D[b, 3 + a]
+    return (-1 if failed else nplastic), e33
 
 
 @njit(cache=True)

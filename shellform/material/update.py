@@ -7,10 +7,16 @@ section tangents D (6 x 6) and the counts of plastic layers, of layers whose ret
 failed, and of points past the strain guard: a strain that is not finite or beyond 1000 % is
 not updated (no material takes it; the iterate has left the physical range) and the driver
 cuts back, naming which of the two stopped it.
+
+finite: the layers work in logarithmic strains (shellform.material.hencky); their lever arm is
+t lever_stretch (the thickness of the last converged state), and the trial thickness stretch
+lambda3 = exp(sum_i w_i e33_i) (a uniform stretch across the section) is written to `stretch`.
 ``elastic_tangent`` returns the elastic section tangent with the elastic-plastic stresses: the
 first iteration after a load reversal, where a perfectly plastic tangent is (nearly) singular
 along the very direction in which the sheet unloads elastically.
 """
+
+import math
 
 import numba
 import numpy as np
@@ -19,7 +25,8 @@ from shellform.material import section
 
 
 @numba.njit(parallel=True)  # not cached: numba would not see edits of section.py
-def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D, elastic_tangent=False):
+def section_update(e, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, lever_stretch, ep, p, stretch,
+                   S, D, elastic_tangent=False):
     nplastic, nfail, nguard = 0, 0, 0
     for c in numba.prange(e.shape[0]):  # cells are independent: threads share them
         Sg = np.zeros(6)
@@ -32,8 +39,10 @@ def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D,
                 nguard += 1
                 section.elastic_section(em * 0.0, k * 0.0, thickness, mat, Sg, Dg)
             elif plastic:
-                st = section.section_response(em, k, thickness, zeta, wz, ep_n[c, g], p_n[c, g], mat,
-                                              Sg, Dg, ep[c, g], p[c, g])
+                lever = thickness * lever_stretch[c, g] if finite else thickness
+                st, e33 = section.section_response(em, k, thickness, lever, zeta, wz, ep_n[c, g], p_n[c, g],
+                                                   mat, finite, elastic_tangent, Sg, Dg, ep[c, g], p[c, g])
+                stretch[c, g] = math.exp(e33) if finite else 1.0
                 if st < 0:
                     nfail += 1
                 else:
@@ -41,7 +50,5 @@ def section_update(e, mat, thickness, plastic, zeta, wz, ep_n, p_n, ep, p, S, D,
             else:
                 section.elastic_section(em, k, thickness, mat, Sg, Dg)
             S[c, g, :] = Sg
-            if elastic_tangent:  # the unloading predictor: stresses plastic, tangent elastic
-                section.elastic_section(em, k, thickness, mat, np.zeros(6), Dg)
             D[c, g, :, :] = Dg
     return nplastic, nfail, nguard

@@ -10,7 +10,9 @@ Each increment lambda_n -> lambda_n + dlambda:
                 by the converged tangent), dq_D = 0 after; q += alpha dq
     line search on the energy slope s(alpha) = dq . R(q + alpha dq): alpha = 1 unless the step
                 overshoots the energy minimum along dq (s(1) > |s(0)|), then secant steps
-                towards s = 0; halved where the material update fails or |R| is not finite
+                towards s = 0; halved where the material update fails or |R| is not finite.
+                Not in the lifted iteration (a prescribed jump): s(0) on the free rows is about
+                zero there (a converged start) and is no energy slope of the whole move
     converged   |R_free| <= rtol max(|lambda f_ext|, |element forces|) or below the round-off
                 floor 1e3 eps max(K_ii) h (a very thin sheet), or a correction at
                 round-off level (|dq| <= stol |q|) with |R_free| <= 1e3 rtol max(...)
@@ -198,6 +200,7 @@ class Driver:
     def _restore_converged(self) -> None:
         """Before a stop: make every derived quantity (residual, reactions) that of the last
         converged state, which q already holds, so that what is reported is that state."""
+        self.model.converged_lever()
         self._set_dirichlet(self.lam)
         self.residual(self.lam, tangent=False)
 
@@ -255,7 +258,9 @@ class Driver:
                 if not np.isfinite(trial) or ev.failed:
                     alpha *= 0.5  # outside the material's reach: shorten
                     continue
-                shorter = shorten(alpha, s0, self.dq.x.petsc_vec.dot(self.b))
+                # The lifted iteration moves the prescribed dofs: its slope on the free rows
+                # (about zero at a converged start) says nothing of the energy: full step.
+                shorter = None if jump > 0 else shorten(alpha, s0, self.dq.x.petsc_vec.dot(self.b))
                 if shorter is None:
                     accepted = True
                     break
@@ -342,7 +347,7 @@ class Driver:
         rank = self.model.mesh.comm.rank
         path = d / f"last_converged.rank{rank}.npz"
         m = self.model
-        np.savez(path, lam=self.lam, q=self.q.x.array, ep=m.ep_n, p=m.p_n)
+        np.savez(path, lam=self.lam, q=self.q.x.array, ep=m.ep_n, p=m.p_n, thickness_stretch=m.stretch_n, lever_stretch=m.lever)
         if rank == 0:
             (d / "history.json").write_text(json.dumps([asdict(h) for h in self.history], indent=1))
         return path

@@ -19,7 +19,7 @@ from shellform.assembly.kernels import check_mesh
 from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly.sheet_kernels import SheetKernels
-from shellform.material import hill79, section
+from shellform.material import hencky, hill79, section
 from shellform.material.update import section_update
 from shellform.nonlinear.assemble import CellArrayForms
 
@@ -77,6 +77,9 @@ class SheetModel:
         self.mesh, self.effects = mesh, tuple(effects)
         self.nonlinear = "geometric_nonlinearity" in self.effects
         self.plastic = "plasticity" in self.effects
+        self.finite = "finite_strain" in self.effects
+        if self.finite and not (self.plastic and self.nonlinear):
+            raise InputError("effects", "'finite_strain' needs 'plasticity' and 'geometric_nonlinearity'")
         self.shallow = kappa0 is not None
         self.kernels = SheetKernels.get(self.nonlinear, self.shallow, mesh.comm, quadrature_degree)
         self.material = np.asarray(material, dtype=np.float64)
@@ -94,6 +97,7 @@ class SheetModel:
         x = self.cell_coords.reshape(-1, 3, 3)
         a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
         area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+        self.cell_area = area
         self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element
         self.nqp = el.nqp
@@ -109,6 +113,10 @@ class SheetModel:
         shape = (self.num_cells, self.nqp, nz)
         self.ep_n, self.p_n = np.zeros(shape + (3,)), np.zeros(shape)
         self.ep, self.p = np.zeros(shape + (3,)), np.zeros(shape)
+        # thickness stretch lambda3 per point (finite strain): committed and trial, and the one
+        # the layers' lever arm t lambda3 uses in this increment (that of the last commit)
+        self.stretch_n, self.stretch = np.ones(shape[:2]), np.ones(shape[:2])
+        self.lever, self._lever_before = np.ones(shape[:2]), np.ones(shape[:2])
         self.z = np.zeros((self.num_cells, el.nz))
         self.strain = np.zeros((self.num_cells, self.nqp, 6))
         self.resultants = np.zeros((self.num_cells, self.nqp, 6))
@@ -124,9 +132,10 @@ class SheetModel:
         k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.z,
                       self.strain)
         t1 = time.perf_counter()
-        nplastic, nfail, nguard = section_update(self.strain, self.material, self.thickness, self.plastic, self.zeta,
-                                         self.wz, self.ep_n, self.p_n, self.ep, self.p, self.resultants,
-                                         self.tangents, elastic_tangent)
+        nplastic, nfail, nguard = section_update(
+            self.strain, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
+            self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
+            elastic_tangent)
         t2 = time.perf_counter()
         k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.z, self.resultants,
                       self.tangents, tangent, self.forms.vectors, self.forms.matrices)
@@ -137,14 +146,42 @@ class SheetModel:
         """Accept the trial material state (an increment converged)."""
         self.ep_n[...] = self.ep
         self.p_n[...] = self.p
+        self.stretch_n[...] = self.stretch
+        self._lever_before[...] = self.lever
+        self.lever[...] = self.stretch  # the next increment's lever arm
+
+    def converged_lever(self) -> None:
+        """The lever arm with which the last converged increment was solved (it lags one
+        increment): evaluating the committed state with it reproduces that state's forces."""
+        self.lever[...] = self._lever_before
 
     # -- output fields ------------------------------------------------------------------------
     def cell_fields(self) -> dict[str, np.ndarray]:
-        """Per owned cell, averaged over its quadrature points: equivalent plastic strain
-        (max over the layers) and thickness strain of the mid-surface (mean over the layers)."""
+        """Per owned cell, averaged over its quadrature points, at the last evaluated state:
+        equivalent plastic strain (max over the layers), thickness strain of the section (mean
+        over the layers; ln(t/t0) with finite strains, the small-strain e33 without) and the
+        major and minor logarithmic strains of the mid-surface."""
         peq = self.p_n.max(axis=2).mean(axis=1)
-        e33 = _mean_thickness_strain(self.strain, self.ep_n, self.material, self.zeta, self.wz, self.thickness)
-        return {"equivalent_plastic_strain": peq, "thickness_strain": e33}
+        if self.finite:
+            e33 = np.log(self.stretch_n).mean(axis=1)
+        else:
+            e33 = _mean_thickness_strain(self.strain, self.ep_n, self.material, self.zeta, self.wz,
+                                         self.thickness)
+        major, minor = _surface_strains(self.strain)
+        return {"equivalent_plastic_strain": peq, "thickness_strain": e33,
+                "major_strain": major, "minor_strain": minor}
+
+
+    def volume_change(self) -> float:
+        """(V - V0) / V0 of the whole sheet at the last evaluated state: per cell its initial
+        area times the mean area stretch sqrt(det(I + 2E)) of the mid-surface times the thickness
+        stretch exp(thickness strain). With finite strains only elastic volume change remains."""
+        e = self.strain[:, :, :3]
+        J2 = np.sqrt(np.maximum((1 + 2 * e[..., 0]) * (1 + 2 * e[..., 1]) - e[..., 2] ** 2, 0.0)).mean(axis=1)
+        t = np.exp(self.cell_fields()["thickness_strain"])
+        comm = self.mesh.comm
+        V = comm.allreduce(float(np.sum(self.cell_area * J2 * t)), op=MPI.SUM)
+        return V / comm.allreduce(float(np.sum(self.cell_area)), op=MPI.SUM) - 1.0
 
 
 @numba.njit(cache=True)
@@ -161,3 +198,20 @@ def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
                 acc += wz[k] * hill79.thickness_strain(layer, ep[c, g, k], mat)
         e33[c] = acc / nqp
     return e33
+
+
+@numba.njit(cache=True)
+def _surface_strains(strain):
+    """Per cell: the principal values of the mid-surface Hencky strain 1/2 ln(I + 2E), of the
+    tensor averaged over the quadrature points (major >= minor)."""
+    ncells, nqp = strain.shape[0], strain.shape[1]
+    major, minor = np.zeros(ncells), np.zeros(ncells)
+    eps, P, W = np.zeros(3), np.zeros((3, 3)), np.zeros(16)
+    for c in range(ncells):
+        m = np.zeros(3)
+        for g in range(nqp):
+            if hencky.log_strain(strain[c, g, :3].copy(), eps, P, W):
+                m += eps / nqp
+        mean, rad = 0.5 * (m[0] + m[1]), np.sqrt(0.25 * (m[0] - m[1]) ** 2 + 0.25 * m[2] ** 2)
+        major[c], minor[c] = mean + rad, mean - rad
+    return major, minor

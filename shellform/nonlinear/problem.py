@@ -6,7 +6,9 @@
     p.value("w", x, y), p.reaction(side, "w")
 
 `prescribed` maps (side, component) to the value reached at load factor 1 (displacement
-control); those components are also held on the side. Studies, tests and `shellform run` build
+control); those components are also held on the side. The side "all" holds the component at
+every vertex, and a value may be a function of the initial (x, y) (a homogeneous deformation
+imposed everywhere: a material test on the structural model, free of structural instability). Studies, tests and `shellform run` build
 their problems here.
 """
 
@@ -45,10 +47,15 @@ class SheetProblem:
                                                  fixed=named_supports.sheet_fixed_components)
         qbar = fem.Function(V)
         pdofs = {}
+        xy = V.tabulate_dof_coordinates()
         for (side, comp), value in (prescribed or {}).items():
             sub = V.sub(comps.index(comp))
-            dofs = fem.locate_dofs_topological(sub, 1, rect.facet_tags.find(SIDE_TAG[side]))
-            qbar.x.array[dofs] = value
+            if side == "all":
+                dofs = (V.dofmap.index_map_bs * np.arange(xy.shape[0]) + comps.index(comp)).astype(np.int32)
+            else:
+                dofs = fem.locate_dofs_topological(sub, 1, rect.facet_tags.find(SIDE_TAG[side]))
+            at = xy[dofs // V.dofmap.index_map_bs]
+            qbar.x.array[dofs] = value(at[:, 0], at[:, 1]) if callable(value) else value
             pdofs[(side, comp)] = dofs
             bcs.append(fem.dirichletbc(np.float64(0), dofs, sub))
         tol = 1e-9 * max(lx, ly)
@@ -63,8 +70,11 @@ class SheetProblem:
         return value_at(self.driver.q, self.model.components, name, x, y, tol)
 
     def reaction(self, side: str, comp: str) -> float:
-        """Sum over the side of the internal force conjugate to a prescribed component."""
-        dofs = self.prescribed_dofs[(side, comp)]
+        """Sum over the side of the internal force conjugate to a held component."""
+        dofs = self.prescribed_dofs.get((side, comp))
+        if dofs is None:
+            sub = self.model.V.sub(self.model.components.index(comp))
+            dofs = fem.locate_dofs_topological(sub, 1, self.rect.facet_tags.find(SIDE_TAG[side]))
         owned = self.model.V.dofmap.index_map.size_local * self.model.V.dofmap.index_map_bs
         local = float(np.sum(self.driver.residual_full[dofs[dofs < owned]]))
         return self.model.mesh.comm.allreduce(local, op=MPI.SUM)
