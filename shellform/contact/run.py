@@ -12,7 +12,9 @@ Writes into the output folder (forces and draw-in for the whole blank):
                              closed holder, iterations, smallest line-search factor, contacts
     thickness_diagonal.csv   initial distance from the centre along x = y, thickness strain
     thickness_transverse.csv the same along the transverse centre line y = 0
-    cup.bp                   VTX time series (displacement, thickness strain) at the reports
+    cup.bp, cup_cells.bp     VTX time series at the reports: displacement and nodal thickness
+                             strain; per cell the equivalent plastic strain and the major and
+                             minor logarithmic surface strains
     cup.png                  the drawn cup coloured by thickness strain (serial runs)
     last_converged.*         only if the run stops: the last converged state
 
@@ -80,26 +82,37 @@ def _peak_thinning(p: DrawingProblem) -> dict:
 
 
 class _Series:
-    """VTX time series of the displacement and the nodal thickness strain."""
+    """VTX time series: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the
+    cells' equivalent plastic strain and major and minor (logarithmic) surface strains."""
+
+    CELL_FIELDS = ("equivalent_plastic_strain", "major_strain", "minor_strain")
 
     def __init__(self, p: DrawingProblem, path: Path):
         mesh = p.model.mesh
         self.p = p
         self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
         self.e33 = fem.Function(fem.functionspace(mesh, ("Lagrange", 1)), name="thickness_strain")
-        self.writer = io.VTXWriter(mesh.comm, path, [self.disp, self.e33], engine="BP4")
+        dg0 = fem.functionspace(mesh, ("DG", 0))
+        self.cells = [fem.Function(dg0, name=name) for name in self.CELL_FIELDS]
+        self.writers = [io.VTXWriter(mesh.comm, path, [self.disp, self.e33], engine="BP4"),
+                        io.VTXWriter(mesh.comm, path.with_name(path.stem + "_cells.bp"), self.cells, engine="BP4")]
 
     def write(self, stroke):
         d = self.p.driver
         n = d.n_owned
         self.disp.x.array.reshape(-1, 3)[:n] = d.q.x.array.reshape(-1, BS)[:n, :3]
         self.e33.x.array[:n] = self.p.nodal_values()[2]
-        for f in (self.disp, self.e33):
+        fields = self.p.model.cell_fields()
+        for f in self.cells:
+            f.x.array[: self.p.model.num_cells] = fields[f.name]
+        for f in (self.disp, self.e33, *self.cells):
             f.x.scatter_forward()
-        self.writer.write(stroke)
+        for w in self.writers:
+            w.write(stroke)
 
     def close(self):
-        self.writer.close()
+        for w in self.writers:
+            w.close()
 
 
 def _plot_force(path: Path, rows: list[dict], title: str) -> None:
