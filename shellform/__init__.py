@@ -2,8 +2,10 @@
 
 Data flow, one subpackage per stage:
 
-    scene (shellform.scene) -> mesh (shellform.mesh) -> forms (top-level ``forms``)
-      -> assembly (shellform.assembly: map, condense, assemble) -> solve -> results (shellform.output)
+    scene (shellform.scene) -> mesh (shellform.mesh) -> forms (shellform.forms, the folder forms/)
+      -> assembly (shellform.assembly: map, condense, assemble)
+      -> solve (shellform.linear; shellform.nonlinear: model, driver; shellform.contact)
+      -> results (shellform.results: log and progress, tables, fields, the cup's outputs)
 """
 
 from shellform import _env  # noqa: F401  (must run before dolfinx / petsc4py are imported)

@@ -20,7 +20,9 @@ from shellform.errors import InputError
 def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
     from mpi4py import MPI
 
-    from shellform import linear, output, scene
+    from shellform import linear, scene
+    from shellform.results import fields
+    from shellform.results.tables import write_json
 
     s = scene.load(path)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -41,10 +43,10 @@ def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
         "wall_time_s": time.perf_counter() - t0, **res.timings,
     }
     if s.output.vtx:
-        output.write_vtx(outdir, res.q, res.components, cells)
+        fields.write_vtx(outdir, res.q, res.components, cells)
     if s.output.png and "w" in res.components:
-        output.write_png(outdir / "deformed.png", res.q, res.components, title=s.title)
-    output.write_json(outdir / "summary.json", summary)
+        fields.write_png(outdir / "deformed.png", res.q, res.components, title=s.title)
+    write_json(outdir / "summary.json", summary)
     return summary
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from dolfinx import fem
 
-from shellform.material import Hill79Material, hencky, through_thickness_rule
+from shellform.material import hencky, through_thickness_rule
 from shellform.material.section import section_response
 from shellform.studies import strip
 

@@ -49,7 +49,7 @@ from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
 from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver, shorten
-from shellform.studies.common import say
+from shellform.results.log import say
 
 FREE = -1
 W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)

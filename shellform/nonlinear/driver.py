@@ -35,7 +35,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from shellform.errors import InputError
-from shellform.studies.common import say
+from shellform.results.log import Progress
 
 
 class ConvergenceFailure(RuntimeError):
@@ -106,6 +106,7 @@ class Driver:
         self.controls.check()
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
         self.verbose = verbose
+        self.progress = Progress()  # a run sets its own (label, total, unit)
         V = model.V
         self.q = fem.Function(V, name="carrier")
         self.prescribed = prescribed  # Function with qbar on the Dirichlet dofs (or None: zero)
@@ -311,8 +312,8 @@ class Driver:
                 cutbacks += 1
                 dlam *= c.cut
                 if self.verbose:
-                    say(f"  cut back: lambda {lam:.6g} failed after {its} iterations "
-                        f"(|R| {res[-1]:.3e}: {self._cause}); retry with dlambda {dlam:.3g}")
+                    self.progress.note(f"  cut back: lambda {lam:.6g} failed after {its} iterations "
+                                       f"(|R| {res[-1]:.3e}: {self._cause}); retry with dlambda {dlam:.3g}")
                 if dlam < c.min_step:
                     self._restore_converged()
                     path = self.save_checkpoint()
@@ -329,7 +330,9 @@ class Driver:
                             {"wall_s": time.perf_counter() - t0}, self._increment_info())
             self.history.append(inc)
             if self.verbose:
-                say(f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "
+                self.progress.increment(
+                    lam, inc.number, sum(h.iterations for h in self.history),
+                    f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "
                     f"|R| {res[0]:.2e} -> {res[-1]:.2e}  plastic layers {ev.plastic_layers}")
             if on_increment is not None:
                 on_increment(self)

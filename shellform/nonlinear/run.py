@@ -18,12 +18,13 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from shellform import output
 from shellform.nonlinear.driver import ConvergenceFailure, Controls
 from shellform.nonlinear.loads import EdgeMoment, PointForce, SheetLoads
 from shellform.nonlinear.problem import SheetProblem
 from shellform.scene import Scene
-from shellform.studies.common import say, write_csv
+from shellform.results import fields
+from shellform.results.log import Progress
+from shellform.results.tables import write_csv, write_json
 
 
 def problem(s: Scene, comm=MPI.COMM_WORLD, outdir=None) -> SheetProblem:
@@ -69,6 +70,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
     p = problem(s, comm, outdir)
     setup_s = time.perf_counter() - t0
     reports, stopped = [], None
+    p.driver.progress = Progress("load factor", max(abs(x) for x in s.process.path))
     targets = sorted(set(s.process.report))
     try:
         for target in s.process.path:
@@ -80,7 +82,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
                 reports.append(_record(p, s))
     except ConvergenceFailure as err:
         stopped = str(err)
-        say(f"shellform: stopped: {err}")
+        p.driver.progress.note(f"shellform: stopped: {err}")
+    p.driver.progress.close()
     d = p.driver
     summary = {
         "title": s.title, "effects": list(s.effects), "ranks": comm.size,
@@ -95,8 +98,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
              "plastic_layers": h.plastic_layers, "cutbacks": h.cutbacks} for h in d.history]
     write_csv(outdir / "increments.csv", rows, list(rows[0]) if rows else ["increment"])
     if s.output.vtx:
-        output.write_vtx(outdir, d.q, p.model.components, cell_functions(p))
+        fields.write_vtx(outdir, d.q, p.model.components, cell_functions(p))
     if s.output.png:
-        output.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
-    output.write_json(outdir / "summary.json", summary)
+        fields.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
+    write_json(outdir / "summary.json", summary)
     return summary

@@ -14,7 +14,8 @@ import dolfinx.fem.petsc as fem_petsc
 
 from shellform import linear
 from shellform.studies import plate, shell
-from shellform.studies.common import say, write_csv
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 COLUMNS = ["case", "cells", "dofs", "compile_s", "first_assembly_s", "reassembly_s", "us_per_cell", "solve_s"]
 

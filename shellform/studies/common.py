@@ -1,28 +1,11 @@
-"""Shared pieces of the studies: tables, observed rates, the error-against-time plot."""
+"""Shared pieces of the studies: observed rates and the error-against-time plot (tables and
+log lines are the results stage's: shellform.results)."""
 
-import csv
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
-
-
-def say(*args):
-    if MPI.COMM_WORLD.rank == 0:
-        print(*args, flush=True)
-        sys.stdout.flush()
-
-
-def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
-    if MPI.COMM_WORLD.rank != 0:
-        return
-    with open(path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
 
 
 def convergence_rates(errors, cells) -> tuple[np.ndarray, float]:

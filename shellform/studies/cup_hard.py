@@ -18,7 +18,8 @@ from pathlib import Path
 
 from shellform import scene
 from shellform.contact.run import run as run_cup
-from shellform.studies.common import say, write_csv
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 ROOT = Path(__file__).resolve().parents[2]
 COLUMNS = ["case", "n", "stroke_mm", "target_mm", "finished", "increments", "newton_iterations", "cutbacks",

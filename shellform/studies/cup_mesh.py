@@ -12,7 +12,8 @@ from the finest run (n = 24); and cup_mesh_error_time.png.
 
 from pathlib import Path
 
-from shellform.studies.common import say, write_csv
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 from shellform.studies.cup_hard import draw, folder, row, variant
 
 LEVELS = (12, 16, 24)

@@ -13,7 +13,8 @@ import csv
 import json
 from pathlib import Path
 
-from shellform.studies.common import say, write_csv
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 from shellform.studies.cup_hard import draw, folder, variant
 
 COLUMNS = ["case", "stroke_mm", "punch_force_kN", "DX", "DY", "DD", "max_thickness_strain",

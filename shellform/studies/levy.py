@@ -17,7 +17,9 @@ from shellform.material import Hill79Material
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.loads import SheetLoads
 from shellform.nonlinear.problem import SheetProblem
-from shellform.studies.common import plot_error_time, say, write_csv
+from shellform.studies.common import plot_error_time
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 NU = 0.316
 TABLE = {17.8: 0.237, 38.3: 0.471, 63.4: 0.695, 95.0: 0.912, 134.9: 1.121, 184.0: 1.323, 245.0: 1.521,

@@ -15,7 +15,8 @@ from mpi4py import MPI
 from shellform.material import Hill79Material
 from shellform.nonlinear.driver import Controls
 from shellform.studies import levy
-from shellform.studies.common import say, write_csv
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 LEVELS = (16, 36, 71)  # 512, 2592, 10082 cells
 QUICK_LEVELS = (16,)

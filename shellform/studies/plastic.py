@@ -20,7 +20,9 @@ from mpi4py import MPI
 from shellform.material import Hill79Material, section
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.problem import SheetProblem
-from shellform.studies.common import plot_error_time, say, write_csv
+from shellform.studies.common import plot_error_time
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 L, T, E, NU, SY = 1.0, 0.02, 1000.0, 0.3, 1.0
 COLUMNS = ["n", "thickness_points", "r", "m", "cells", "P_max_over_PL", "P_max_over_PL_discrete",

@@ -10,7 +10,9 @@ from pathlib import Path
 
 from shellform import linear
 from shellform.scene import Scene, from_dict
-from shellform.studies.common import observed_rates, plot_error_time, say, write_csv
+from shellform.studies.common import observed_rates, plot_error_time
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 REFERENCE = {"simply_supported": 0.00406235, "clamped": 0.00126532}
 NU = 0.3

@@ -17,7 +17,9 @@ from shellform.material import Hill79Material
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.loads import EdgeMoment, SheetLoads
 from shellform.nonlinear.problem import SheetProblem
-from shellform.studies.common import plot_error_time, say, write_csv
+from shellform.studies.common import plot_error_time
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 L, T, E = 1.0, 0.01, 1.0
 EI = E * T**3 / 12

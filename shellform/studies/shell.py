@@ -16,7 +16,9 @@ import numpy as np
 
 from shellform import linear
 from shellform.scene import Scene, from_dict
-from shellform.studies.common import observed_rates, plot_error_time, say, write_csv
+from shellform.studies.common import observed_rates, plot_error_time
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 A, T, NU, E = 1.0, 0.01, 0.3, 1.0
 D = E * T**3 / (12 * (1 - NU**2))

@@ -28,7 +28,8 @@ from mpi4py import MPI
 from shellform.material import Hill79Material, flow_stress
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.problem import SheetProblem
-from shellform.studies.common import say, write_csv
+from shellform.results.log import say
+from shellform.results.tables import write_csv
 
 LENGTH, WIDTH, T0 = 5.0, 1.0, 1.0  # the quarter strip
 SHEET = ("bending", "membrane", "geometric_nonlinearity", "plasticity", "anisotropy")

@@ -1,16 +1,14 @@
-"""Results on disk: VTX (ADIOS2) for ParaView, a PNG of the deformed shape, JSON summaries.
+"""Fields on disk: VTX (ADIOS2) for ParaView and a PNG of the deformed shape.
 
 The carrier holds physical nodal values, so output reads it directly: DOLFINx's interpolation
 and plotting know nothing of the slope map and are not used for the element's fields.
 """
 
-import json
 import os
 from pathlib import Path
 
 import numpy as np
 from dolfinx import fem, io, plot
-from mpi4py import MPI
 
 
 def nodal_fields(q, components) -> list[fem.Function]:
@@ -45,7 +43,7 @@ def write_vtx(outdir: Path, q, components, cell_fields: dict) -> list[Path]:
     return paths
 
 
-def _offscreen_backend() -> None:
+def offscreen_backend() -> None:
     """Render without a display: OSMesa where installed, else EGL, else VTK's own fallback."""
     import ctypes.util
 
@@ -61,7 +59,7 @@ def write_png(path: Path, q, components, title: str = "", scale: float | None = 
     """The deformed mid-surface coloured by w (rank 0 gathers nothing: serial runs only)."""
     if q.function_space.mesh.comm.size > 1:
         return None
-    _offscreen_backend()
+    offscreen_backend()
     import pyvista
 
     mesh = q.function_space.mesh
@@ -88,8 +86,3 @@ def write_png(path: Path, q, components, title: str = "", scale: float | None = 
     pl.screenshot(str(path))
     pl.close()
     return Path(path)
-
-
-def write_json(path: Path, data: dict) -> None:
-    if MPI.COMM_WORLD.rank == 0:
-        Path(path).write_text(json.dumps(data, indent=2, default=float) + "\n")

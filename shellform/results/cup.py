@@ -1,0 +1,139 @@
+"""The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX series, the
+force-stroke plot and the picture of the cup (used by shellform.contact.run).
+
+DX = draw-in of the blank edge at the middle of the side x = L/2 (initial x minus current x),
+DY the same on y = L/2, DD along the diagonal at the corner (initial minus current radius).
+"""
+
+from pathlib import Path
+
+import numpy as np
+from dolfinx import fem, io
+from mpi4py import MPI
+
+from shellform.assembly.sheet_element import BS
+from shellform.results.fields import offscreen_backend
+
+
+def _gather(comm, *arrays):
+    return [np.concatenate(comm.allgather(a)) for a in arrays]
+
+
+def draw_in(p) -> dict:
+    """DX, DY, DD (mm) at the blank's edge midpoints and corner (x, y >= 0 quadrant)."""
+    X, x, _ = p.nodal_values()
+    X, x = _gather(p.model.mesh.comm, X, x)
+    hx, hy = p.scene.geometry.lx / 2, p.scene.geometry.ly / 2
+
+    def at(px, py):
+        i = int(np.argmin(np.hypot(X[:, 0] - px, X[:, 1] - py)))
+        return x[i]
+
+    corner = at(hx, hy)
+    return {"DX": float(hx - at(hx, 0.0)[0]), "DY": float(hy - at(0.0, hy)[1]),
+            "DD": float(np.hypot(hx, hy) - np.hypot(corner[0], corner[1]))}
+
+
+def thickness_lines(p) -> tuple[list[dict], list[dict]]:
+    """Thickness strain at the nodes along the diagonal and along y = 0, by initial distance."""
+    X, _, e33 = p.nodal_values()
+    X, e33 = _gather(p.model.mesh.comm, X, e33)
+    tol = 1e-6 * p.scene.geometry.lx
+    lines = []
+    for on in (np.abs(X[:, 0] - X[:, 1]) < tol, np.abs(X[:, 1]) < tol):
+        r = np.hypot(X[on, 0], X[on, 1])
+        order = np.argsort(r)
+        lines.append([{"initial_position_mm": float(r[i]), "thickness_strain": float(e33[on][i])} for i in order])
+    return lines[0], lines[1]
+
+
+def peak_thinning(p) -> dict:
+    X, x, e33 = p.nodal_values()
+    X, x, e33 = _gather(p.model.mesh.comm, X, x, e33)
+    i = int(np.argmin(e33))
+    return {"max_thickness_strain": float(e33[i]), "where_initial_xy_mm": X[i].tolist(),
+            "where_current_xyz_mm": x[i].tolist(), "max_thickening_strain": float(e33.max())}
+
+
+class CupSeries:
+    """VTX time series: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the
+    cells' equivalent plastic strain and major and minor (logarithmic) surface strains."""
+
+    CELL_FIELDS = ("equivalent_plastic_strain", "major_strain", "minor_strain")
+
+    def __init__(self, p, path: Path):
+        mesh = p.model.mesh
+        self.p = p
+        self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
+        self.e33 = fem.Function(fem.functionspace(mesh, ("Lagrange", 1)), name="thickness_strain")
+        dg0 = fem.functionspace(mesh, ("DG", 0))
+        self.cells = [fem.Function(dg0, name=name) for name in self.CELL_FIELDS]
+        self.writers = [io.VTXWriter(mesh.comm, path, [self.disp, self.e33], engine="BP4"),
+                        io.VTXWriter(mesh.comm, path.with_name(path.stem + "_cells.bp"), self.cells, engine="BP4")]
+
+    def write(self, stroke):
+        d = self.p.driver
+        n = d.n_owned
+        self.disp.x.array.reshape(-1, 3)[:n] = d.q.x.array.reshape(-1, BS)[:n, :3]
+        self.e33.x.array[:n] = self.p.nodal_values()[2]
+        fields = self.p.model.cell_fields()
+        for f in self.cells:
+            f.x.array[: self.p.model.num_cells] = fields[f.name]
+        for f in (self.disp, self.e33, *self.cells):
+            f.x.scatter_forward()
+        for w in self.writers:
+            w.write(stroke)
+
+    def close(self):
+        for w in self.writers:
+            w.close()
+
+
+def plot_force(path: Path, rows: list[dict], title: str) -> None:
+    if MPI.COMM_WORLD.rank != 0 or not rows:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot([r["stroke_mm"] for r in rows], [r["punch_force_kN"] for r in rows], "-")
+    ax.set_xlabel("punch stroke (mm)")
+    ax.set_ylabel("punch force (kN)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def picture(path: Path, p, title: str) -> None:
+    """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
+    an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
+    strain; serial runs only."""
+    mesh = p.model.mesh
+    if mesh.comm.size > 1:
+        return
+    offscreen_backend()
+    import pyvista
+    from dolfinx import plot
+
+    topology, cell_types, x = plot.vtk_mesh(mesh)
+    d = p.driver
+    grid = pyvista.UnstructuredGrid(topology, cell_types, x + d.q.x.array.reshape(-1, BS)[: x.shape[0], :3])
+    e33 = np.zeros(x.shape[0])
+    e33[: d.n_owned] = p.nodal_values()[2]
+    grid.point_data["thickness strain"] = e33
+    if p.symmetry == 4:  # the quarter and its mirror images in x = 0, y = 0 and both
+        parts = [grid, grid.reflect((1, 0, 0), point=(0, 0, 0))]
+        parts += [g.reflect((0, 1, 0), point=(0, 0, 0)) for g in parts]
+        grid = parts[0].merge(parts[1:])
+    pl = pyvista.Plotter(off_screen=True, window_size=(1000, 800))
+    pl.add_mesh(grid, scalars="thickness strain", show_edges=True, cmap="coolwarm", edge_color="#555555",
+                line_width=0.5, scalar_bar_args={"title": "thickness strain"})
+    pl.add_text(title, font_size=10)
+    L = max(p.scene.geometry.lx, p.scene.geometry.ly)
+    pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
+    pl.screenshot(str(path))
+    pl.close()
