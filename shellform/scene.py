@@ -137,6 +137,7 @@ class ToolsSpec:
 class Output:
     vtx: bool = True
     png: bool = True
+    fld: bool = True  # tool scenes with plasticity: the forming-limit view (results/fld.py)
 
 
 @dataclass

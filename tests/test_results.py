@@ -29,3 +29,23 @@ def test_progress_in_a_log_keeps_the_plain_increment_lines():
     p.increment(0.5, 3, 12, "increment   3  lambda 0.5")
     p.note("  cut back: ...")
     assert log.getvalue() == "increment   3  lambda 0.5\n  cut back: ...\n"
+
+
+def test_keeler_brazier_curve():
+    """FLC0 = (23.3 + 14.13 t) n / 0.21 % (engineering); the left side keeps the thinning
+    -(eps1 + eps2) constant, the right side rises by 0.6 per engineering minor strain."""
+    import numpy as np
+    import pytest
+
+    from shellform.results import fld
+
+    t, n = 0.78, 0.2589
+    e0 = np.log(1 + (23.3 + 14.13 * t) * n / 0.21 / 100)
+    curve = fld.keeler_brazier(t, n)
+    assert fld.flc0(t, n) == pytest.approx(e0, rel=1e-14)
+    assert curve(0.0) == pytest.approx(e0, rel=1e-14)
+    for minor in (-0.3, -0.1, -0.01):
+        assert curve(minor) + minor == pytest.approx(e0, rel=1e-14)
+    for minor in (0.05, 0.2):
+        assert np.expm1(curve(minor)) - np.expm1(e0) == pytest.approx(0.6 * np.expm1(minor), rel=1e-12)
+    assert fld.margins(0.2, 0.0, curve) == pytest.approx(e0 - 0.2, rel=1e-14)

@@ -16,6 +16,9 @@ Writes into the output folder (forces and draw-in for the whole blank):
                              strain; per cell the equivalent plastic strain and the major and
                              minor logarithmic surface strains
     cup.png                  the drawn cup coloured by thickness strain (serial runs)
+    fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
+                             Keeler-Brazier forming-limit curve, each cell's margin to it;
+                             cup_margin.png the cup coloured by that margin (results/fld.py)
     last_converged.*         only if the run stops: the last converged state
 
 DX, DY, DD: shellform.results.cup.
@@ -83,13 +86,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
     cup.plot_force(outdir / "force_stroke.png", curve, s.title)
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
+    limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
     summary = {
         "title": s.title, "effects": list(s.effects), "ranks": comm.size,
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
         "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],
         **{k: v for k, v in reports[-1].items() if k not in ("stroke_mm", "draw_in_mm", "punch_force_kN")},
-        "reports": reports,
+        "reports": reports, **limits,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,

@@ -55,6 +55,34 @@ def peak_thinning(p) -> dict:
             "where_current_xyz_mm": x[i].tolist(), "max_thickening_strain": float(e33.max())}
 
 
+def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
+    """fld.csv (per cell: initial centre, major and minor true strains, margin), fld.png and
+    cup_margin.png (the cup coloured by the margin); returns the smallest margin and where."""
+    from shellform.results import fld
+    from shellform.results.tables import write_csv
+
+    mat = p.scene.material
+    t, n = mat.thickness, fld.hardening_exponent(mat)
+    curve = fld.keeler_brazier(t, n)
+    f = p.model.cell_fields()
+    margin = fld.margins(f["major_strain"], f["minor_strain"], curve)
+    centre = p.model.cell_coords.reshape(-1, 3, 3).mean(axis=1)[:, :2]
+    rows = [{"x0_mm": c[0], "y0_mm": c[1], "major": a, "minor": b, "margin": m}
+            for c, a, b, m in zip(centre, f["major_strain"], f["minor_strain"], margin)]
+    comm = p.model.mesh.comm
+    rows = [r for part in comm.allgather(rows) for r in part]
+    write_csv(outdir / "fld.csv", rows, ["x0_mm", "y0_mm", "major", "minor", "margin"])
+    label = f"Keeler-Brazier, t {t:g} mm, n {n:.3g}: FLC0 {fld.flc0(t, n):.3f}"
+    fld.plot(outdir / "fld.png", f["major_strain"], f["minor_strain"], curve,
+             f"{title}: stroke {p.stroke:.1f} mm", label)
+    if png:
+        picture(outdir / "cup_margin.png", p, f"{title}: margin to the forming-limit curve",
+                ("margin to the FLC", margin, (-0.1, 0.3), "RdYlGn"))
+    worst = min(rows, key=lambda r: r["margin"])
+    return {"forming_limit": label, "min_margin": float(worst["margin"]),
+            "min_margin_at_initial_xy_mm": [float(worst["x0_mm"]), float(worst["y0_mm"])]}
+
+
 class CupSeries:
     """VTX time series: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the
     cells' equivalent plastic strain and major and minor (logarithmic) surface strains."""
@@ -108,10 +136,10 @@ def plot_force(path: Path, rows: list[dict], title: str) -> None:
     plt.close(fig)
 
 
-def picture(path: Path, p, title: str) -> None:
+def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
     an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
-    strain; serial runs only."""
+    strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only."""
     mesh = p.model.mesh
     if mesh.comm.size > 1:
         return
@@ -125,13 +153,17 @@ def picture(path: Path, p, title: str) -> None:
     e33 = np.zeros(x.shape[0])
     e33[: d.n_owned] = p.nodal_values()[2]
     grid.point_data["thickness strain"] = e33
+    name, clim, cmap = "thickness strain", None, "coolwarm"
+    if cell_field is not None:
+        name, values, clim, cmap = cell_field
+        grid.cell_data[name] = values
     if p.symmetry == 4:  # the quarter and its mirror images in x = 0, y = 0 and both
         parts = [grid, grid.reflect((1, 0, 0), point=(0, 0, 0))]
         parts += [g.reflect((0, 1, 0), point=(0, 0, 0)) for g in parts]
         grid = parts[0].merge(parts[1:])
     pl = pyvista.Plotter(off_screen=True, window_size=(1000, 800))
-    pl.add_mesh(grid, scalars="thickness strain", show_edges=True, cmap="coolwarm", edge_color="#555555",
-                line_width=0.5, scalar_bar_args={"title": "thickness strain"})
+    pl.add_mesh(grid, scalars=name, show_edges=True, cmap=cmap, clim=clim, edge_color="#555555",
+                line_width=0.5, scalar_bar_args={"title": name})
     pl.add_text(title, font_size=10)
     L = max(p.scene.geometry.lx, p.scene.geometry.ly)
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
