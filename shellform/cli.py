@@ -6,7 +6,9 @@
                                             against time), strip (finite-strain plasticity against
                                             closed forms), assembly, newton (benchmarks), cup-hard
                                             (the square cup's hard cases), cup-mesh (its meshes),
-                                            cup-strain (before and after finite strains)
+                                            cup-strain (before and after finite strains),
+                                            cup-paper (the paper's Figs. 5 to 8), numisheet
+                                            (the NUMISHEET'93 cups to 40 mm)
 """
 
 import argparse
@@ -51,7 +53,7 @@ def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
 
 
 STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain"]
+           "cup-strain", "cup-paper", "numisheet"]
 
 
 def main(argv=None) -> int:
