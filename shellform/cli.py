@@ -1,7 +1,9 @@
 """The ``shellform`` command.
 
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
-                                            (--trace: a tool scene logs every contact iterate)
+                                            (--trace: a tool scene logs every contact iterate;
+                                            --resume: a tool scene continues from DIR's last
+                                            converged state)
     shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
                                             against time), strip (finite-strain plasticity against
                                             closed forms), assembly, newton (benchmarks), cup-hard
@@ -19,7 +21,7 @@ from pathlib import Path
 from shellform.errors import InputError
 
 
-def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
+def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = False) -> dict:
     from mpi4py import MPI
 
     from shellform import linear, scene
@@ -31,7 +33,9 @@ def run_scene(path: Path, outdir: Path, trace: bool = False) -> dict:
     if s.tools is not None:
         from shellform.contact import run as contact_run
 
-        return contact_run.run(s, outdir, trace=trace)
+        return contact_run.run(s, outdir, trace=trace, resume=resume)
+    if resume:
+        raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
     if s.nonlinear:
         from shellform.nonlinear import run as nonlinear_run
 
@@ -63,6 +67,8 @@ def main(argv=None) -> int:
     p_run = sub.add_parser("run", help="solve a scene file")
     p_run.add_argument("scene", type=Path)
     p_run.add_argument("--out", type=Path, required=True)
+    p_run.add_argument("--resume", action="store_true",
+                       help="a tool scene: continue from the last converged state in --out (longer stroke, other steps)")
     p_run.add_argument("--trace", action="store_true",
                        help="tool scenes: log every contact pass, Newton step and iterate (diagnosis)")
     p_study = sub.add_parser("study", help="run a convergence study")
@@ -75,7 +81,7 @@ def main(argv=None) -> int:
 
     try:
         if args.command == "run":
-            summary = run_scene(args.scene, args.out, trace=args.trace)
+            summary = run_scene(args.scene, args.out, trace=args.trace, resume=args.resume)
             if "draw_in_mm" in summary:
                 last = summary["draw_in_mm"][-1] if summary["draw_in_mm"] else {}
                 print(f"shellform: {summary['title']}: {summary['cells']} cells, stroke {summary['stroke_mm']:.2f} mm, "

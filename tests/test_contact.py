@@ -350,3 +350,50 @@ def test_bad_tool_scenes_name_the_field(bad):
     data[section][key] = value
     with pytest.raises(InputError, match=field.replace(".", r"\.")):
         scene.from_dict(data)
+
+
+def test_a_resumed_run_equals_an_uninterrupted_one(tmp_path, monkeypatch):
+    """A cup run killed right after its first report (only its checkpoint survives) and resumed
+    with --resume ends where the uninterrupted run ends: punch force, draw-in, thinning, every
+    report and the force-stroke curve to 1e-9. A checkpoint of another mesh is refused, naming
+    what differs."""
+    import csv
+
+    from shellform.contact import run as contact_run
+    from shellform.errors import InputError
+
+    s = _cup(n=6, stroke=1.0)
+    s.process.report = [0.5]
+    s.process.initial_step, s.process.max_step = 0.05, 0.1  # of the 1 mm stroke
+    s.output.vtx = s.output.png = s.output.fld = False
+    whole = contact_run.run(s, tmp_path / "whole")
+
+    class Killed(Exception):
+        pass
+
+    save = SemiInverseDriver.save_checkpoint
+
+    def save_and_die(self, *args, **kwargs):
+        save(self, *args, **kwargs)
+        raise Killed
+
+    monkeypatch.setattr(SemiInverseDriver, "save_checkpoint", save_and_die)
+    with pytest.raises(Killed):
+        contact_run.run(s, tmp_path / "pieces")
+    monkeypatch.undo()
+    pieces = contact_run.run(s, tmp_path / "pieces", resume=True)
+    assert pieces["resumed_from_stroke_mm"] == pytest.approx(0.5)
+    assert len(pieces["reports"]) == len(whole["reports"]) == 2
+    for a, b in zip(whole["reports"], pieces["reports"]):
+        assert b["punch_force_kN"] == pytest.approx(a["punch_force_kN"], rel=1e-9)
+        for k in ("DX", "DD"):
+            assert b["draw_in_mm"][k] == pytest.approx(a["draw_in_mm"][k], rel=1e-9, abs=1e-12)
+        assert b["max_thickness_strain"] == pytest.approx(a["max_thickness_strain"], rel=1e-9)
+    rows = [list(csv.DictReader(open(tmp_path / d / "force_stroke.csv"))) for d in ("whole", "pieces")]
+    assert len(rows[0]) == len(rows[1])
+    assert float(rows[1][-1]["punch_force_kN"]) == pytest.approx(float(rows[0][-1]["punch_force_kN"]), rel=1e-9)
+
+    other = _cup(n=4, stroke=1.0)
+    with pytest.raises(InputError) as err:
+        contact_run.run(other, tmp_path / "pieces", resume=True)
+    assert err.value.field == "resume" and "mesh.n" in str(err.value)

@@ -78,12 +78,12 @@ import json, shellform
 from mpi4py import MPI
 from shellform import scene
 from shellform.contact.problem import DrawingProblem
-from shellform.contact.run import draw_in, _peak_thinning
+from shellform.results.cup import draw_in, peak_thinning
 s = scene.load("demos/square_cup.toml")
 s.mesh.n = 8
 p = DrawingProblem.from_scene(s, verbose=False)
 p.driver.run(1.5 / s.tools.stroke)
-out = {"force": p.punch_force(), "DD": draw_in(p)["DD"], "e33": _peak_thinning(p)["max_thickness_strain"],
+out = {"force": p.punch_force(), "DD": draw_in(p)["DD"], "e33": peak_thinning(p)["max_thickness_strain"],
        "holder": p.holder_force(), "pinched": p.in_contact()["pinched"], "increments": len(p.driver.history)}
 if MPI.COMM_WORLD.rank == 0:
     print("RESULT " + json.dumps(out))
@@ -111,3 +111,60 @@ def test_short_cup_two_ranks_match_serial(tmp_path):
 def _write(path, text):
     path.write_text(text)
     return str(path)
+
+
+RESUME = """
+import json, sys, shellform
+from mpi4py import MPI
+from shellform import scene
+from shellform.contact import run as contact_run
+from shellform.contact.semi_inverse import SemiInverseDriver
+
+def cup():
+    s = scene.load("demos/square_cup.toml")
+    s.mesh.n, s.tools.stroke, s.process.report = 6, 1.0, [0.5]
+    s.process.initial_step, s.process.max_step = 0.05, 0.1
+    s.output.vtx = s.output.png = s.output.fld = False
+    return s
+
+class Killed(Exception):
+    pass
+
+save = SemiInverseDriver.save_checkpoint
+def save_and_die(self, *args, **kwargs):
+    save(self, *args, **kwargs)
+    raise Killed
+
+out = "OUT"
+SemiInverseDriver.save_checkpoint = save_and_die
+try:
+    contact_run.run(cup(), out)
+except Killed:
+    pass
+SemiInverseDriver.save_checkpoint = save
+r = contact_run.run(cup(), out, resume=True)["reports"][-1]
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps({"force": r["punch_force_kN"], "DD": r["draw_in_mm"]["DD"],
+                                  "e33": r["max_thickness_strain"]}))
+"""
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_resumed_cup_on_two_ranks_matches_serial(tmp_path):
+    """A cup killed after its first report on two ranks and resumed there ends where the serial
+    uninterrupted run ends, to the solver tolerance."""
+    from shellform import scene
+    from shellform.contact import run as contact_run
+
+    root = Path(__file__).resolve().parents[1]
+    source = RESUME.replace("demos/", f"{root}/demos/").replace("OUT", str(tmp_path / "pieces"))
+    parallel = on_two_ranks(tmp_path, source)
+    s = scene.load(root / "demos" / "square_cup.toml")
+    s.mesh.n, s.tools.stroke, s.process.report = 6, 1.0, [0.5]
+    s.process.initial_step, s.process.max_step = 0.05, 0.1
+    s.output.vtx = s.output.png = s.output.fld = False
+    r = contact_run.run(s, tmp_path / "whole")["reports"][-1]
+    assert parallel["force"] == pytest.approx(r["punch_force_kN"], rel=1e-6)
+    assert parallel["DD"] == pytest.approx(r["draw_in_mm"]["DD"], rel=1e-6, abs=1e-9)
+    assert parallel["e33"] == pytest.approx(r["max_thickness_strain"], rel=1e-6)

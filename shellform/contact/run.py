@@ -7,6 +7,7 @@ Writes into the output folder (forces and draw-in for the whole blank):
                              Newton iterations, contact passes; wall_time_s and its split;
                              over_the_stroke: the worst penetration, z-balance, holder share
                              and count of free nodes under the closed holder
+    reports.json             the reports so far (rewritten at each; a resumed run takes them over)
     force_stroke.csv, .png   per increment: punch force, holder force, height and largest nodal
                              share, the tools' z-balance, penetration, free nodes under the
                              closed holder, iterations, smallest line-search factor, contacts
@@ -19,17 +20,21 @@ Writes into the output folder (forces and draw-in for the whole blank):
     fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
                              Keeler-Brazier forming-limit curve, each cell's margin to it;
                              cup_margin.png the cup coloured by that margin (results/fld.py)
-    last_converged.*         only if the run stops: the last converged state
+    last_converged.*         the last converged state (at every report, at the end, at a stop):
+                             `shellform run SCENE --out DIR --resume` continues from it
 
 DX, DY, DD: shellform.results.cup.
 """
 
+import json
 import time
 from pathlib import Path
 
+import numpy as np
 from mpi4py import MPI
 
 from shellform.contact.problem import DrawingProblem
+from shellform.errors import InputError
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.results import cup
 from shellform.results.log import Progress
@@ -41,16 +46,62 @@ from shellform.scene import Scene
 CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
 
 
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
-    """Draw the scene's cup; trace: log every contact pass, Newton step and iterate."""
+def fingerprint(s: Scene, comm) -> dict:
+    """What a checkpoint must share with the scene that resumes it: the blank and its mesh, the
+    material, the effects that shape the state, the section, the tools' shapes and the ranks.
+    (Stroke, friction, holder force, steps and reports may change.)"""
+    tools = {k: v for k, v in vars(s.tools).items() if k not in ("stroke", "friction", "blank_holder_force")}
+    return {"geometry": vars(s.geometry), "mesh": vars(s.mesh), "material": vars(s.material),
+            "effects": sorted(e for e in s.effects if e != "friction"),
+            "thickness_points": s.process.thickness_points, "tools": tools, "ranks": comm.size}
+
+
+def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list]:
+    """Restore the last converged state in outdir; the force-stroke rows and reports up to it."""
+    import csv
+
+    path = outdir / f"last_converged.rank{comm.rank}.npz"
+    if not path.exists():
+        raise InputError("resume", f"no checkpoint {path}: run the scene into {outdir} first")
+    data = np.load(path)
+    saved = json.loads(str(data["fingerprint"]))
+    now = json.loads(json.dumps(fingerprint(s, comm), default=str))
+    differ = []
+    for k, v in now.items():
+        if isinstance(v, dict):
+            differ += [f"{k}.{f}" for f in v if saved.get(k, {}).get(f) != v[f]]
+        elif saved.get(k) != v:
+            differ.append(k)
+    if differ:
+        raise InputError("resume", f"the checkpoint {path} was written for another scene or mesh: "
+                                   f"{', '.join(differ)} differ")
+    p.driver.restore_state(data)
+    upto = p.stroke + 1e-9
+    curve, reports = [], []
+    if (outdir / "force_stroke.csv").exists():
+        with open(outdir / "force_stroke.csv") as f:
+            curve = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f) if float(r["stroke_mm"]) <= upto]
+    if (outdir / "reports.json").exists():
+        reports = [r for r in json.loads((outdir / "reports.json").read_text()) if r["stroke_mm"] <= upto]
+    return curve, reports
+
+
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) -> dict:
+    """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
+    continue from the last converged state in outdir (written at every report, at the end and
+    at a stop), with this scene's stroke, steps, friction and holder force."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
+    p.driver.fingerprint = json.dumps(fingerprint(s, comm), default=str)
+    curve, reports, stopped, resumed = [], [], None, None
+    if resume:
+        curve, reports = _resume(p, s, outdir, comm)
+        resumed = p.stroke
     setup_s = time.perf_counter() - t0
     series = cup.CupSeries(p, outdir / "cup.bp") if s.output.vtx else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
-    curve, reports, stopped = [], [], None
 
     def on_increment(d):
         h = d.history[-1]
@@ -64,13 +115,18 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
     def report():
         reports.append({"stroke_mm": p.stroke, "draw_in_mm": cup.draw_in(p), "punch_force_kN": p.punch_force() / 1e3,
                         **cup.peak_thinning(p), "volume_change": p.model.volume_change()})
+        write_json(outdir / "reports.json", reports)  # what a resumed run takes over
+        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
         if series is not None:
             series.write(p.stroke)
 
     try:
         for target in sorted(set(s.process.report) | {1.0}):
+            if target <= p.driver.lam + 1e-12:
+                continue  # reached before the resumed state
             p.driver.run(target, on_increment=on_increment)
             report()
+            p.driver.save_checkpoint()
     except ConvergenceFailure as err:
         stopped = str(err)
         p.driver.progress.note(f"shellform: stopped: {err}")
@@ -96,7 +152,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False) -> dict:
         "reports": reports, **limits,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
-        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,
+        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "resumed_from_stroke_mm": resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
     }

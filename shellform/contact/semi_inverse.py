@@ -46,6 +46,7 @@ from dolfinx import fem, la
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS, COMPONENTS
+from shellform.errors import InputError
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
 from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver, shorten
@@ -565,6 +566,36 @@ class SemiInverseDriver(Driver):
         if self.model.plastic:
             _, e33 = self._nodal_areas_and_thickness_strain()
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
+
+    # -- checkpoints -------------------------------------------------------------------------
+    STATE = ("tool", "pressure", "holder_face", "normal", "friction", "closed")
+
+    def checkpoint_state(self) -> dict:
+        """The sheet's state and the contact's: the committed contact set, forces and friction
+        history, the holder's state, the pinched nodes, positions and thicknesses of the last
+        converged increment."""
+        c = self.committed
+        return {**super().checkpoint_state(), **{f"contact_{k}": getattr(c, k) for k in self.STATE},
+                "contact_pinched": self.pinched, "contact_x_n": self.x_n, "contact_lam_n": self.lam_n,
+                "contact_half_thickness": self.half_thickness, "contact_travel": self.travel}
+
+    def restore_state(self, data, lam_scale: float | None = None) -> None:
+        """As Driver's; the load factor is rescaled to this run's tool travel (a longer or
+        shorter stroke continues from the same punch position)."""
+        if lam_scale is None:
+            lam_scale = float(data["contact_travel"][0] / self.travel[0])
+        super().restore_state(data, lam_scale)
+        if data["contact_tool"].shape != self.state.tool.shape:
+            raise InputError("resume", "the checkpoint's contact state does not fit this model")
+        c = ContactState(self.n_owned)
+        for k in self.STATE:
+            getattr(c, k)[...] = data[f"contact_{k}"]
+        self.committed, self.state = c, c.copy()
+        self.pinched = data["contact_pinched"].copy()
+        self.x_n = data["contact_x_n"].copy()
+        self.lam_n = float(data["contact_lam_n"]) * lam_scale
+        self.half_thickness = data["contact_half_thickness"].copy()
+        self._previous = None
 
     def _restore_converged(self):
         """The committed contact state and its forces (a stop reports the last converged state)."""
