@@ -114,6 +114,7 @@ class Process:
     rtol: float = 1e-9  # residual tolerance (> 0)
     path: list[float] = field(default_factory=lambda: [1.0])  # load factors to step through, in order
     report: list[float] = field(default_factory=list)  # load factors at which results are recorded
+    springback: bool = False  # tool scenes: after the stroke the tools withdraw (contact/springback.py)
 
 
 @dataclass

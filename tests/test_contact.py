@@ -397,3 +397,42 @@ def test_a_resumed_run_equals_an_uninterrupted_one(tmp_path, monkeypatch):
     with pytest.raises(InputError) as err:
         contact_run.run(other, tmp_path / "pieces", resume=True)
     assert err.value.field == "resume" and "mesh.n" in str(err.value)
+
+
+def test_an_elastic_sheet_springs_back_flat():
+    """An elastic sheet (no friction: nothing dissipates) pressed 1 mm by the punch and released
+    (contact/springback.py) returns to its flat blank: u, v and the slopes to 1e-8 mm, w to a
+    rigid lift of the held centre to 1e-8 mm."""
+    from shellform.contact import springback
+
+    s = _cup(n=6, stroke=1.0)
+    s.effects = ("bending", "membrane", "geometric_nonlinearity", "contact")
+    s.material.hardening, s.material.r = "none", 1.0
+    s.process.initial_step, s.process.max_step = 0.1, 0.25
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(1.0)
+    drawn = p.driver.q.x.array.reshape(-1, 9)
+    assert np.abs(drawn[:, 2]).max() > 0.5  # pressed well into the die opening
+    sb = springback.release(p.driver)
+    q = sb.q.x.array.reshape(-1, 9)
+    centre = q[np.argmin(np.hypot(*p.driver.X[:, :2].T)), 2]
+    assert np.abs(q[:, [0, 1, 3, 4, 5, 6, 7, 8]]).max() < 1e-8
+    assert np.abs(q[:, 2] - centre).max() < 1e-8
+    assert sum(h.plastic_layers for h in sb.history) == 0
+
+
+def test_drawn_cup_springback_outputs(tmp_path):
+    """A plastic cup drawn 3 mm and released: the run reports the flange's and the wall's change,
+    the residual resultants and the unloading's plastic layers, and writes the profiles."""
+    from shellform.contact import run as contact_run
+
+    s = _cup(n=6, stroke=3.0)
+    s.process.initial_step, s.process.max_step = 0.02, 0.05
+    s.process.springback = True
+    s.output.vtx = s.output.png = s.output.fld = False
+    summary = contact_run.run(s, tmp_path)
+    sb = summary["springback"]
+    assert abs(sb["flange_edge_dz_mm"]["diagonal"]) > 1e-3  # it springs
+    assert sb["residual_max_N_per_mm"] > 1.0 and sb["residual_max_M_N"] > 0.1  # residual stresses
+    assert sb["unloading_increments"] >= 1 and sb["plastic_layers_on_unloading"] >= 0
+    assert (tmp_path / "springback.csv").exists() and (tmp_path / "springback.png").exists()

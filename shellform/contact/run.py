@@ -20,6 +20,9 @@ Writes into the output folder (forces and draw-in for the whole blank):
     fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
                              Keeler-Brazier forming-limit curve, each cell's margin to it;
                              cup_margin.png the cup coloured by that margin (results/fld.py)
+    springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
+                             after the tools withdraw (contact/springback.py); summary.json:
+                             wall angle, flange edge, re-yield, residual resultants
     last_converged.*         the last converged state (at every report, at the end, at a stop):
                              `shellform run SCENE --out DIR --resume` continues from it
 
@@ -143,13 +146,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
     limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
+    sprung = cup.springback(outdir, p, s.title) if s.process.springback and stopped is None else None
     summary = {
         "title": s.title, "effects": list(s.effects), "ranks": comm.size,
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
         "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],
         **{k: v for k, v in reports[-1].items() if k not in ("stroke_mm", "draw_in_mm", "punch_force_kN")},
-        "reports": reports, **limits,
+        "reports": reports, **limits, "springback": sprung,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "resumed_from_stroke_mm": resumed,

@@ -169,3 +169,56 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
     pl.screenshot(str(path))
     pl.close()
+
+
+def springback(outdir: Path, p, title: str) -> dict:
+    """Release the tools' forces (shellform.contact.springback) and report what changed: wall
+    angle and flange edge along the transverse line, the diagonal's corner, the unloading's
+    plastic layers, the residual resultants; springback.csv and springback.png (profiles)."""
+    from shellform.contact import springback as sb
+    from shellform.results.tables import write_csv
+
+    d = p.driver
+    lines = {"transverse": False, "diagonal": True}
+    before = {k: sb.profile(d, d.X, diagonal=v) for k, v in lines.items()}
+    released = sb.release(d)
+    after = {k: sb.profile(released, d.X, diagonal=v) for k, v in lines.items()}
+    depth = float(-before["transverse"][:, 2].min())
+    rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
+             "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]
+    write_csv(outdir / "springback.csv", rows, list(rows[0]))
+    m = p.model
+    N, M = m.resultants[..., :3], m.resultants[..., 3:]
+    comm = m.mesh.comm
+    edge = {k: (before[k][-1], after[k][-1]) for k in lines}
+    out = {
+        "wall_angle_deg": {"before": sb.wall_angle(before["transverse"], depth),
+                           "after": sb.wall_angle(after["transverse"], depth)},
+        "flange_edge_dz_mm": {k: float(a[2] - b[2]) for k, (b, a) in edge.items()},
+        "flange_edge_dr_mm": {k: float(a[1] - b[1]) for k, (b, a) in edge.items()},
+        "unloading_increments": len(released.history),
+        "plastic_layers_on_unloading": int(sum(h.plastic_layers for h in released.history)),
+        "residual_max_N_per_mm": comm.allreduce(float(np.abs(N[..., :2]).max(initial=0.0)), op=MPI.MAX),
+        "residual_max_M_N": comm.allreduce(float(np.abs(M[..., :2]).max(initial=0.0)), op=MPI.MAX),
+    }
+    if comm.rank == 0:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+        for ax, k in zip(axes, lines):
+            ax.plot(before[k][:, 1], before[k][:, 2], "k-", label="drawn (tools in place)")
+            ax.plot(after[k][:, 1], after[k][:, 2], "r--", label="sprung back")
+            ax.set_xlabel("distance from the centre (mm)")
+            ax.set_ylabel("z (mm)")
+            ax.set_aspect("equal")
+            ax.set_title(f"{k} line", fontsize=9)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+        fig.suptitle(f"{title}: springback", fontsize=10)
+        fig.tight_layout()
+        fig.savefig(outdir / "springback.png", dpi=120)
+        plt.close(fig)
+    return out

@@ -1,0 +1,92 @@
+"""Springback: the tools withdraw and the drawn sheet springs back.
+
+At the end of the stroke the sheet is in equilibrium with the tools' forces on it: contact,
+friction and the holder's squeeze, together f = f_int(q) (the internal force of the drawn
+state on every node that symmetry does not hold). Withdrawing the tools releases f. A plain
+Newton driver without tools carries the sheet from f applied (load factor 1, equilibrium by
+construction) to f = 0, the material unloading from its drawn state (the first iteration with
+the elastic tangent, as after any load reversal). The quarter's symmetry planes hold it in x,
+y and the rotations; the bottom's centre node keeps its height (w held), which removes the one
+rigid motion left. The tools do not come back: a part that would touch them again as it springs
+is outside this model.
+"""
+
+import numpy as np
+from mpi4py import MPI
+
+from shellform.assembly.sheet_element import BS, COMPONENTS
+from shellform.nonlinear.driver import Controls, Driver
+
+W = COMPONENTS.index("w")
+
+
+class ReleasedForces:
+    """The tools' forces f on the owned dofs as a nodal load of the driver: R -= lam f."""
+
+    def __init__(self, f: np.ndarray, comm):
+        self.f = f
+        self.magnitude = float(np.sqrt(comm.allreduce(float(f @ f), op=MPI.SUM)))
+
+    def add(self, lam, q, R, A):
+        R[:] -= lam * self.f[: R.size]
+
+
+class SpringbackDriver(Driver):
+    """Newton from the drawn state (load factor 1) to the released one (0); the held dofs keep
+    the values they have (symmetry: 0; the centre's w: its drawn height)."""
+
+    def _set_dirichlet(self, lam, dofs=None):
+        d = self.bc_dofs if dofs is None else dofs
+        self.g[d] = self.held[d]
+        jump = np.abs(self.g[d] - self.q.x.array[d]).max() if d.size else 0.0
+        return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
+
+
+def release(contact_driver, controls: Controls | None = None, verbose=False) -> SpringbackDriver:
+    """Spring the drawn sheet of `contact_driver` back; returns the springback driver, whose
+    history counts the plastic layers of every unloading increment."""
+    from dolfinx import fem
+
+    cd = contact_driver
+    model, V = cd.model, cd.model.V
+    n_owned = cd.n_owned
+    X = cd.X
+    centre = np.flatnonzero(np.hypot(X[:n_owned, 0], X[:n_owned, 1]) < 1e-9 * max(np.abs(X[:, :2]).max(), 1.0))
+    held = fem.dirichletbc(np.float64(0), (BS * centre + W).astype(np.int32), V.sub(W))
+    sb = SpringbackDriver(model, list(cd.symmetry_bcs) + [held], controls=controls or Controls(
+        initial_step=0.25, max_step=0.5, min_step=1e-3), verbose=verbose)
+    sb.q.x.array[:] = cd.q.x.array
+    sb.held = sb.q.x.array.copy()
+    sb.held[cd.support_dofs] = 0.0  # symmetry planes
+    sb.lam, sb._direction = 1.0, 1.0  # run(0) is a load reversal: elastic first tangent
+    sb.residual(0.0, tangent=False)
+    f = sb.residual_full[: V.dofmap.index_map.size_local * BS].copy()  # f_int(q): the tools' forces
+    f[sb.bc_dofs[sb.bc_dofs < f.size]] = 0.0
+    sb.nodal = ReleasedForces(f, model.mesh.comm)
+    sb.run(0.0)
+    return sb
+
+
+def profile(driver, X, y0: float = 0.0, diagonal=False):
+    """(initial distance, x or r, z) of the owned nodes on the line y = 0 (or x = y), by initial
+    distance from the centre, gathered on every rank."""
+    n = driver.model.V.dofmap.index_map.size_local
+    x = X[:n] + driver.q.x.array.reshape(-1, BS)[:n, :3]
+    tol = 1e-6 * max(np.abs(X[:, :2]).max(), 1.0)
+    on = np.abs(X[:n, 0] - X[:n, 1]) < tol if diagonal else np.abs(X[:n, 1] - y0) < tol
+    r0 = np.hypot(X[:n, 0], X[:n, 1])[on]
+    r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
+    rows = np.column_stack([r0, r, x[on, 2]])
+    rows = np.concatenate(driver.model.mesh.comm.allgather(rows))
+    return rows[np.argsort(rows[:, 0])]
+
+
+def wall_angle(rows, depth: float) -> float:
+    """The wall's angle from the horizontal (degrees, 90: vertical): a line x(z) fitted to the
+    profile's points between 30 % and 70 % of the depth."""
+    z = rows[:, 2]
+    wall = (z < -0.3 * depth) & (z > -0.7 * depth)
+    if wall.sum() < 2:
+        return float("nan")
+    dxdz = np.polyfit(rows[wall, 2], rows[wall, 1], 1)[0]
+    return float(90.0 - np.degrees(np.arctan(abs(dxdz))))
