@@ -178,10 +178,15 @@ def springback(outdir: Path, p, title: str) -> dict:
     from shellform.contact import springback as sb
     from shellform.results.tables import write_csv
 
+    from shellform.nonlinear.driver import ConvergenceFailure
+
     d = p.driver
     lines = {"transverse": False, "diagonal": True}
     before = {k: sb.profile(d, d.X, diagonal=v) for k, v in lines.items()}
-    released = sb.release(d)
+    try:
+        released = sb.release(d)
+    except ConvergenceFailure as err:  # the drawn state is kept and reported; springback is not
+        return {"stopped": str(err)}
     after = {k: sb.profile(released, d.X, diagonal=v) for k, v in lines.items()}
     depth = float(-before["transverse"][:, 2].min())
     rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
@@ -192,6 +197,7 @@ def springback(outdir: Path, p, title: str) -> dict:
     comm = m.mesh.comm
     edge = {k: (before[k][-1], after[k][-1]) for k in lines}
     out = {
+        "stopped": None,
         "wall_angle_deg": {"before": sb.wall_angle(before["transverse"], depth),
                            "after": sb.wall_angle(after["transverse"], depth)},
         "flange_edge_dz_mm": {k: float(a[2] - b[2]) for k, (b, a) in edge.items()},
