@@ -352,35 +352,21 @@ def test_bad_tool_scenes_name_the_field(bad):
         scene.from_dict(data)
 
 
-def test_a_resumed_run_equals_an_uninterrupted_one(tmp_path, monkeypatch):
+def test_a_resumed_run_equals_an_uninterrupted_one(tmp_path):
     """A cup run killed right after its first report (only its checkpoint survives) and resumed
     with --resume ends where the uninterrupted run ends: punch force, draw-in, thinning, every
     report and the force-stroke curve to 1e-9. A checkpoint of another mesh is refused, naming
     what differs."""
     import csv
 
+    from resume_cup import cup, killed_after_first_report
+
     from shellform.contact import run as contact_run
     from shellform.errors import InputError
 
-    s = _cup(n=6, stroke=1.0)
-    s.process.report = [0.5]
-    s.process.initial_step, s.process.max_step = 0.05, 0.1  # of the 1 mm stroke
-    s.output.vtx = s.output.png = s.output.fld = False
+    s = cup()
     whole = contact_run.run(s, tmp_path / "whole")
-
-    class Killed(Exception):
-        pass
-
-    save = SemiInverseDriver.save_checkpoint
-
-    def save_and_die(self, *args, **kwargs):
-        save(self, *args, **kwargs)
-        raise Killed
-
-    monkeypatch.setattr(SemiInverseDriver, "save_checkpoint", save_and_die)
-    with pytest.raises(Killed):
-        contact_run.run(s, tmp_path / "pieces")
-    monkeypatch.undo()
+    killed_after_first_report(tmp_path / "pieces")
     pieces = contact_run.run(s, tmp_path / "pieces", resume=True)
     assert pieces["resumed_from_stroke_mm"] == pytest.approx(0.5)
     assert len(pieces["reports"]) == len(whole["reports"]) == 2

@@ -114,35 +114,15 @@ def _write(path, text):
 
 
 RESUME = """
-import json, sys, shellform
+import json, sys
+sys.path.insert(0, "TESTS")
+import shellform
 from mpi4py import MPI
-from shellform import scene
+from resume_cup import cup, killed_after_first_report
 from shellform.contact import run as contact_run
-from shellform.contact.semi_inverse import SemiInverseDriver
 
-def cup():
-    s = scene.load("demos/square_cup.toml")
-    s.mesh.n, s.tools.stroke, s.process.report = 6, 1.0, [0.5]
-    s.process.initial_step, s.process.max_step = 0.05, 0.1
-    s.output.vtx = s.output.png = s.output.fld = False
-    return s
-
-class Killed(Exception):
-    pass
-
-save = SemiInverseDriver.save_checkpoint
-def save_and_die(self, *args, **kwargs):
-    save(self, *args, **kwargs)
-    raise Killed
-
-out = "OUT"
-SemiInverseDriver.save_checkpoint = save_and_die
-try:
-    contact_run.run(cup(), out)
-except Killed:
-    pass
-SemiInverseDriver.save_checkpoint = save
-r = contact_run.run(cup(), out, resume=True)["reports"][-1]
+killed_after_first_report("OUT")
+r = contact_run.run(cup(), "OUT", resume=True)["reports"][-1]
 if MPI.COMM_WORLD.rank == 0:
     print("RESULT " + json.dumps({"force": r["punch_force_kN"], "DD": r["draw_in_mm"]["DD"],
                                   "e33": r["max_thickness_strain"]}))
@@ -154,17 +134,13 @@ if MPI.COMM_WORLD.rank == 0:
 def test_resumed_cup_on_two_ranks_matches_serial(tmp_path):
     """A cup killed after its first report on two ranks and resumed there ends where the serial
     uninterrupted run ends, to the solver tolerance."""
-    from shellform import scene
+    from resume_cup import cup
+
     from shellform.contact import run as contact_run
 
-    root = Path(__file__).resolve().parents[1]
-    source = RESUME.replace("demos/", f"{root}/demos/").replace("OUT", str(tmp_path / "pieces"))
+    source = RESUME.replace("TESTS", str(Path(__file__).parent)).replace("OUT", str(tmp_path / "pieces"))
     parallel = on_two_ranks(tmp_path, source)
-    s = scene.load(root / "demos" / "square_cup.toml")
-    s.mesh.n, s.tools.stroke, s.process.report = 6, 1.0, [0.5]
-    s.process.initial_step, s.process.max_step = 0.05, 0.1
-    s.output.vtx = s.output.png = s.output.fld = False
-    r = contact_run.run(s, tmp_path / "whole")["reports"][-1]
+    r = contact_run.run(cup(), tmp_path / "whole")["reports"][-1]
     assert parallel["force"] == pytest.approx(r["punch_force_kN"], rel=1e-6)
     assert parallel["DD"] == pytest.approx(r["draw_in_mm"]["DD"], rel=1e-6, abs=1e-9)
     assert parallel["e33"] == pytest.approx(r["max_thickness_strain"], rel=1e-6)

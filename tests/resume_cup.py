@@ -1,0 +1,40 @@
+"""The short cup of the resume tests and a run of it killed right after its first report
+(only the checkpoint survives), shared by test_contact.py and test_mpi.py's two-rank script."""
+
+from pathlib import Path
+
+from shellform import scene
+from shellform.contact import run as contact_run
+from shellform.contact.semi_inverse import SemiInverseDriver
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def cup():
+    """The paper's cup on 6 x 6, 1 mm of stroke in steps of 0.05 to 0.1 mm, a report at 0.5 mm."""
+    s = scene.load(ROOT / "demos" / "square_cup.toml")
+    s.mesh.n, s.tools.stroke, s.process.report = 6, 1.0, [0.5]
+    s.process.initial_step, s.process.max_step = 0.05, 0.1
+    s.output.vtx = s.output.png = s.output.fld = False
+    return s
+
+
+class Killed(Exception):
+    pass
+
+
+def killed_after_first_report(outdir) -> None:
+    """Run cup() into outdir and die as the first checkpoint is written."""
+    save = SemiInverseDriver.save_checkpoint
+
+    def save_and_die(self, *args, **kwargs):
+        save(self, *args, **kwargs)
+        raise Killed
+
+    SemiInverseDriver.save_checkpoint = save_and_die
+    try:
+        contact_run.run(cup(), outdir)
+    except Killed:
+        pass
+    finally:
+        SemiInverseDriver.save_checkpoint = save
