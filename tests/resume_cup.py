@@ -15,7 +15,7 @@ def cup():
     s = scene.load(ROOT / "demos" / "square_cup.toml")
     s.mesh.n, s.tools.stroke, s.process.report = 6, 1.0, [0.5]
     s.process.initial_step, s.process.max_step = 0.05, 0.1
-    s.output.vtx = s.output.png = s.output.fld = False
+    s.output.vtx = s.output.png = s.output.fld = s.process.springback = False
     return s
 
 

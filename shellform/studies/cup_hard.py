@@ -27,13 +27,15 @@ COLUMNS = ["case", "n", "stroke_mm", "target_mm", "finished", "increments", "new
 
 
 def variant(n: int, name: str = "square_cup.toml", **changes) -> scene.Scene:
-    """A demo scene on an n x n quarter mesh with changes section__key=value (no VTX output)."""
+    """A demo scene on an n x n quarter mesh with changes section__key=value (no VTX output, no
+    springback: the studies compare the drawn state)."""
     s = scene.load(ROOT / "demos" / name)
     s.mesh.n = n
     for key, value in changes.items():
         section, field = key.split("__")
         setattr(getattr(s, section), field, value)
     s.output.vtx = False
+    s.process.springback = False
     return s
 
 
