@@ -422,3 +422,41 @@ def test_drawn_cup_springback_outputs(tmp_path):
     assert sb["residual_max_N_per_mm"] > 1.0 and sb["residual_max_M_N"] > 0.1  # residual stresses
     assert sb["unloading_increments"] >= 1 and sb["plastic_layers_on_unloading"] >= 0
     assert (tmp_path / "springback.csv").exists() and (tmp_path / "springback.png").exists()
+
+
+@pytest.mark.parametrize("name", ["numisheet93_aluminium.toml", "numisheet93_steel.toml"])
+def test_numisheet_scenes_draw_their_first_millimetres(name):
+    """The NUMISHEET'93 scenes (the numisheet study's, on 6 x 6) draw 2 mm: the holder's forces
+    sum to F, the tools balance, no free node under the closed holder, penetration within 1 % of
+    t, and the punch force grows."""
+    s = scene.load(ROOT / "demos" / name)
+    s.mesh.n = 6
+    p = DrawingProblem.from_scene(s, verbose=False)
+    forces = []
+
+    def check(d):
+        assert abs(p.holder_force() - s.tools.blank_holder_force) <= 1e-9 * s.tools.blank_holder_force
+        assert p.force_balance() <= 1e-6 and p.free_under_holder() == 0
+        assert p.max_penetration() <= 0.01 * s.material.thickness
+        forces.append(p.punch_force())
+
+    p.driver.run(2.0 / s.tools.stroke, on_increment=check)
+    assert p.stroke == pytest.approx(2.0)
+    assert forces[-1] > forces[0] > 0
+
+
+def test_friction_raises_the_punch_force():
+    """The trend of Fig. 7's runs (cup-paper), short: with friction 0.2 the cup needs more punch
+    force at 3 mm than without friction, and draws in less."""
+    out = {}
+    for mu in (0.0, 0.2):
+        s = _cup(n=6, friction=mu)
+        if mu == 0.0:
+            s.effects = tuple(e for e in s.effects if e != "friction")
+        s.process.initial_step, s.process.max_step = 0.02, 0.05
+        p = DrawingProblem.from_scene(s, verbose=False)
+        p.driver.run(3.0 / s.tools.stroke)
+        X, x, _ = p.nodal_values()
+        out[mu] = (p.punch_force(), np.abs(x[:, :2] - X).max())
+    assert out[0.2][0] > 1.05 * out[0.0][0]
+    assert out[0.2][1] < out[0.0][1]
