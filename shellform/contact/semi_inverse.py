@@ -186,7 +186,7 @@ class SemiInverseDriver(Driver):
         x = m.cell_coords.reshape(-1, 3, 3)
         a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
         cell_area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-        e33 = m.cell_fields()["thickness_strain"] if m.plastic else np.zeros(m.num_cells)
+        e33 = m.thickness_strain() if m.plastic else np.zeros(m.num_cells)
         f = fem.Function(m.V)
         arr = f.x.array.reshape(-1, BS)
         for col, values in ((0, cell_area / 3), (1, cell_area / 3 * e33)):

@@ -344,36 +344,30 @@ class Driver:
     # -- disk ----------------------------------------------------------------------------------
     def checkpoint_state(self) -> dict:
         """Everything the next increment starts from: load factor, carrier, material state."""
-        m = self.model
-        return {"lam": self.lam, "q": self.q.x.array, "ep": m.ep_n, "p": m.p_n, "thickness_stretch": m.stretch_n,
-                "lever_before": m._lever_before}  # the next increment's lever arm is the committed stretch
+        return {"lam": self.lam, "q": self.q.x.array, **self.model.checkpoint()}
 
     def restore_state(self, data, lam_scale: float = 1.0) -> None:
         """Continue from a checkpoint_state (lam_scale: its load factor in this run's units)."""
-        m = self.model
-        pairs = (("q", self.q.x.array), ("ep", m.ep_n), ("p", m.p_n), ("thickness_stretch", m.stretch_n),
-                 ("lever_before", m._lever_before))
-        for key, target in pairs:
-            if key not in data or data[key].shape != target.shape:
-                raise InputError("resume", f"the checkpoint's {key!r} does not fit this model (another mesh, "
-                                           "effects or number of ranks)")
-        for key, target in pairs:
-            target[...] = data[key]
-        m.ep[...], m.p[...], m.stretch[...], m.lever[...] = m.ep_n, m.p_n, m.stretch_n, m.stretch_n
+        if "q" not in data or data["q"].shape != self.q.x.array.shape:
+            raise InputError("resume", "the checkpoint's carrier does not fit this model (another mesh or "
+                                       "number of ranks)")
+        self.model.restore(data)
+        self.q.x.array[:] = data["q"]
         self.q.x.scatter_forward()
         self.lam = float(data["lam"]) * lam_scale
         self._direction = 1.0 if self.lam > 0 else None
         self._dlam_prev = None
 
-    def save_checkpoint(self, fingerprint: str = ""):
-        """The last converged state (checkpoint_state, per rank, npz) and the history (json)."""
+    def save_checkpoint(self):
+        """The last converged state (checkpoint_state, per rank, npz, with the run's fingerprint)
+        and the history (json)."""
         if self.checkpoint_dir is None:
             return None
         d = self.checkpoint_dir
         d.mkdir(parents=True, exist_ok=True)
         rank = self.model.mesh.comm.rank
         path = d / f"last_converged.rank{rank}.npz"
-        np.savez(path, fingerprint=fingerprint or self.fingerprint, **self.checkpoint_state())
+        np.savez(path, fingerprint=self.fingerprint, **self.checkpoint_state())
         if rank == 0:
             (d / "history.json").write_text(json.dumps([asdict(h) for h in self.history], indent=1))
         return path

@@ -150,6 +150,22 @@ class SheetModel:
         self._lever_before[...] = self.lever
         self.lever[...] = self.stretch  # the next increment's lever arm
 
+    def checkpoint(self) -> dict:
+        """The committed material state; the next increment's lever arm is its stretch."""
+        return {"ep": self.ep_n, "p": self.p_n, "thickness_stretch": self.stretch_n, "lever_before": self._lever_before}
+
+    def restore(self, data) -> None:
+        """The committed material state from a checkpoint() (refused if it does not fit)."""
+        pairs = (("ep", self.ep_n), ("p", self.p_n), ("thickness_stretch", self.stretch_n),
+                 ("lever_before", self._lever_before))
+        for key, target in pairs:
+            if key not in data or data[key].shape != target.shape:
+                raise InputError("resume", f"the checkpoint's {key!r} does not fit this model (another mesh, "
+                                           "effects or number of ranks)")
+        for key, target in pairs:
+            target[...] = data[key]
+        self.ep[...], self.p[...], self.stretch[...], self.lever[...] = self.ep_n, self.p_n, self.stretch_n, self.stretch_n
+
     def converged_lever(self) -> None:
         """The lever arm with which the last converged increment was solved (it lags one
         increment): evaluating the committed state with it reproduces that state's forces."""
@@ -162,15 +178,16 @@ class SheetModel:
         over the layers; ln(t/t0) with finite strains, the small-strain e33 without) and the
         major and minor logarithmic strains of the mid-surface."""
         peq = self.p_n.max(axis=2).mean(axis=1)
-        if self.finite:
-            e33 = np.log(self.stretch_n).mean(axis=1)
-        else:
-            e33 = _mean_thickness_strain(self.strain, self.ep_n, self.material, self.zeta, self.wz,
-                                         self.thickness)
         major, minor = _surface_strains(self.strain)
-        return {"equivalent_plastic_strain": peq, "thickness_strain": e33,
+        return {"equivalent_plastic_strain": peq, "thickness_strain": self.thickness_strain(),
                 "major_strain": major, "minor_strain": minor}
 
+    def thickness_strain(self) -> np.ndarray:
+        """Per owned cell: ln(t/t0) = mean ln lambda3 with finite strains, else the small-strain
+        e33 of the layers (mean over the layers and the quadrature points)."""
+        if self.finite:
+            return np.log(self.stretch_n).mean(axis=1)
+        return _mean_thickness_strain(self.strain, self.ep_n, self.material, self.zeta, self.wz, self.thickness)
 
     def volume_change(self) -> float:
         """(V - V0) / V0 of the whole sheet at the last evaluated state: per cell its initial
@@ -178,7 +195,7 @@ class SheetModel:
         stretch exp(thickness strain). With finite strains only elastic volume change remains."""
         e = self.strain[:, :, :3]
         J2 = np.sqrt(np.maximum((1 + 2 * e[..., 0]) * (1 + 2 * e[..., 1]) - e[..., 2] ** 2, 0.0)).mean(axis=1)
-        t = np.exp(self.cell_fields()["thickness_strain"])
+        t = np.exp(self.thickness_strain())
         comm = self.mesh.comm
         V = comm.allreduce(float(np.sum(self.cell_area * J2 * t)), op=MPI.SUM)
         return V / comm.allreduce(float(np.sum(self.cell_area)), op=MPI.SUM) - 1.0
