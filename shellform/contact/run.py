@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from shellform.contact import springback
 from shellform.contact.problem import DrawingProblem
 from shellform.errors import InputError
 from shellform.nonlinear.driver import ConvergenceFailure
@@ -146,7 +147,15 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
     limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
-    sprung = cup.springback(outdir, p, s.title) if s.process.springback and stopped is None else None
+    sprung = None
+    if s.process.springback and stopped is None:
+        before = cup.profiles(p.driver, p.driver.X)
+        try:
+            released = springback.release(p.driver)
+        except ConvergenceFailure as err:  # the drawn state is kept and reported; springback is not
+            sprung = {"stopped": str(err)}
+        else:
+            sprung = cup.springback(outdir, p, s.title, before, released)
     summary = {
         "title": s.title, "effects": list(s.effects), "ranks": comm.size,
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,

@@ -65,28 +65,3 @@ def release(contact_driver, controls: Controls | None = None, verbose=False) -> 
     sb.nodal = ReleasedForces(f, model.mesh.comm)
     sb.run(0.0)
     return sb
-
-
-def profile(driver, X, y0: float = 0.0, diagonal=False):
-    """(initial distance, x or r, z) of the owned nodes on the line y = 0 (or x = y), by initial
-    distance from the centre, gathered on every rank."""
-    n = driver.model.V.dofmap.index_map.size_local
-    x = X[:n] + driver.q.x.array.reshape(-1, BS)[:n, :3]
-    tol = 1e-6 * max(np.abs(X[:, :2]).max(), 1.0)
-    on = np.abs(X[:n, 0] - X[:n, 1]) < tol if diagonal else np.abs(X[:n, 1] - y0) < tol
-    r0 = np.hypot(X[:n, 0], X[:n, 1])[on]
-    r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
-    rows = np.column_stack([r0, r, x[on, 2]])
-    rows = np.concatenate(driver.model.mesh.comm.allgather(rows))
-    return rows[np.argsort(rows[:, 0])]
-
-
-def wall_angle(rows, depth: float) -> float:
-    """The wall's angle from the horizontal (degrees, 90: vertical): a line x(z) fitted to the
-    profile's points between 30 % and 70 % of the depth."""
-    z = rows[:, 2]
-    wall = (z < -0.3 * depth) & (z > -0.7 * depth)
-    if wall.sum() < 2:
-        return float("nan")
-    dxdz = np.polyfit(rows[wall, 2], rows[wall, 1], 1)[0]
-    return float(90.0 - np.degrees(np.arctan(abs(dxdz))))

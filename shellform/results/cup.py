@@ -171,23 +171,48 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.close()
 
 
-def springback(outdir: Path, p, title: str) -> dict:
-    """Release the tools' forces (shellform.contact.springback) and report what changed: wall
-    angle and flange edge along the transverse line, the diagonal's corner, the unloading's
-    plastic layers, the residual resultants; springback.csv and springback.png (profiles)."""
-    from shellform.contact import springback as sb
+def profile(driver, X, y0: float = 0.0, diagonal=False):
+    """(initial distance, x or r, z) of the owned nodes on the line y = 0 (or x = y), by initial
+    distance from the centre, gathered on every rank."""
+    n = driver.model.V.dofmap.index_map.size_local
+    x = X[:n] + driver.q.x.array.reshape(-1, BS)[:n, :3]
+    tol = 1e-6 * max(np.abs(X[:, :2]).max(), 1.0)
+    on = np.abs(X[:n, 0] - X[:n, 1]) < tol if diagonal else np.abs(X[:n, 1] - y0) < tol
+    r0 = np.hypot(X[:n, 0], X[:n, 1])[on]
+    r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
+    rows = np.column_stack([r0, r, x[on, 2]])
+    rows = np.concatenate(driver.model.mesh.comm.allgather(rows))
+    return rows[np.argsort(rows[:, 0])]
+
+
+def wall_angle(rows, depth: float) -> float:
+    """The wall's angle from the horizontal (degrees, 90: vertical): a line x(z) fitted to the
+    profile's points between 30 % and 70 % of the depth."""
+    z = rows[:, 2]
+    wall = (z < -0.3 * depth) & (z > -0.7 * depth)
+    if wall.sum() < 2:
+        return float("nan")
+    dxdz = np.polyfit(rows[wall, 2], rows[wall, 1], 1)[0]
+    return float(90.0 - np.degrees(np.arctan(abs(dxdz))))
+
+
+SPRINGBACK_LINES = {"transverse": False, "diagonal": True}
+
+
+def profiles(driver, X) -> dict:
+    """The transverse and diagonal profiles of `driver`'s state (before or after springback);
+    X: the nodes' initial positions."""
+    return {k: profile(driver, X, diagonal=v) for k, v in SPRINGBACK_LINES.items()}
+
+
+def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
+    """What springback changed (shellform.contact.springback released the tools' forces into
+    `released`): wall angle and flange edge along the transverse line, the diagonal's corner,
+    the unloading's plastic layers, the residual resultants; springback.csv and springback.png."""
     from shellform.results.tables import write_csv
 
-    from shellform.nonlinear.driver import ConvergenceFailure
-
-    d = p.driver
-    lines = {"transverse": False, "diagonal": True}
-    before = {k: sb.profile(d, d.X, diagonal=v) for k, v in lines.items()}
-    try:
-        released = sb.release(d)
-    except ConvergenceFailure as err:  # the drawn state is kept and reported; springback is not
-        return {"stopped": str(err)}
-    after = {k: sb.profile(released, d.X, diagonal=v) for k, v in lines.items()}
+    lines = SPRINGBACK_LINES
+    after = profiles(released, p.driver.X)
     depth = float(-before["transverse"][:, 2].min())
     rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
              "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]
@@ -198,8 +223,8 @@ def springback(outdir: Path, p, title: str) -> dict:
     edge = {k: (before[k][-1], after[k][-1]) for k in lines}
     out = {
         "stopped": None,
-        "wall_angle_deg": {"before": sb.wall_angle(before["transverse"], depth),
-                           "after": sb.wall_angle(after["transverse"], depth)},
+        "wall_angle_deg": {"before": wall_angle(before["transverse"], depth),
+                           "after": wall_angle(after["transverse"], depth)},
         "flange_edge_dz_mm": {k: float(a[2] - b[2]) for k, (b, a) in edge.items()},
         "flange_edge_dr_mm": {k: float(a[1] - b[1]) for k, (b, a) in edge.items()},
         "unloading_increments": len(released.history),
