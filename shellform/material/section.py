@@ -19,7 +19,7 @@ from numba import njit
 from shellform.errors import InputError
 from shellform.material import E_, NU_
 from shellform.material import hencky
-from shellform.material.hill79 import _return_core
+from shellform.material.hill79 import _return_core, thickness_strain
 
 
 def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
@@ -68,8 +68,7 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
         Dt[0, 0], Dt[0, 1], Dt[0, 2] = d00, d01, d02
         Dt[1, 0], Dt[1, 1], Dt[1, 2] = d01, d11, d12
         Dt[2, 0], Dt[2, 1], Dt[2, 2] = d02, d12, d22
-    e33 = -(q0 + q1) - nu / (1.0 - nu) * ((eps[0] - q0) + (eps[1] - q1))
-    return p, st, e33
+    return p, st, thickness_strain(eps, ep_new, mat)
 
 
 @njit(cache=True)

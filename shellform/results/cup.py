@@ -34,13 +34,18 @@ def draw_in(p) -> dict:
             "DD": float(np.hypot(hx, hy) - np.hypot(corner[0], corner[1]))}
 
 
+def _on_line(X, diagonal: bool, tol: float) -> np.ndarray:
+    """The nodes (initial positions X) on the diagonal x = y or on the transverse line y = 0."""
+    return np.abs(X[:, 0] - X[:, 1]) < tol if diagonal else np.abs(X[:, 1]) < tol
+
+
 def thickness_lines(p) -> tuple[list[dict], list[dict]]:
     """Thickness strain at the nodes along the diagonal and along y = 0, by initial distance."""
     X, _, e33 = p.nodal_values()
     X, e33 = _gather(p.model.mesh.comm, X, e33)
     tol = 1e-6 * p.scene.geometry.lx
     lines = []
-    for on in (np.abs(X[:, 0] - X[:, 1]) < tol, np.abs(X[:, 1]) < tol):
+    for on in (_on_line(X, True, tol), _on_line(X, False, tol)):
         r = np.hypot(X[on, 0], X[on, 1])
         order = np.argsort(r)
         lines.append([{"initial_position_mm": float(r[i]), "thickness_strain": float(e33[on][i])} for i in order])
@@ -171,17 +176,14 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.close()
 
 
-def profile(driver, X, y0: float = 0.0, diagonal=False):
+def profile(driver, X, diagonal=False):
     """(initial distance, x or r, z) of the owned nodes on the line y = 0 (or x = y), by initial
     distance from the centre, gathered on every rank."""
     n = driver.model.V.dofmap.index_map.size_local
     x = X[:n] + driver.q.x.array.reshape(-1, BS)[:n, :3]
-    tol = 1e-6 * max(np.abs(X[:, :2]).max(), 1.0)
-    on = np.abs(X[:n, 0] - X[:n, 1]) < tol if diagonal else np.abs(X[:n, 1] - y0) < tol
-    r0 = np.hypot(X[:n, 0], X[:n, 1])[on]
+    on = _on_line(X[:n], diagonal, 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
     r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
-    rows = np.column_stack([r0, r, x[on, 2]])
-    rows = np.concatenate(driver.model.mesh.comm.allgather(rows))
+    rows, = _gather(driver.model.mesh.comm, np.column_stack([np.hypot(X[:n, 0], X[:n, 1])[on], r, x[on, 2]]))
     return rows[np.argsort(rows[:, 0])]
 
 
