@@ -10,7 +10,8 @@
                                             (the square cup's hard cases), cup-mesh (its meshes),
                                             cup-strain (before and after finite strains),
                                             cup-paper (the paper's Figs. 5 to 8), numisheet
-                                            (the NUMISHEET'93 cups to 40 mm)
+                                            (the NUMISHEET'93 cups to 40 mm), numisheet-cost
+                                            (the aluminium cup's accuracy against time)
 """
 
 import argparse
@@ -57,7 +58,7 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
 
 
 STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain", "cup-paper", "numisheet"]
+           "cup-strain", "cup-paper", "numisheet", "numisheet-cost"]
 
 
 def main(argv=None) -> int:

@@ -243,6 +243,9 @@ def test_short_square_cup_draw():
     def check(d):
         assert abs(p.holder_force() - s.tools.blank_holder_force) <= 1e-9 * s.tools.blank_holder_force
         assert p.holder_share() <= 0.1
+        assert 0.0 <= p.holder_held_down() < 1.0  # the closed holder: the lift it holds is below F
+        x, y = p.holder_largest_at()
+        assert 0 <= x <= s.geometry.lx / 2 and 0 <= y <= s.geometry.ly / 2
         assert p.force_balance() <= 1e-6
         assert p.free_under_holder() == 0 and d.state.closed[0]
         assert p.max_penetration() <= 0.01 * s.material.thickness

@@ -11,7 +11,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform import supports as named_supports
-from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
+from shellform.contact.semi_inverse import FREE, ContactControls, SemiInverseDriver
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import rectangle
 from shellform.nonlinear.driver import Controls
@@ -83,6 +83,26 @@ class DrawingProblem:
         if d.holder is None or d.holder.force <= 0:
             return 0.0
         return d.model.mesh.comm.allreduce(float(d.state.holder_face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
+
+    def holder_held_down(self) -> float:
+        """The part of the closed holder's force that holds pinched nodes down against the sheet's
+        own lift (their sum of max(-R0, 0), R0 the net normal force), as a fraction of F; the
+        holder opens when it passes 1. 0 when the holder is open."""
+        d = self.driver
+        if d.holder is None or d.holder.force <= 0 or not d.state.closed[0]:
+            return 0.0
+        net = np.where(d.state.tool != FREE, d.reactions()[:, 2], 0.0)
+        return 1.0 - d.holder.squeeze_left(d.pinched, net) / d.holder.force
+
+    def holder_largest_at(self) -> tuple[float, float]:
+        """Initial (x, y) of the node with the largest holder force (mm), all ranks."""
+        d = self.driver
+        comm = d.model.mesh.comm
+        h = d.state.holder_face
+        i = int(np.argmax(h)) if h.size else -1
+        mine = (float(h[i]), tuple(d.X[i, :2])) if i >= 0 else (-1.0, (np.nan, np.nan))
+        _, xy = max(comm.allgather(mine), key=lambda c: c[0])
+        return float(xy[0]), float(xy[1])
 
     def holder_height(self) -> float:
         """The holder's face: the highest top z + t/2 of the sheet under it (mm)."""

@@ -8,9 +8,11 @@ Writes into the output folder (forces and draw-in for the whole blank):
                              over_the_stroke: the worst penetration, z-balance, holder share
                              and count of free nodes under the closed holder
     reports.json             the reports so far (rewritten at each; a resumed run takes them over)
-    force_stroke.csv, .png   per increment: punch force, holder force, height and largest nodal
-                             share, the tools' z-balance, penetration, free nodes under the
-                             closed holder, iterations, smallest line-search factor, contacts
+    force_stroke.csv, .png   per increment: punch force, holder force, height, largest nodal
+                             share and where it is (initial x y), the share of F that holds
+                             pinched nodes down (the holder opens past 1), the tools' z-balance,
+                             penetration, free nodes under the closed holder, iterations,
+                             smallest line-search factor, contacts
     thickness_diagonal.csv   initial distance from the centre along x = y, thickness strain
     thickness_transverse.csv the same along the transverse centre line y = 0
     cup.bp, cup_cells.bp     VTX time series at the reports: displacement and nodal thickness
@@ -109,10 +111,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
 
     def on_increment(d):
         h = d.history[-1]
+        hx, hy = p.holder_largest_at()
         curve.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
                       "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
                       "max_penetration_mm": p.max_penetration(), "force_balance": p.force_balance(),
-                      "holder_largest_share": p.holder_share(), "free_under_closed_holder": p.free_under_holder(),
+                      "holder_largest_share": p.holder_share(), "holder_largest_x_mm": hx, "holder_largest_y_mm": hy,
+                      "holder_held_down": p.holder_held_down(), "free_under_closed_holder": p.free_under_holder(),
                       "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
 

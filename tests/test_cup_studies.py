@@ -1,0 +1,50 @@
+"""Short versions of the square-cup studies (issue 11): what accuracy costs in time.
+
+The numisheet-cost study on two coarse meshes and two increment sizes, 1.5 mm of stroke: every
+run finishes in balance, the table measures each run against the finest, and the picks for 1,
+5 and 10 % are runs that really lie within them. The picking itself on a table made by hand.
+"""
+
+import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
+
+import csv
+import json
+import math
+
+import pytest
+
+from shellform.studies import cup_accuracy, numisheet_cost
+from shellform.studies.cup_hard import folder
+
+
+def test_picks_take_the_cheapest_run_within_each_tolerance():
+    rows = [{"case": "fine", "finished": True, "wall_s": 100.0, "worst_rel_diff": 0.0},
+            {"case": "a", "finished": True, "wall_s": 10.0, "worst_rel_diff": 0.08},
+            {"case": "b", "finished": True, "wall_s": 30.0, "worst_rel_diff": 0.03},
+            {"case": "c", "finished": False, "wall_s": 5.0, "worst_rel_diff": 0.001},  # stopped: never
+            {"case": "d", "finished": True, "wall_s": 40.0, "worst_rel_diff": 0.004}]
+    chosen = {p["tolerance"]: p["case"] for p in cup_accuracy.picks(rows, "fine")}
+    assert chosen == {0.01: "d", 0.05: "b", 0.10: "a"}
+    none = cup_accuracy.picks(rows, "fine", tolerances=(1e-4,))[0]
+    assert none["case"] == "none coarser than fine" and none["wall_s"] == ""
+
+
+def test_numisheet_cost_short(tmp_path):
+    rows = numisheet_cost.run(tmp_path, levels=(4, 6), steps=(1, 2), stroke=1.5)
+    assert [r["case"] for r in rows] == ["n 4, 2x step", "n 6, 2x step", "n 4", "n 6"]
+    finest = rows[-1]
+    qs = cup_accuracy.quantities(("0.5625", "1.5"))
+    for r in rows:
+        assert r["finished"] and r["stroke_mm"] == pytest.approx(1.5)
+        assert all(math.isfinite(r[f"rel_diff_{q}"]) for q in qs), r
+        summary = json.loads((folder(tmp_path, r["case"]) / "summary.json").read_text())
+        assert summary["over_the_stroke"]["force_balance"] <= 1e-6
+    assert all(finest[f"rel_diff_{q}"] == 0.0 for q in qs)
+    assert finest["force_1.5"] > finest["force_0.5625"] > 0
+    # the larger step on the same mesh: the same answer to within a few per cent at this stroke
+    assert abs(rows[1]["rel_diff_force_1.5"]) < 0.05 and abs(rows[1]["rel_diff_DD_1.5"]) < 0.05
+    with open(tmp_path / "numisheet_cost_picks.csv") as f:
+        for p in csv.DictReader(f):
+            if p["worst_rel_diff"]:
+                assert float(p["worst_rel_diff"]) <= float(p["tolerance"])
+    assert (tmp_path / "numisheet_cost_error_time.png").stat().st_size > 0
