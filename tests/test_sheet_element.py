@@ -1,5 +1,5 @@
-"""The nonlinear sheet element on its own: rigid modes, patch tests, exact rotations, the
-consistent tangent, and Newton's quadratic convergence.
+"""The nonlinear sheet element on its own: its map's structured product, rigid modes, patch
+tests, exact rotations, the consistent tangent, and Newton's quadratic convergence.
 
 Patch tests run on the distorted 10-triangle patch: every carrier value of an exact field is
 prescribed on the boundary vertices, the driver solves for the interior ones, and they must
@@ -50,6 +50,25 @@ def solve_patch(effects, U, grad_U):
                verbose=False)
     d.run(1.0)
     return model, d.q.x.array, exact
+
+
+def test_congruence_equals_the_dense_product():
+    """K = Q^T Kz Q from Q's structure (the element's tangent) equals the product with the dense
+    Q, for a nonsymmetric Kz on every cell of the distorted patch."""
+    from shellform.assembly import slope_map
+    from shellform.assembly.sheet_element import NDOF, build_q, congruence
+
+    model = SheetModel(distorted_patch(MPI.COMM_WORLD), MAT, T, NL)
+    el = model.kernels.element
+    (cols, codes), comp = el.q_map(), el.component_columns()
+    Kz = np.random.default_rng(1).standard_normal((el.nz, el.nz))
+    Q, K = np.zeros((el.nz, NDOF)), np.zeros((NDOF, NDOF))
+    for c in range(model.num_cells):
+        J = slope_map.jacobian(model.cell_coords[c])
+        build_q(J, model.P[c], cols, codes, comp, Q)
+        congruence(Kz, J, model.P[c], cols, codes, comp, np.zeros((NDOF, el.nz)), np.zeros((el.nz, NDOF)), K)
+        dense = Q.T @ Kz @ Q
+        assert np.abs(K - dense).max() <= 1e-13 * np.abs(dense).max()
 
 
 def test_rigid_modes_of_the_element():

@@ -16,9 +16,10 @@ G is factored once per cell (Cholesky); no saddle-point solve is needed.
 
 import numba
 import numpy as np
+from shellform import _jit as jit
 
 
-@numba.njit(cache=True)
+@jit.njit
 def cholesky(A):
     """Lower-triangular L with L L^T = A (A SPD, small)."""
     n = A.shape[0]
@@ -36,7 +37,7 @@ def cholesky(A):
     return L
 
 
-@numba.njit(cache=True)
+@jit.njit
 def cholesky_solve(L, X):
     """X <- (L L^T)^-1 X, column by column, in place."""
     n = L.shape[0]
@@ -53,7 +54,7 @@ def cholesky_solve(L, X):
             X[i, c] = s / L[i, i]
 
 
-@numba.njit(cache=True)
+@jit.njit
 def blocks(Az, iq, ie, il):
     """G, C, H, Kqq from the element matrix of the mixed reference element."""
     ne, nq = ie.size, iq.size
@@ -73,7 +74,7 @@ def blocks(Az, iq, ie, il):
     return G, C, H, Kqq
 
 
-@numba.njit(cache=True)
+@jit.njit
 def strain_operator(Az, iq, ie, il):
     """B = G^-1 C (assumed-strain coefficients per reference nodal dof) and H."""
     G, C, H, Kqq = blocks(Az, iq, ie, il)
@@ -81,7 +82,7 @@ def strain_operator(Az, iq, ie, il):
     return C, H, Kqq
 
 
-@numba.njit(cache=True)
+@jit.njit
 def condensed_matrix(Az, iq, ie, il):
     """K_ref = Kqq + B^T H B."""
     B, H, K = strain_operator(Az, iq, ie, il)
@@ -102,7 +103,7 @@ def condensed_matrix(Az, iq, ie, il):
     return K
 
 
-@numba.njit(cache=True)
+@jit.njit
 def recover(Az, iq, ie, il, q_ref):
     """Assumed strains eps = B q and multipliers lam = G^-1 H eps of one element."""
     G, C, H, _ = blocks(Az, iq, ie, il)

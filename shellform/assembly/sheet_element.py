@@ -32,6 +32,7 @@ import numpy as np
 
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.elements import reduced_cubic
+from shellform import _jit as jit
 
 COMPONENTS = ("u", "v", "w", "u_x", "u_y", "v_x", "v_y", "w_x", "w_y")
 BS = len(COMPONENTS)
@@ -92,7 +93,7 @@ class SheetElement:
         return out
 
 
-@numba.njit(cache=True)
+@jit.njit
 def build_q(J, P, cols, codes, comp_cols, Q):
     """Fill the dense (nz x 27) map Q of one cell (see the module docstring)."""
     Q[:, :] = 0.0
@@ -109,3 +110,42 @@ def build_q(J, P, cols, codes, comp_cols, Q):
         for h in range(nh):
             for m in range(9):
                 Q[27 + nh * i + h, comp_cols[i, m]] = P[h, m]
+
+
+@jit.njit
+def congruence(Kz, J, P, cols, codes, comp_cols, QtK, KQ, K):
+    """K = Q^T Kz Q (27 x 27) without forming Q, from its structure: the rows of U hold at most
+    two entries each (1 or an entry of J), the rows of H_i the 9 x 9 block P at the component's
+    columns. Both products are row updates X[col, :] += v Y[r, :] over Q's nonzeros (r, col, v):
+    Q^T Kz, then Q^T (Q^T Kz)^T = (Q^T Kz Q)^T. Scratch: QtK (27 x nz), KQ (nz x 27)."""
+    nz = Kz.shape[0]
+    _rows_of_qt(Kz, J, P, cols, codes, comp_cols, QtK)
+    for a in range(NDOF):
+        for j in range(nz):
+            KQ[j, a] = QtK[a, j]
+    _rows_of_qt(KQ, J, P, cols, codes, comp_cols, K)  # K^T
+    for a in range(NDOF):
+        for b in range(a):
+            K[a, b], K[b, a] = K[b, a], K[a, b]
+
+
+@jit.njit
+def _rows_of_qt(Y, J, P, cols, codes, comp_cols, X):
+    """X = Q^T Y, row by row: X[col, :] += v Y[r, :] for every nonzero Q[r, col] = v."""
+    nu, nh, n = cols.shape[0], P.shape[0], Y.shape[1]
+    X[:, :] = 0.0
+    for r in range(nu):
+        for k in range(2):
+            c = codes[r, k]
+            if c >= 1:
+                v = 1.0 if c == 1 else J[(c - 2) // 2, (c - 2) % 2]
+                col = cols[r, k]
+                for j in range(n):
+                    X[col, j] += v * Y[r, j]
+    for i in range(3):
+        for h in range(nh):
+            r = nu + nh * i + h
+            for m in range(9):
+                v, col = P[h, m], comp_cols[i, m]
+                for j in range(n):
+                    X[col, j] += v * Y[r, j]

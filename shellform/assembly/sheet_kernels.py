@@ -17,8 +17,9 @@ shellform.material.section.update, a loop of its own so that its time is measure
 Assembly is DOLFINx's (shellform.nonlinear.assemble).
 """
 
+import functools
+
 import basix.ufl
-import cffi
 import numba
 import numpy as np
 import ufl
@@ -27,14 +28,9 @@ from dolfinx.jit import ffcx_jit
 from shellform.forms import kirchhoff_love as kl
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.kernels import reference_fields
-from shellform.assembly.sheet_element import NDOF, SheetElement, build_q
-
-try:  # the module moves in FFCx 0.12
-    from ffcx.codegeneration.utils import empty_void_pointer
-except ImportError:  # pragma: no cover
-    from ffcx.codegeneration.numba.utils import empty_void_pointer
-
-_ffi = cffi.FFI()
+from shellform.assembly.sheet_element import NDOF, SheetElement, build_q, congruence
+from shellform import _jit as jit
+from shellform._jit import kernel_address
 _OPTIONS = {"scalar_type": "float64"}
 
 
@@ -126,158 +122,137 @@ class SheetKernels:
         self.strain_loop = self._strain_loop()
         self.tensor_loop = self._tensor_loop()
 
-    # -- numba ---------------------------------------------------------------------------------
+    # -- the loops, bound to this configuration's kernels and tables -----------------------------
     def _setup_loop(self):
-        """Per cell: P (H = P q_c) and the element pressure vector for p = 1."""
-        hc, hf, pk = self.hessian_cell, self.hessian_facet, self.pressure
         el = self.element
         he = el.hessian
-        iq, ie, il = he.q, he.eps, he.lam
-        hcols, hcodes = el.hessian_tables
-        qcols, qcodes = el.q_map()
-        ccols = el.component_columns()
-        nzh, nz, ns = he.dim, el.nz, el.sym_dim
-        ffi = _ffi
-
-        @numba.njit
-        def setup(cells_coords, P_out, F_out):
-            Ah = np.zeros((nzh, nzh))
-            wz = np.zeros(1)
-            ck = np.zeros(1)
-            one = np.ones(1)
-            local = np.zeros(1, dtype=np.int32)
-            perm = np.zeros(1, dtype=np.uint8)
-            Q = np.zeros((nz, NDOF))
-            fz = np.zeros(nz)
-            for cidx in range(cells_coords.shape[0]):
-                coords = cells_coords[cidx]
-                Ah[:, :] = 0.0
-                local[0] = 0
-                hc(ffi.from_buffer(Ah), ffi.from_buffer(wz), ffi.from_buffer(ck), ffi.from_buffer(coords),
-                   ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
-                for f in range(3):
-                    local[0] = f
-                    hf(ffi.from_buffer(Ah), ffi.from_buffer(wz), ffi.from_buffer(ck), ffi.from_buffer(coords),
-                       ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
-                # G H + C q_ref = 0  ->  H = -G^-1 C T q_c
-                G = np.empty((ns, ns))
-                C = np.empty((ns, iq.size))
-                for a in range(ns):
-                    for b in range(ns):
-                        G[a, b] = Ah[il[a], ie[b]]
-                    for b in range(iq.size):
-                        C[a, b] = Ah[il[a], iq[b]]
-                J = slope_map.jacobian(coords)
-                coef = slope_map.coefficients(J, hcodes, True)
-                CT = np.zeros((ns, 9))
-                for a in range(ns):
-                    for r in range(iq.size):
-                        for k in range(2):
-                            if hcols[r, k] >= 0:
-                                CT[a, hcols[r, k]] += C[a, r] * coef[r, k]
-                CT *= -1.0
-                condensation.cholesky_solve(condensation.cholesky(G), CT)
-                P_out[cidx] = CT
-                build_q(J, P_out[cidx], qcols, qcodes, ccols, Q)
-                fz[:] = 0.0
-                local[0] = 0
-                pk(ffi.from_buffer(fz), ffi.from_buffer(wz), ffi.from_buffer(one), ffi.from_buffer(coords),
-                   ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
-                F_out[cidx, :] = Q.T @ fz
-
-        return setup
-
-    def _scratch(self):
-        """A numba function giving a loop's per-call buffers: constants and kernel arguments."""
-        nconst = self.nconst
-
-        @numba.njit
-        def scratch(consts):
-            c = np.zeros(max(nconst, 1))
-            c[:nconst] = consts[:nconst]
-            return c, np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
-
-        return scratch
+        return functools.partial(setup_loop, kernel_address(self.hessian_cell), kernel_address(self.hessian_facet),
+                                 kernel_address(self.pressure), he.q, he.eps, he.lam, *el.hessian_tables,
+                                 *el.q_map(), el.component_columns(), he.dim, el.nz, el.sym_dim)
 
     def _strain_loop(self):
-        strain = self.strain
         el = self.element
-        qcols, qcodes = el.q_map()
-        ccols = el.component_columns()
-        nz = el.nz
-        scratch = self._scratch()
-        ffi = _ffi
-
-        @numba.njit(parallel=True)
-        def loop(cells, cells_coords, dofs, x, P, consts, z_out, e_out):
-            """z = Q q and the section strains e at the quadrature points of every cell (the
-            cells dealt out to the threads, each with its own buffers)."""
-            nt = numba.get_num_threads()
-            for t in numba.prange(nt):
-                Q = np.zeros((nz, NDOF))
-                q = np.empty(NDOF)
-                c, local, perm = scratch(consts)
-                for k in range(t, cells.size, nt):
-                    cidx = cells[k]
-                    coords = cells_coords[cidx]
-                    build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
-                    for v in range(3):
-                        for b in range(9):
-                            q[9 * v + b] = x[9 * dofs[cidx, v] + b]
-                    z_out[k, :] = Q @ q
-                    e = e_out[k].ravel()
-                    e[:] = 0.0
-                    strain(ffi.from_buffer(e), ffi.from_buffer(z_out[k]), ffi.from_buffer(c),
-                           ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
-                           empty_void_pointer())
-
-        return loop
+        bound = functools.partial(strain_loop, kernel_address(self.strain), *el.q_map(), el.component_columns(),
+                                  el.nz, self.nconst)
+        return lambda *args: bound(numba.get_num_threads(), *args)
 
     def _tensor_loop(self):
-        force, tangent = self.force, self.tangent
         el = self.element
-        qcols, qcodes = el.q_map()
-        ccols = el.component_columns()
-        nz, nqp = el.nz, el.nqp
-        scratch = self._scratch()
-        fo, to = self.force_offsets, self.tangent_offsets
-        ffi = _ffi
+        bound = functools.partial(tensor_loop, kernel_address(self.force), kernel_address(self.tangent),
+                                  self.force_offsets, self.tangent_offsets, *el.q_map(), el.component_columns(),
+                                  el.nz, el.nqp, self.nconst)
+        return lambda *args: bound(numba.get_num_threads(), *args)
 
-        @numba.njit
-        def pack(w, offsets, z, S, D):
-            if offsets[0] >= 0:
-                w[offsets[0]: offsets[0] + nz] = z
-            if offsets[1] >= 0:
-                w[offsets[1]: offsets[1] + 6 * nqp] = S
-            if offsets[2] >= 0:
-                w[offsets[2]: offsets[2] + 36 * nqp] = D
 
-        @numba.njit(parallel=True)
-        def loop(cells, cells_coords, P, consts, z, S, D, want_tangent, R_out, K_out):
-            """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out
-            to the threads, each with its own buffers)."""
-            nt = numba.get_num_threads()
-            for t in numba.prange(nt):
-                Q = np.zeros((nz, NDOF))
-                w = np.zeros(nz + 42 * nqp)
-                rz = np.zeros(nz)
-                Kz = np.zeros((nz, nz))
-                c, local, perm = scratch(consts)
-                for k in range(t, cells.size, nt):
-                    cidx = cells[k]
-                    coords = cells_coords[cidx]
-                    build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
-                    pack(w, fo, z[k], S[k].ravel(), D[k].ravel())
-                    rz[:] = 0.0
-                    force(ffi.from_buffer(rz), ffi.from_buffer(w), ffi.from_buffer(c), ffi.from_buffer(coords),
-                          ffi.from_buffer(local), ffi.from_buffer(perm), empty_void_pointer())
-                    R_out[k, :] = Q.T @ rz
-                    if want_tangent:
-                        pack(w, to, z[k], S[k].ravel(), D[k].ravel())
-                        Kz[:, :] = 0.0
-                        tangent(ffi.from_buffer(Kz), ffi.from_buffer(w), ffi.from_buffer(c),
-                                ffi.from_buffer(coords), ffi.from_buffer(local), ffi.from_buffer(perm),
-                                empty_void_pointer())
-                        K_out[k, :, :] = Q.T @ (Kz @ Q)
+# -- numba loops (cached: the kernels come in as addresses) ------------------------------------
+@jit.njit
+def setup_loop(hc, hf, pk, iq, ie, il, hcols, hcodes, qcols, qcodes, ccols, nzh, nz, ns, cells_coords, P_out,
+               F_out):
+    """Per cell: P (H = P q_c) and the element pressure vector for p = 1."""
+    Ah = np.zeros((nzh, nzh))
+    wz = np.zeros(1)
+    ck = np.zeros(1)
+    one = np.ones(1)
+    local = np.zeros(1, dtype=np.int32)
+    perm = np.zeros(1, dtype=np.uint8)
+    Q = np.zeros((nz, NDOF))
+    fz = np.zeros(nz)
+    for cidx in range(cells_coords.shape[0]):
+        coords = cells_coords[cidx]
+        Ah[:, :] = 0.0
+        local[0] = 0
+        jit.call_kernel(hc, Ah, wz, ck, coords, local, perm)
+        for f in range(3):
+            local[0] = f
+            jit.call_kernel(hf, Ah, wz, ck, coords, local, perm)
+        # G H + C q_ref = 0  ->  H = -G^-1 C T q_c
+        G = np.empty((ns, ns))
+        C = np.empty((ns, iq.size))
+        for a in range(ns):
+            for b in range(ns):
+                G[a, b] = Ah[il[a], ie[b]]
+            for b in range(iq.size):
+                C[a, b] = Ah[il[a], iq[b]]
+        J = slope_map.jacobian(coords)
+        coef = slope_map.coefficients(J, hcodes, True)
+        CT = np.zeros((ns, 9))
+        for a in range(ns):
+            for r in range(iq.size):
+                for k in range(2):
+                    if hcols[r, k] >= 0:
+                        CT[a, hcols[r, k]] += C[a, r] * coef[r, k]
+        CT *= -1.0
+        condensation.cholesky_solve(condensation.cholesky(G), CT)
+        P_out[cidx] = CT
+        build_q(J, P_out[cidx], qcols, qcodes, ccols, Q)
+        fz[:] = 0.0
+        local[0] = 0
+        jit.call_kernel(pk, fz, wz, one, coords, local, perm)
+        F_out[cidx, :] = Q.T @ fz
 
-        return loop
+
+@jit.njit
+def _scratch(consts, nconst):
+    """A loop's per-thread buffers: the constants and the kernel's index arguments."""
+    c = np.zeros(max(nconst, 1))
+    c[:nconst] = consts[:nconst]
+    return c, np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
+
+
+@jit.njit(parallel=True)
+def strain_loop(strain, qcols, qcodes, ccols, nz, nconst, nt, cells, cells_coords, dofs, x, P, consts, z_out, e_out):
+    """z = Q q and the section strains e at the quadrature points of every cell (the cells dealt
+    out to the nt threads, each with its own buffers)."""
+    for t in numba.prange(nt):
+        Q = np.zeros((nz, NDOF))
+        q = np.empty(NDOF)
+        c, local, perm = _scratch(consts, nconst)
+        for k in range(t, cells.size, nt):
+            cidx = cells[k]
+            coords = cells_coords[cidx]
+            build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
+            for v in range(3):
+                for b in range(9):
+                    q[9 * v + b] = x[9 * dofs[cidx, v] + b]
+            z_out[k, :] = Q @ q
+            e = e_out[k].ravel()
+            e[:] = 0.0
+            jit.call_kernel(strain, e, z_out[k], c, coords, local, perm)
+
+
+@jit.njit
+def _pack(w, offsets, nz, nqp, z, S, D):
+    if offsets[0] >= 0:
+        w[offsets[0]: offsets[0] + nz] = z
+    if offsets[1] >= 0:
+        w[offsets[1]: offsets[1] + 6 * nqp] = S
+    if offsets[2] >= 0:
+        w[offsets[2]: offsets[2] + 36 * nqp] = D
+
+
+@jit.njit(parallel=True)
+def tensor_loop(force, tangent, fo, to, qcols, qcodes, ccols, nz, nqp, nconst, nt, cells, cells_coords, P, consts, z,
+                S, D, want_tangent, R_out, K_out):
+    """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
+    nt threads, each with its own buffers)."""
+    for t in numba.prange(nt):
+        Q = np.zeros((nz, NDOF))
+        w = np.zeros(nz + 42 * nqp)
+        rz = np.zeros(nz)
+        Kz = np.zeros((nz, nz))
+        QtK, KQ = np.zeros((NDOF, nz)), np.zeros((nz, NDOF))
+        c, local, perm = _scratch(consts, nconst)
+        for k in range(t, cells.size, nt):
+            cidx = cells[k]
+            coords = cells_coords[cidx]
+            J = slope_map.jacobian(coords)
+            build_q(J, P[cidx], qcols, qcodes, ccols, Q)
+            _pack(w, fo, nz, nqp, z[k], S[k].ravel(), D[k].ravel())
+            rz[:] = 0.0
+            jit.call_kernel(force, rz, w, c, coords, local, perm)
+            R_out[k, :] = Q.T @ rz
+            if want_tangent:
+                _pack(w, to, nz, nqp, z[k], S[k].ravel(), D[k].ravel())
+                Kz[:, :] = 0.0
+                jit.call_kernel(tangent, Kz, w, c, coords, local, perm)
+                congruence(Kz, J, P[cidx], qcols, qcodes, ccols, QtK, KQ, K_out[k])

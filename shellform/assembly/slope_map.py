@@ -13,9 +13,10 @@ kept for the study that shows why the map is needed.
 
 import numba
 import numpy as np
+from shellform import _jit as jit
 
 
-@numba.njit(cache=True)
+@jit.njit
 def jacobian(coords):
     """J[a, b] = dx_a/dX_b from coordinate_dofs (3 nodes x 3, flattened) of an affine triangle."""
     J = np.empty((2, 2))
@@ -25,7 +26,7 @@ def jacobian(coords):
     return J
 
 
-@numba.njit(cache=True)
+@jit.njit
 def coefficients(J, codes, mapped):
     coef = np.zeros(codes.shape)
     for r in range(codes.shape[0]):
@@ -39,7 +40,7 @@ def coefficients(J, codes, mapped):
     return coef
 
 
-@numba.njit(cache=True)
+@jit.njit
 def pull_back_matrix(K_ref, cols, coef, K):
     """K += T^T K_ref T."""
     nq = K_ref.shape[0]
@@ -58,7 +59,7 @@ def pull_back_matrix(K_ref, cols, coef, K):
                     K[c, d] += coef[r, k] * KT[r, d]
 
 
-@numba.njit(cache=True)
+@jit.njit
 def pull_back_vector(b_ref, cols, coef, b):
     """b += T^T b_ref."""
     for r in range(b_ref.shape[0]):
@@ -67,7 +68,7 @@ def pull_back_vector(b_ref, cols, coef, b):
                 b[cols[r, k]] += coef[r, k] * b_ref[r]
 
 
-@numba.njit(cache=True)
+@jit.njit
 def push_forward(q_carrier, cols, coef, q_ref):
     """q_ref = T q_carrier."""
     for r in range(q_ref.shape[0]):

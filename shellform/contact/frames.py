@@ -14,6 +14,7 @@ import numba
 import numpy as np
 
 from shellform.assembly.sheet_element import BS
+from shellform import _jit as jit
 
 
 def nodal_frames(normals: np.ndarray) -> np.ndarray:
@@ -37,7 +38,7 @@ def nodal_frames(normals: np.ndarray) -> np.ndarray:
     return F
 
 
-@numba.njit(cache=True)
+@jit.njit
 def rotate_cell_arrays(dofs, rotated, frames, vectors, matrices, tangent):
     """In place, for every cell: f' = T f, K' = T K T^T on the blocks flagged in `rotated`."""
     ncells, nv = dofs.shape

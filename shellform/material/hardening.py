@@ -13,12 +13,12 @@ elastic (law 0): no yield; returns (inf, 0).
 
 import math
 
-from numba import njit
 
 from shellform.material import A_, B_, C_, E_, LAW_, LAW_POWER, LAW_SWIFT
+from shellform import _jit as jit
 
 
-@njit(cache=True)
+@jit.njit
 def _power_law(p, E, sy, n):
     if n <= 1.0 + 1e-12:
         return sy, 0.0
@@ -35,7 +35,7 @@ def _power_law(p, E, sy, n):
     return sy * x, E / (n * x ** (n - 1.0) - 1.0)
 
 
-@njit(cache=True)
+@jit.njit
 def flow_stress(p, mat):
     """(sigma_bar, d sigma_bar / d p) at equivalent plastic strain p for the packed material."""
     law = int(mat[LAW_])

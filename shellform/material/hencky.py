@@ -25,14 +25,14 @@ tangent as dS/dE = P^T (dT/deps) P + L(T) (docs/material.md).
 """
 
 import math
+from shellform import _jit as jit
 
-from numba import njit
 
 SERIES_BELOW = 0.1  # x below which h, h', h'' are summed as power series
 SERIES_TERMS = 24  # 0.1^24: below rounding
 
 
-@njit(cache=True)
+@jit.njit
 def _h(x):
     """h(x) = atanh(sqrt x)/sqrt x and its first two derivatives, 0 <= x < 1."""
     if x < SERIES_BELOW:  # c_k = 1/(2k + 1): h = sum c_k x^k and its term-wise derivatives
@@ -54,7 +54,7 @@ def _h(x):
     return h, h1, h2
 
 
-@njit(cache=True)
+@jit.njit
 def log_strain(E, eps, P, W):
     """eps = 1/2 ln(I + 2E) (3, engineering shear) and P = d eps/dE (3 x 3); W (16) keeps what
     second_order needs. Returns False where I + 2E is not positive definite (no stretch gives
@@ -105,7 +105,7 @@ def log_strain(E, eps, P, W):
     return True
 
 
-@njit(cache=True)
+@jit.njit
 def second_order(T, s, W, L):
     """L = sum_k T_k d^2 eps_k/dE^2 (3 x 3) at the strain of the last log_strain call (W), s its
     shear E[2]: J^T [tau A'' + w B'' + B' w'^T + w' B'^T] J, w' = (0, T1 - T2, 2 T3)."""

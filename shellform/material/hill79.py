@@ -26,10 +26,10 @@ below m eps^2 / 2 ~ 1e-24 (below rounding) for m >= 2.
 
 import math
 
-from numba import njit
 
 from shellform.material import E_, LAW_, LAW_ELASTIC, M_, NU_, R_
 from shellform.material.hardening import flow_stress
+from shellform import _jit as jit
 
 EPS2 = 1.0e-24  # eps^2 of the regularisation above
 TOL = 1.0e-12  # local Newton: residual (scaled by the flow stress) relative to 1 + |e_trial|/eps_y
@@ -38,7 +38,7 @@ MAXIT = 300
 MAXLS = 40
 
 
-@njit(cache=True)
+@jit.njit
 def _invariants(s0, s1, s2):
     """u = s11 + s22, q = rho^2 and the regularised X = u^2 + eps^2 q, Y = q + eps^2 u^2, X + Y."""
     u = s0 + s1
@@ -49,7 +49,7 @@ def _invariants(s0, s1, s2):
     return u, q, X, Y, X + Y
 
 
-@njit(cache=True)
+@jit.njit
 def _sbar(s0, s1, s2, r, m):
     """sigma_bar (value only), scaled by sqrt(u^2 + rho^2) to avoid overflow at large m."""
     u, q, X, Y, S2 = _invariants(s0, s1, s2)
@@ -60,7 +60,7 @@ def _sbar(s0, s1, s2, r, m):
                             / (2.0 * (1.0 + r))) ** (1.0 / m)
 
 
-@njit(cache=True)
+@jit.njit
 def _hill(s0, s1, s2, r, m):
     """sigma_bar, gradient (a0, a1, a2) and Hessian (h00, h01, h02, h11, h12, h22).
 
@@ -112,13 +112,13 @@ def _hill(s0, s1, s2, r, m):
     return sb, a0, a1, a2, h00, h01, h02, h11, h12, h22
 
 
-@njit(cache=True)
+@jit.njit
 def equivalent_stress(s, r, m):
     """sigma_bar(s) of Hill 1979 (planar isotropy), s = (s11, s22, s12)."""
     return _sbar(s[0], s[1], s[2], r, m)
 
 
-@njit(cache=True)
+@jit.njit
 def yield_derivatives(s, r, m, a, H):
     """sigma_bar(s); writes a = d sigma_bar/ds (3) and H = d^2 sigma_bar/ds^2 (3x3)."""
     sb, a0, a1, a2, h00, h01, h02, h11, h12, h22 = _hill(s[0], s[1], s[2], r, m)
@@ -129,7 +129,7 @@ def yield_derivatives(s, r, m, a, H):
     return sb
 
 
-@njit(cache=True)
+@jit.njit
 def _inv3(a00, a01, a02, a11, a12, a22):
     """Inverse of a symmetric 3x3 matrix (upper triangle in, upper triangle out), cofactors."""
     c00 = a11 * a22 - a12 * a12
@@ -142,7 +142,7 @@ def _inv3(a00, a01, a02, a11, a12, a22):
     return c00 / det, c01 / det, c02 / det, c11 / det, c12 / det, c22 / det
 
 
-@njit(cache=True)
+@jit.njit
 def _residual(s0, s1, s2, mu, g0, g1, g2, p_n, k, mat):
     """Scaled closest-point residual at (s^ = s/k, mu = E dlambda / k):
 
@@ -160,7 +160,7 @@ def _residual(s0, s1, s2, mu, g0, g1, g2, p_n, k, mat):
     return Rn, R0, R1, R2, Rf, a0, a1, a2, h00, h01, h02, h11, h12, h22, hs
 
 
-@njit(cache=True)
+@jit.njit
 def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat):
     """Return map on scalars. Returns (s0, s1, s2, D00, D01, D02, D11, D12, D22, ep0, ep1, ep2,
     p_new, status); on failure (status -1) the elastic trial state."""
@@ -256,7 +256,7 @@ def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat):
     return out + (1,)
 
 
-@njit(cache=True)
+@jit.njit
 def return_map(e, ep_n, p_n, mat, s_out, D_out, ep_out):
     """Closest-point projection (backward Euler, associated flow) for the total strain e.
 
@@ -282,7 +282,7 @@ def return_map(e, ep_n, p_n, mat, s_out, D_out, ep_out):
     return p, st
 
 
-@njit(cache=True)
+@jit.njit
 def thickness_strain(e, ep, mat):
     """e33 = -(ep11 + ep22) - nu/(1-nu) ((e11 - ep11) + (e22 - ep22)):
     plastic incompressibility plus the plane-stress elastic part."""

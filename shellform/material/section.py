@@ -14,12 +14,12 @@ section exactly.
 """
 
 import numpy as np
-from numba import njit
 
 from shellform.errors import InputError
 from shellform.material import E_, NU_
 from shellform.material import hencky
 from shellform.material.hill79 import _return_core, thickness_strain
+from shellform import _jit as jit
 
 
 def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
@@ -30,7 +30,7 @@ def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * x, 0.5 * w
 
 
-@njit(cache=True)
+@jit.njit
 def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
     """One layer at section strain e = (E11, E22, 2 E12): stress s conjugate to e, tangent Dt,
     new plastic strain; returns (p_new, status, e33). w: scratch (3, 16).
@@ -71,7 +71,7 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
     return p, st, thickness_strain(eps, ep_new, mat)
 
 
-@njit(cache=True)
+@jit.njit
 def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_tangent,
                      S, D, ep_new, p_new):
     """Resultants S = (N, M) (6) and section tangent D (6x6) of the layered section of initial
@@ -114,7 +114,7 @@ def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_
     return (-1 if failed else nplastic), e33
 
 
-@njit(cache=True)
+@jit.njit
 def elastic_section(em, k, t, mat, S, D):
     """Closed-form elastic resultants N = t C em, M = t^3/12 C k and D = diag(t C, t^3/12 C)."""
     E, nu = mat[E_], mat[NU_]

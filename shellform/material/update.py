@@ -22,9 +22,10 @@ import numba
 import numpy as np
 
 from shellform.material import section
+from shellform import _jit as jit
 
 
-@numba.njit(parallel=True)  # not cached: numba would not see edits of section.py
+@jit.njit(parallel=True)
 def section_update(e, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, lever_stretch, ep, p, stretch,
                    S, D, elastic_tangent=False):
     nplastic, nfail, nguard = 0, 0, 0

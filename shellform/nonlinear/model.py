@@ -22,6 +22,7 @@ from shellform.assembly.sheet_kernels import SheetKernels
 from shellform.material import hencky, hill79, section
 from shellform.material.update import section_update
 from shellform.nonlinear.assemble import CellArrayForms
+from shellform import _jit as jit
 
 
 @dataclass
@@ -201,7 +202,7 @@ class SheetModel:
         return V / comm.allreduce(float(np.sum(self.cell_area)), op=MPI.SUM) - 1.0
 
 
-@numba.njit(cache=True)
+@jit.njit
 def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
     """Per cell: the thickness strain of every layer (hill79.thickness_strain) at strains
     e_m + zeta t k, weighted through the thickness and averaged over the quadrature points."""
@@ -217,7 +218,7 @@ def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
     return e33
 
 
-@numba.njit(cache=True)
+@jit.njit
 def _surface_strains(strain):
     """Per cell: the principal values of the mid-surface Hencky strain 1/2 ln(I + 2E), of the
     tensor averaged over the quadrature points (major >= minor)."""

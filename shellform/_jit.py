@@ -1,0 +1,104 @@
+"""shellform's numba code: compiled once, cached on disk under a key of the sources.
+
+numba's own cache checks only the file of the function it compiles, not the files of the
+functions it calls: an edit of hill79.py would leave the compiled section update, which calls
+it, stale. So every numba function of the package is cached in a folder named by a hash of all
+the package's modules that hold numba code: an edit of any of them recompiles them once, and
+a fresh process otherwise loads machine code instead of compiling (about 30 s saved on every
+run of the sheet).
+
+The folder is NUMBA_CACHE_DIR/shellform-HASH when the user sets NUMBA_CACHE_DIR, else
+~/.cache/shellform/numba/HASH (XDG_CACHE_HOME respected). Other numba code in the process keeps
+its own cache location.
+
+The FFCx kernels are called through their addresses, passed as integers (``call_kernel``), so
+that the loops around them hold no address of this process and can be cached too.
+"""
+
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
+
+_PACKAGE = Path(__file__).resolve().parent
+_NUMBA_MODULES = ("_jit.py", "assembly", "material", "contact/frames.py", "nonlinear/model.py",
+                  "nonlinear/assemble.py")
+
+
+def _source_key() -> str:
+    h = hashlib.sha256(numba.__version__.encode())
+    for entry in _NUMBA_MODULES:
+        path = _PACKAGE / entry
+        for f in sorted(path.rglob("*.py")) if path.is_dir() else [path]:
+            h.update(f.relative_to(_PACKAGE).as_posix().encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def cache_dir() -> Path:
+    key = _source_key()
+    user = os.environ.get("NUMBA_CACHE_DIR")
+    if user:
+        return Path(user) / f"shellform-{key}"
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return base / "shellform" / "numba" / key
+
+
+_CACHE_DIR = str(cache_dir())
+
+
+def njit(*args, **options):
+    """numba.njit(cache=True, ...) with the cache in shellform's source-keyed folder (numba binds
+    a function to its cache folder when it is decorated)."""
+
+    def decorate(f):
+        saved = numba.config.CACHE_DIR
+        numba.config.CACHE_DIR = _CACHE_DIR
+        try:
+            return numba.njit(cache=True, **options)(f)
+        finally:
+            numba.config.CACHE_DIR = saved
+
+    if args and callable(args[0]):
+        return decorate(args[0])
+    return decorate
+
+
+_f8p, _i4p, _u1p = types.CPointer(types.float64), types.CPointer(types.int32), types.CPointer(types.uint8)
+
+
+@intrinsic
+def call_kernel(typingctx, address, A, w, c, coords, local, perm):
+    """The UFCx kernel at `address` (an integer) on the arrays' data:
+    void tabulate_tensor(double *A, const double *w, const double *c, const double *coords,
+                         const int *local_index, const uint8_t *permutation, void *custom_data)
+    with custom_data NULL."""
+    arrays = (A, w, c, coords, local, perm)
+    dtypes = (types.float64,) * 4 + (types.int32, types.uint8)
+    if not isinstance(address, types.Integer) or any(
+            not isinstance(a, types.Array) or a.dtype != d for a, d in zip(arrays, dtypes)):
+        return None
+    sig = types.void(address, A, w, c, coords, local, perm)
+
+    def codegen(context, builder, signature, args):
+        double, i32, i8 = ir.DoubleType(), ir.IntType(32), ir.IntType(8)
+        fnty = ir.FunctionType(ir.VoidType(), [double.as_pointer()] * 4 + [i32.as_pointer(), i8.as_pointer(),
+                                                                            i8.as_pointer()])
+        fn = builder.inttoptr(args[0], fnty.as_pointer())
+        data = [context.make_array(t)(context, builder, v).data for t, v in zip(signature.args[1:], args[1:])]
+        data = [builder.bitcast(d, fnty.args[i]) for i, d in enumerate(data)]
+        builder.call(fn, data + [ir.Constant(i8.as_pointer(), None)])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+def kernel_address(kernel) -> int:
+    """The address of a cffi kernel pointer (FFCx's tabulate_tensor_float64) as an integer."""
+    import cffi
+
+    return int(cffi.FFI().cast("uintptr_t", kernel))
