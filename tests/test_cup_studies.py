@@ -18,14 +18,15 @@ from shellform.studies.cup_hard import folder
 
 
 def test_picks_take_the_cheapest_run_within_each_tolerance():
-    rows = [{"case": "fine", "finished": True, "wall_s": 100.0, "worst_rel_diff": 0.0},
-            {"case": "a", "finished": True, "wall_s": 10.0, "worst_rel_diff": 0.08},
-            {"case": "b", "finished": True, "wall_s": 30.0, "worst_rel_diff": 0.03},
-            {"case": "c", "finished": False, "wall_s": 5.0, "worst_rel_diff": 0.001},  # stopped: never
-            {"case": "d", "finished": True, "wall_s": 40.0, "worst_rel_diff": 0.004}]
-    chosen = {p["tolerance"]: p["case"] for p in cup_accuracy.picks(rows, "fine")}
-    assert chosen == {0.01: "d", 0.05: "b", 0.10: "a"}
-    none = cup_accuracy.picks(rows, "fine", tolerances=(1e-4,))[0]
+    rows = [{"case": "fine", "finished": True, "wall_s": 100.0, "rel_diff_DX": 0.0, "worst_rel_diff": 0.0},
+            {"case": "a", "finished": True, "wall_s": 10.0, "rel_diff_DX": -0.08, "worst_rel_diff": 0.2},
+            {"case": "b", "finished": True, "wall_s": 30.0, "rel_diff_DX": 0.03, "worst_rel_diff": 0.03},
+            {"case": "c", "finished": False, "wall_s": 5.0, "rel_diff_DX": 0.001, "worst_rel_diff": 0.001},  # stopped
+            {"case": "d", "finished": True, "wall_s": 40.0, "rel_diff_DX": -0.004, "worst_rel_diff": 0.004}]
+    chosen = {(p["quantity"], p["tolerance"]): p["case"] for p in cup_accuracy.picks(rows, "fine", ("DX",))}
+    assert chosen == {("DX", 0.01): "d", ("DX", 0.05): "b", ("DX", 0.10): "a",
+                      ("all", 0.01): "d", ("all", 0.05): "b", ("all", 0.10): "b"}
+    none = cup_accuracy.picks(rows, "fine", ("DX",), tolerances=(1e-4,))[0]
     assert none["case"] == "none coarser than fine" and none["wall_s"] == ""
 
 
@@ -45,6 +46,6 @@ def test_numisheet_cost_short(tmp_path):
     assert abs(rows[1]["rel_diff_force_1.5"]) < 0.05 and abs(rows[1]["rel_diff_DD_1.5"]) < 0.05
     with open(tmp_path / "numisheet_cost_picks.csv") as f:
         for p in csv.DictReader(f):
-            if p["worst_rel_diff"]:
-                assert float(p["worst_rel_diff"]) <= float(p["tolerance"])
+            if p["rel_diff"]:
+                assert abs(float(p["rel_diff"])) <= float(p["tolerance"])
     assert (tmp_path / "numisheet_cost_error_time.png").stat().st_size > 0

@@ -1,5 +1,6 @@
 """What a cup run's answers cost: its quantities at each report against its wall time, each with
-its relative difference from the finest run of the study, and the cheapest run within a tolerance.
+its relative difference from the finest run of the study, and the cheapest run within a
+tolerance, for each quantity and for all at once.
 
 Shared by the cup studies that vary the mesh and the increment (cup-mesh, numisheet-cost). A run
 is a (name, scene) whose summary.json and force_stroke.csv lie in the study's folder
@@ -51,15 +52,18 @@ def columns(reports: tuple[str, ...], measures=MEASURES) -> list[str]:
             "wall_s", *qs, *(f"rel_diff_{q}" for q in qs), "worst_rel_diff", "stopped"]
 
 
-def picks(rows: list[dict], finest: str, tolerances=(0.01, 0.05, 0.10)) -> list[dict]:
-    """For each tolerance, the cheapest finished run (other than the finest) whose every quantity
-    lies within it of the finest run; none when no coarser run does."""
+def picks(rows: list[dict], finest: str, qs: tuple[str, ...], tolerances=(0.01, 0.05, 0.10)) -> list[dict]:
+    """For each quantity (and for all of them at once) and each tolerance, the cheapest finished
+    run other than the finest whose difference from the finest lies within it; "none" when no
+    coarser run does."""
     out = []
-    for tol in tolerances:
-        within = [r for r in rows if r["case"] != finest and r["finished"] and r["worst_rel_diff"] <= tol]
-        best = min(within, key=lambda r: r["wall_s"], default=None)
-        out.append({"tolerance": tol, "case": best["case"] if best else "none coarser than " + finest,
-                    "wall_s": best["wall_s"] if best else "", "worst_rel_diff": best["worst_rel_diff"] if best else ""})
+    for q in (*qs, "all"):
+        key = "worst_rel_diff" if q == "all" else f"rel_diff_{q}"
+        for tol in tolerances:
+            within = [r for r in rows if r["case"] != finest and r["finished"] and key in r and abs(r[key]) <= tol]
+            best = min(within, key=lambda r: r["wall_s"], default=None)
+            out.append({"quantity": q, "tolerance": tol, "case": best["case"] if best else f"none coarser than {finest}",
+                        "wall_s": best["wall_s"] if best else "", "rel_diff": best[key] if best else ""})
     return out
 
 
@@ -94,7 +98,7 @@ def write(out: Path, stem: str, runs, finest: str, reports: tuple[str, ...], tit
     """STEM.csv, STEM_picks.csv and STEM_error_time.png in out; returns (rows, picks)."""
     rows = table(out, runs, finest, reports, measures)
     write_csv(Path(out) / f"{stem}.csv", rows, columns(reports, measures))
-    chosen = picks(rows, finest)
-    write_csv(Path(out) / f"{stem}_picks.csv", chosen, ["tolerance", "case", "wall_s", "worst_rel_diff"])
+    chosen = picks(rows, finest, quantities(reports, measures))
+    write_csv(Path(out) / f"{stem}_picks.csv", chosen, ["quantity", "tolerance", "case", "wall_s", "rel_diff"])
     plot(Path(out) / f"{stem}_error_time.png", rows, quantities(reports, measures), title, finest)
     return rows, chosen
