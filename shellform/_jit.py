@@ -68,9 +68,6 @@ def njit(*args, **options):
     return decorate
 
 
-_f8p, _i4p, _u1p = types.CPointer(types.float64), types.CPointer(types.int32), types.CPointer(types.uint8)
-
-
 @intrinsic
 def call_kernel(typingctx, address, A, w, c, coords, local, perm):
     """The UFCx kernel at `address` (an integer) on the arrays' data:

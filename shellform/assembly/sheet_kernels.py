@@ -31,6 +31,7 @@ from shellform.assembly.kernels import reference_fields
 from shellform.assembly.sheet_element import NDOF, SheetElement, build_q, congruence
 from shellform import _jit as jit
 from shellform._jit import kernel_address
+
 _OPTIONS = {"scalar_type": "float64"}
 
 
