@@ -299,6 +299,18 @@ def validate(s: Scene) -> None:
     _validate_loads(s)
     _validate_process(s)
     _validate_tools(s)
+    _validate_size(s)
+
+
+def _validate_size(s: Scene) -> None:
+    """A mesh whose estimated memory exceeds what the machine allows is refused before it is built."""
+    from shellform.mesh import budget
+
+    g, m = s.geometry, s.mesh
+    cells = budget.estimated_cells(g.lx, g.ly, g.region, m.kind, m.n, m.refine)
+    need, have = budget.estimated_bytes(cells, s.nonlinear or s.tools is not None), budget.available_bytes()
+    _require(need <= have, "mesh.n", f"n = {m.n} (refine {m.refine}) makes about {cells:,} cells, which need about "
+             f"{need / 1e9:.3g} GB; this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
 
 
 def _validate_effects(s: Scene) -> None:

@@ -233,3 +233,29 @@ def test_square_cup_scene():
     full = scene.from_dict(cup(geometry={"region": "full"}, supports={"left": "free", "bottom": "free"}))
     assert full.tools == scene.ToolsSpec()
     assert scene.from_dict({}).tools is None  # no [tools] table: no tools
+
+
+def test_a_mesh_too_large_for_the_machine_is_refused_before_it_is_built(monkeypatch):
+    """mesh.n = 20000 on the square plate would make 8e8 cells: refused naming mesh.n with its
+    estimated cells and memory; under a 1 GB limit even a 400 x 400 quarter is refused."""
+    from shellform.mesh import budget
+
+    with pytest.raises(InputError) as err:
+        scene.from_dict({"mesh": {"n": 20000}})
+    assert err.value.field == "mesh.n" and "800,000,000 cells" in str(err.value) and "GB" in str(err.value)
+    scene.from_dict({"mesh": {"n": 400}})  # 320,000 cells: about 2.5 GB, fits
+    monkeypatch.setattr(budget, "available_bytes", lambda: 1e9)
+    with pytest.raises(InputError) as err:
+        scene.from_dict({"mesh": {"n": 400}})
+    assert err.value.field == "mesh.n" and "320,000 cells" in str(err.value)
+
+
+@pytest.mark.parametrize("kind, region, n, refine", [("structured", "quarter", 7, 1), ("structured", "full", 6, 0),
+                                                     ("unstructured", "quarter", 8, 0)])
+def test_estimated_cells_match_the_built_mesh(kind, region, n, refine):
+    from shellform.mesh import budget, rectangle
+
+    built = rectangle(MPI.COMM_WORLD, 2.0, 1.5, region=region, kind=kind, n=n, refine=refine).mesh
+    cells = built.topology.index_map(2).size_global
+    estimate = budget.estimated_cells(2.0, 1.5, region, kind, n, refine)
+    assert estimate == cells if kind == "structured" else abs(estimate - cells) <= 0.2 * cells

@@ -1,0 +1,57 @@
+"""Will the mesh fit? The cells a [mesh] section makes and the memory a run on them needs,
+estimated before anything is built, so that a mesh too large for the machine is an input error
+naming mesh.n instead of an allocation failure deep inside DOLFINx.
+
+Bytes per cell, measured on the 2-core machine (peak resident memory, `shellform run`):
+- linear plate or shell: 5.4 kB per cell (square plate, 320k -> 1.28M cells: 1.8 -> 7.0 GB);
+- nonlinear sheet (layers, tangents, contact): about 50 kB per cell (square cup, 4,608 cells:
+  0.82 GB with a base of about 0.6 GB);
+- a process's base (Python, DOLFINx, PETSc, the compiled kernels): 0.6 GB.
+The estimate is rounded up (6 and 60 kB) and meant to catch meshes that are orders of
+magnitude too large, not to predict a run's memory.
+"""
+
+import math
+import os
+
+LINEAR_BYTES_PER_CELL = 6e3
+NONLINEAR_BYTES_PER_CELL = 60e3
+BASE_BYTES = 0.6e9
+
+
+def estimated_cells(lx: float, ly: float, region: str, kind: str, n: int, refine: int) -> int:
+    """Triangles of the rectangle() mesh (structured: exact; gmsh: about 2.31 per h^2 of area)."""
+    w, h = (lx, ly) if region == "full" else (lx / 2, ly / 2)
+    if kind == "structured":
+        ny = max(1, round(n * ly / lx))
+        if region == "full" and n % 2 == 0 and ny % 2 == 1:
+            ny = max(2, 2 * round(n * ly / lx / 2))
+        base = 2 * n * ny
+    else:  # equilateral triangles of side w / n: area sqrt(3)/4 (w/n)^2 each
+        base = math.ceil(w * h / (math.sqrt(3) / 4 * (w / n) ** 2))
+    return int(base * 4**refine)
+
+
+def available_bytes() -> float:
+    """The memory this process may use: the least of the machine's RAM, the cgroup's limit and the
+    address-space and data limits (ulimit -v, -d)."""
+    import resource
+
+    limits = [os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")]
+    for path in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            text = open(path).read().strip()
+        except OSError:
+            continue
+        if text.isdigit():
+            limits.append(float(text))
+    for which in (resource.RLIMIT_AS, resource.RLIMIT_DATA):
+        soft, _ = resource.getrlimit(which)
+        if soft != resource.RLIM_INFINITY:
+            limits.append(float(soft))
+    return float(min(limits))
+
+
+def estimated_bytes(cells: int, nonlinear: bool, ranks: int = 1) -> float:
+    per_cell = NONLINEAR_BYTES_PER_CELL if nonlinear else LINEAR_BYTES_PER_CELL
+    return cells * per_cell + ranks * BASE_BYTES
