@@ -11,7 +11,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform import supports as named_supports
-from shellform.contact.semi_inverse import FREE, ContactControls, SemiInverseDriver
+from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import rectangle
 from shellform.nonlinear.driver import Controls
@@ -91,8 +91,7 @@ class DrawingProblem:
         d = self.driver
         if d.holder is None or d.holder.force <= 0 or not d.state.closed[0]:
             return 0.0
-        net = np.where(d.state.tool != FREE, d.reactions()[:, 2], 0.0)
-        return 1.0 - d.holder.squeeze_left(d.pinched, net) / d.holder.force
+        return 1.0 - d.holder.squeeze_left(d.pinched, d.net_normal_forces()) / d.holder.force
 
     def holder_largest_at(self) -> tuple[float, float]:
         """Initial (x, y) of the node with the largest holder force (mm), all ranks."""

@@ -492,6 +492,11 @@ class SemiInverseDriver(Driver):
         """(n_owned, 3) residual on the u, v, w rows in the nodal frames (tool forces on constrained rows)."""
         return self.residual_full[: self.n_owned * BS].reshape(-1, BS)[:, :3]
 
+    def net_normal_forces(self) -> np.ndarray:
+        """Each owned node's net normal force R0 from its tool (die minus holder on a pinched
+        node; 0 off the tools)."""
+        return np.where(self.state.tool != FREE, self.reactions()[:, 2], 0.0)
+
     def _update_pass(self, lam):
         """After a converged pass: normal forces from the reactions, the holder's faces, release
         of tensile nodes (not pinched), join of penetrating ones. Returns (set changes on all
@@ -500,7 +505,7 @@ class SemiInverseDriver(Driver):
         s, x = self.state, self.positions()
         comm = self.model.mesh.comm
         on = s.tool != FREE
-        net = np.where(on, self.reactions()[:, 2], 0.0)
+        net = self.net_normal_forces()
         s.pressure = np.maximum(net, 0.0)
         changes = 0
         under = self.holder.under(x) if self.holder is not None else np.zeros(self.n_owned, dtype=bool)
