@@ -14,7 +14,6 @@ because eps enters only through U(eps) - lam : eps and lam only linearly. Elimin
 G is factored once per cell (Cholesky); no saddle-point solve is needed.
 """
 
-import numba
 import numpy as np
 from shellform import _jit as jit
 

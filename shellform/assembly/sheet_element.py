@@ -27,7 +27,6 @@ from functools import cached_property
 
 import basix
 import basix.ufl
-import numba
 import numpy as np
 
 from shellform.assembly.hybrid_element import HybridElement

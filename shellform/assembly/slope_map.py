@@ -11,7 +11,6 @@ columns ``cols[r]`` with coefficients given by ``codes[r]`` (0 none, 1 one, 2 + 
 kept for the study that shows why the map is needed.
 """
 
-import numba
 import numpy as np
 from shellform import _jit as jit
 

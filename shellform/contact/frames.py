@@ -10,7 +10,6 @@ rotated). The tangents are chosen so that a symmetry plane keeps its meaning: wh
 condition u = 0 or v = 0 stays a condition on one rotated slot.
 """
 
-import numba
 import numpy as np
 
 from shellform.assembly.sheet_element import BS

@@ -19,14 +19,20 @@ NONLINEAR_BYTES_PER_CELL = 60e3
 BASE_BYTES = 0.6e9
 
 
+def structured_ny(lx: float, ly: float, region: str, n: int) -> int:
+    """Divisions along y of the structured mesh with n along x (even on a full blank with even n,
+    so that the centre is a vertex)."""
+    ny = max(1, round(n * ly / lx))
+    if region == "full" and n % 2 == 0 and ny % 2 == 1:
+        ny = max(2, 2 * round(n * ly / lx / 2))
+    return ny
+
+
 def estimated_cells(lx: float, ly: float, region: str, kind: str, n: int, refine: int) -> int:
     """Triangles of the rectangle() mesh (structured: exact; gmsh: about 2.31 per h^2 of area)."""
     w, h = (lx, ly) if region == "full" else (lx / 2, ly / 2)
     if kind == "structured":
-        ny = max(1, round(n * ly / lx))
-        if region == "full" and n % 2 == 0 and ny % 2 == 1:
-            ny = max(2, 2 * round(n * ly / lx / 2))
-        base = 2 * n * ny
+        base = 2 * n * structured_ny(lx, ly, region, n)
     else:  # equilateral triangles of side w / n: area sqrt(3)/4 (w/n)^2 each
         base = math.ceil(w * h / (math.sqrt(3) / 4 * (w / n) ** 2))
     return int(base * 4**refine)

@@ -13,6 +13,7 @@ import numpy as np
 
 import dolfinx.mesh
 from shellform.errors import InputError
+from shellform.mesh.budget import structured_ny
 
 SIDES = ("left", "right", "bottom", "top")  # x = x_min, x = x_max, y = y_min, y = y_max
 SIDE_TAG = {"left": 1, "right": 2, "bottom": 3, "top": 4}
@@ -92,9 +93,7 @@ def rectangle(comm, lx, ly, region="full", kind="structured", n=8, diagonal="rig
     pts = _check_points(points, bounds, tol)
 
     if kind == "structured":
-        ny = max(1, round(n * ly / lx))
-        if region == "full" and n % 2 == 0 and ny % 2 == 1:
-            ny = max(2, 2 * round(n * ly / lx / 2))
+        ny = structured_ny(lx, ly, region, n)
         msh = dolfinx.mesh.create_rectangle(
             comm,
             [np.array(bounds[0::2]), np.array(bounds[1::2])],
