@@ -72,6 +72,7 @@ class ContactControls:
     stick_stiffness: float = 0.01  # k_t = stick_stiffness E A_i / h (module docstring)
     friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
+    early_set: bool = True  # end a pass once the set will change and the steps are below `penetration`
     refresh_normal: bool = True  # friction's normal forces from every iterate after the first (not per pass)
     consistent_friction: bool = True  # with refresh_normal: the slip force's dp/dq in the tangent
     holder_spread: str = "area"  # "area" or "rigid" (holder.py)
@@ -158,6 +159,7 @@ class SemiInverseDriver(Driver):
         self._scale = 0.0
         self._rub = (np.zeros(0, dtype=np.int64), np.zeros(0), self.X[:n].copy(), np.zeros((0, 3, 3)))
         self._refreshing = False  # normal forces from every iterate's reactions (refresh_normal)
+        self._early, self._step = False, np.inf  # a pass ended early; the last accepted step's largest move
         self.line_search_factors: list[float] = []  # alpha of every accepted Newton step (this increment)
         self.pass_residuals: list[list[float]] = []
         self.times["contact_s"] = 0.0
@@ -428,6 +430,7 @@ class SemiInverseDriver(Driver):
             self._pinch(self.holder.under(self.x_n), grow=False)
         self._extrapolate_normal_forces(lam)
         self._passes = self._changes = 0
+        self._early = False
         self.line_search_factors = []
         self.pass_residuals = []  # |R| of every iterate, one list per pass (this increment)
         self._r_prev, self._omega = None, 1.0  # Aitken's memory of the normal-force updates
@@ -441,12 +444,13 @@ class SemiInverseDriver(Driver):
             self.pass_residuals.append(res)
             if not ok:
                 return False, iterations, residuals, ev
+            early, self._early = self._early, False
             changes, dp, pn = self._update_pass(lam)
             if self.contact.trace:
                 say(f"    pass {self._passes}: {its} iterations, |R| {res[0]:.3e} -> {res[-1]:.3e}, {changes} set "
                     f"changes, friction change |mu dp| {dp:.3e} of |mu p| {pn:.3e}")
             self._changes += changes
-            if changes == 0 and dp <= self.contact.friction_rtol * pn:
+            if changes == 0 and dp <= self.contact.friction_rtol * pn and not early:
                 return True, iterations, residuals, ev
         self._cause = (f"the contact did not settle in {self.contact.max_passes} passes (last pass: {changes} "
                        f"set changes, friction change {dp:.3g} N)")
@@ -498,8 +502,27 @@ class SemiInverseDriver(Driver):
             if not ok:
                 return False, it + 1, residuals, ev
             residuals.append(norm)
+            if self.contact.early_set and self._step <= self.contact.penetration and self._set_will_change(lam):
+                self._early = True  # the set changes: end the pass here, not at convergence
+                return True, it + 1, residuals, ev
         self._cause = f"no convergence in {c.max_iterations} iterations on a fixed contact set"
         return False, c.max_iterations, residuals, ev
+
+    def _set_will_change(self, lam) -> bool:
+        """Whether the contact set will change at the end of this pass, seen from this iterate:
+        a free node penetrating a tool, a node drawn under the closed holder, or a node (not
+        pinched) pulled off its tool by more than 1e-3 of the largest normal force."""
+        s, x = self.state, self.positions()
+        on, can = s.tool != FREE, s.toggles < self.contact.max_toggles
+        depth = np.min([g for g, _ in self._gaps(x, lam)], axis=0)
+        join = ~on & (depth < -self.contact.penetration)
+        if self.holder is not None and s.closed[0]:
+            join |= ~on & self.holder.under(x)
+        net = self.net_normal_forces()
+        comm = self.model.mesh.comm
+        scale = comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX)
+        release = on & ~self.pinched & (net < -1e-3 * scale)
+        return comm.allreduce(int(np.sum((join | release) & can)), op=MPI.SUM) > 0
 
     def _line_search(self, lam, s0, jump):
         """q += alpha dq, alpha first limited by the trust region (no node moves more than
@@ -532,6 +555,7 @@ class SemiInverseDriver(Driver):
             shorter = None if s0 is None else shorten(alpha, s0, s1)
             if shorter is None:
                 self.line_search_factors.append(alpha)
+                self._step = alpha * move
                 return True, norm, scale, ev, jump
             alpha = shorter
         self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
