@@ -466,51 +466,91 @@ def test_friction_raises_the_punch_force():
     assert out[0.2][1] < out[0.0][1]
 
 
-def test_slip_tangent_carries_the_normal_force_change():
-    """Newton updates the friction's normal forces at every iterate (refresh_normal), so the
-    tangent carries the slipping force's dependence on them, d(mu p m)/dq = mu m K_(i,n): on the
-    cup drawn 2 mm, in the next increment's converged state (nodes slipping on the punch), the
-    tangent's columns of the free nodes next to them match central differences of the residual
-    on their tangential rows to 1e-6 of the largest entry; without the term they are off by 1e-3."""
-    s = _cup()
-    p = DrawingProblem.from_scene(s, verbose=False)
-    d, m = p.driver, p.driver.model
-    d.run(2.0 / s.tools.stroke)
-    lam = d.lam + 0.2 / s.tools.stroke
-    assert d._newton(lam)[0]
-    slip = np.flatnonzero(d._slipping & (d.state.tool == 0) & ~d.pinched)
-    assert slip.size > 0
-    near = np.unique(m.dofs[np.isin(m.dofs, slip).any(axis=1)])
-    free = [b for b in near if b < d.n_owned and d.state.tool[b] == FREE][:3]
-    rows = (BS * slip[:, None] + np.arange(2)).ravel()
-
+def _tangent_error(d, lam, rows, columns, h=1e-6):
+    """Largest |K e_j - (R(q + h v) - R(q - h v)) / 2h| on `rows` over the (j, v) in columns (a
+    tangent column and the perturbation of q, global coordinates, that it stands for), relative
+    to the largest entry; the frames, friction and normal forces follow q as in Newton."""
     def residual(tangent):
         d._constraints(lam)
         d._refreshing = True
         d.residual(lam, tangent=tangent)
         return d.b.getArray()[rows].copy()
 
+    residual(True)
+    K = d.A.copy()
+    worst, size = 0.0, 0.0
+    for j, v in columns:
+        e, Ke = K.createVecs()
+        e.set(0.0)
+        e.setValue(j, 1.0)
+        e.assemble()
+        K.mult(e, Ke)
+        q0 = d.q.x.array.copy()
+        d.q.x.array[:] = q0 + h * v
+        plus = residual(False)
+        d.q.x.array[:] = q0 - h * v
+        minus = residual(False)
+        d.q.x.array[:] = q0
+        column = Ke.getArray()[rows]
+        worst = max(worst, np.abs((plus - minus) / (2 * h) - column).max())
+        size = max(size, np.abs(column).max())
+    residual(True)
+    return worst / size
+
+
+def _drawn_cup(stroke):
+    """The coarse cup drawn `stroke` mm, then the next increment (0.2 mm) converged, not committed."""
+    s = _cup()
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(stroke / s.tools.stroke)
+    lam = d.lam + 0.2 / s.tools.stroke
+    assert d._newton(lam)[0]
+    return d, lam
+
+
+def test_slip_tangent_carries_the_normal_force_change():
+    """Newton updates the friction's normal forces at every iterate (refresh_normal), so the
+    tangent carries the slipping force's dependence on them, d(mu p m)/dq = mu m K_(i,n): on the
+    cup drawn 2 mm, in the next increment's converged state (nodes slipping on the punch), the
+    tangent's columns of the free nodes next to them match central differences of the residual
+    on their tangential rows to 1e-6 of the largest entry; without the term they are off by 1e-3."""
+    d, lam = _drawn_cup(2.0)
+    m = d.model
+    slip = np.flatnonzero(d._slipping & (d.state.tool == 0) & ~d.pinched)
+    assert slip.size > 0
+    near = np.unique(m.dofs[np.isin(m.dofs, slip).any(axis=1)])
+    free = [b for b in near if b < d.n_owned and d.state.tool[b] == FREE][:3]
+    rows = (BS * slip[:, None] + np.arange(2)).ravel()
+    columns = [(j, np.eye(d.q.x.array.size)[j]) for j in (BS * b + k for b in free for k in range(BS))
+               if j not in d.bc_dofs]
     errors = {}
     for consistent in (True, False):
         d.contact.consistent_friction = consistent
-        residual(True)
-        K = d.A.copy()
-        worst, size = 0.0, 0.0
-        for j in (BS * b + slot for b in free for slot in range(BS) if BS * b + slot not in d.bc_dofs):
-            e, Ke = K.createVecs()
-            e.set(0.0)
-            e.setValue(j, 1.0)
-            e.assemble()
-            K.mult(e, Ke)
-            q0, h = d.q.x.array.copy(), 1e-6
-            d.q.x.array[j] += h
-            plus = residual(False)
-            d.q.x.array[:] = q0
-            d.q.x.array[j] -= h
-            minus = residual(False)
-            d.q.x.array[:] = q0
-            column = Ke.getArray()[rows]
-            worst = max(worst, np.abs((plus - minus) / (2 * h) - column).max())
-            size = max(size, np.abs(column).max())
-        errors[consistent] = worst / size
+        errors[consistent] = _tangent_error(d, lam, rows, columns)
     assert errors[True] <= 1e-6 and errors[False] >= 1e-3, errors
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.1])
+def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
+    """A node moving along the punch's nose turns its frame: its tangential rows t_a . R change
+    by -R0 W_ab dx_b (W the nose's shape operator). On the cup drawn 6 mm, for nodes on the nose,
+    a step along their own tangents matches the tangent's columns to 1e-6 of the largest entry
+    frictionless, 1e-5 with the scene's friction (whose projection on the turning tangent plane,
+    of order mu times the term, is left out); without the term they are off by 1e-4."""
+    d, lam = _drawn_cup(6.0)
+    d.mu = mu
+    nose = np.flatnonzero((d.state.tool == 0) & (np.abs(d._curvature).max(axis=(1, 2)) > 0))[:3]
+    assert nose.size > 0
+    rows = (BS * nose[:, None] + np.arange(2)).ravel()
+    columns = []
+    for b in nose:
+        for a in np.flatnonzero(~d.sym_fixed[b, :2]):
+            v = np.zeros(d.q.x.array.size)
+            v[BS * b:BS * b + 3] = d.frames[b, a]
+            columns.append((BS * b + a, v))
+    errors = {}
+    for curvature in (True, False):
+        d.contact.tool_curvature = curvature
+        errors[curvature] = _tangent_error(d, lam, rows, columns)
+    assert errors[True] <= (1e-5 if mu else 1e-6) and errors[False] >= 1e-4, errors
