@@ -11,7 +11,8 @@
                                             cup-strain (before and after finite strains),
                                             cup-paper (the paper's Figs. 5 to 8), numisheet
                                             (the NUMISHEET'93 cups to 40 mm), numisheet-cost
-                                            (the aluminium cup's accuracy against time)
+                                            (the aluminium cup's accuracy against time),
+                                            cup-benchmark (its speed at 900 to 10,000 cells)
 """
 
 import argparse
@@ -58,7 +59,7 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
 
 
 STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain", "cup-paper", "numisheet", "numisheet-cost"]
+           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark"]
 
 
 def main(argv=None) -> int:

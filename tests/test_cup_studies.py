@@ -49,3 +49,26 @@ def test_numisheet_cost_short(tmp_path):
             if p["rel_diff"]:
                 assert abs(float(p["rel_diff"])) <= float(p["tolerance"])
     assert (tmp_path / "numisheet_cost_error_time.png").stat().st_size > 0
+
+
+@pytest.mark.mpi
+def test_cup_benchmark_short(tmp_path):
+    """cup-benchmark on a 6 x 6 quarter mesh, 1 mm, on 1 and 2 ranks: the split of an iteration
+    adds up to its time, and the two runs draw the same cup (draw-in and force to 1e-6)."""
+    from shellform.studies import cup_benchmark
+
+    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_level=6)
+    assert [(r["ranks"], r["cells"]) for r in rows] == [(1, 72), (2, 72)]
+    for r in rows:
+        assert r["finished"] and r["stroke_mm"] == pytest.approx(1.0)
+        parts = sum(r[f"{p}_ms"] for p in cup_benchmark.PARTS) + r["rest_ms"]
+        assert parts == pytest.approx(r["iteration_ms"], rel=1e-9)
+        assert all(r[f"{p}_ms"] > 0 for p in cup_benchmark.PARTS) and 0 <= r["rest_share"] < 1
+    assert (tmp_path / "cup_benchmark.png").stat().st_size > 0
+    with open(tmp_path / "cup_benchmark.csv") as f:
+        assert len(list(csv.DictReader(f))) == 2
+    one, two = (json.loads((cup_benchmark.case_folder(tmp_path, 6, k) / "summary.json").read_text()) for k in (1, 2))
+    for a, b in zip(one["reports"], two["reports"]):
+        assert b["punch_force_kN"] == pytest.approx(a["punch_force_kN"], rel=1e-6)
+        for k in ("DX", "DY", "DD"):
+            assert b["draw_in_mm"][k] == pytest.approx(a["draw_in_mm"][k], rel=1e-6)

@@ -1,0 +1,179 @@
+"""Benchmark: how fast the NUMISHEET'93 aluminium cup draws, and what it computes (issue 12).
+
+    shellform study cup-benchmark --out docs/results/cup_benchmark
+
+demos/numisheet93_aluminium.toml (every input stated there) at the scene's increments on
+n x n quarter meshes, n = 21, 35 and 71: 882, 2,450 and 10,082 cells, about 900, 2,500 and
+10,000 elements. The runs go one after the other, so that each wall time is the run's own; the
+2,450-cell cup is drawn once more on 2 MPI ranks (mpiexec -n 2; each rank takes half the
+cores for its threads). The 882 and 2,450-cell cups are drawn to 40 mm; the 10,082-cell cup
+to 5 mm only (STROKES), a run of hours to 40 mm on a 2-core machine: its row gives the cost of
+an iteration at that size, not the time of the whole draw.
+
+Writes cup_benchmark.csv, one row per run:
+- ranks, cells, stroke, wall time, increments, Newton iterations, contact passes;
+- one iteration's time in ms, split into the element loop, the constitutive update, the
+  contact (frames, friction, set updates), DOLFINx assembly, the MUMPS solve and the rest
+  (Python and other work between them), and the rest's share of the run;
+- the punch force, draw-in DX and DD and the peak thinning at 15 and 40 mm (where reached),
+  so that speed is always shown next to accuracy;
+and cup_benchmark.png: the iteration's split against cells, and the wall time against cells.
+
+Run one case alone (what the 2-rank line does under mpiexec):
+
+    python -m shellform.studies.cup_benchmark --n 35 --out DIR [--stroke MM]
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from shellform.results.log import say
+from shellform.results.tables import write_csv
+from shellform.studies.cup_hard import variant
+
+SCENE = "numisheet93_aluminium.toml"
+LEVELS = (21, 35, 71)
+QUICK_LEVELS = (6,)
+STROKES = {71: 5.0}  # mm; the others to the scene's 40 mm
+MPI_LEVEL = 35  # the level drawn once more on 2 ranks
+PARTS = ("element", "constitutive", "contact", "assembly", "solve")
+REPORTS = (15.0, 40.0)
+COLUMNS = ["case", "ranks", "n", "cells", "stroke_mm", "finished", "wall_s", "increments", "newton_iterations",
+           "contact_passes", "iteration_ms", *(f"{p}_ms" for p in PARTS), "rest_ms", "rest_share",
+           *(f"{q}_{mm:g}" for mm in REPORTS for q in ("force", "DX", "DD", "thinning")), "stopped"]
+
+
+def scene_for(n: int, stroke: float | None = None):
+    """The aluminium cup on an n x n quarter mesh, drawn `stroke` mm (None: the scene's 40) with
+    the scene's increments in mm."""
+    s = variant(n, SCENE)
+    s.output.png = False
+    s.output.fld = False
+    if stroke is not None and stroke != s.tools.stroke:
+        scale = s.tools.stroke / stroke
+        s.process.max_step *= scale
+        s.process.initial_step *= scale
+        s.process.report = [f * scale for f in s.process.report if f * scale <= 1.0]
+        s.tools.stroke = stroke
+    return s
+
+
+def draw_one(n: int, out: Path, stroke: float | None = None) -> None:
+    """Draw one case into out (on however many ranks this process has)."""
+    from shellform.contact.run import run as run_cup
+
+    run_cup(scene_for(n, stroke), Path(out))
+
+
+def case_folder(out: Path, n: int, ranks: int) -> Path:
+    return Path(out) / (f"n_{n}" + (f"_ranks_{ranks}" if ranks > 1 else ""))
+
+
+def row(out: Path, n: int, ranks: int) -> dict:
+    """A run's row from its summary.json."""
+    s = json.loads((case_folder(out, n, ranks) / "summary.json").read_text())
+    t, its = s["wall_time_s"], max(s["newton_iterations"], 1)
+    parts = {p: t.get(f"{p}_s", 0.0) for p in PARTS}
+    rest = t["total"] - t["setup"] - sum(parts.values())
+    r = {"case": f"n {n}" + (f", {ranks} ranks" if ranks > 1 else ""), "ranks": s["ranks"], "n": n,
+         "cells": s["cells"], "stroke_mm": s["stroke_mm"], "finished": s["stopped"] is None, "wall_s": t["total"],
+         "increments": s["increments"], "newton_iterations": s["newton_iterations"],
+         "contact_passes": s["contact_passes"], "iteration_ms": 1e3 * (t["total"] - t["setup"]) / its,
+         **{f"{p}_ms": 1e3 * v / its for p, v in parts.items()}, "rest_ms": 1e3 * rest / its,
+         "rest_share": rest / t["total"], "stopped": s["stopped"] or ""}
+    for at in s["reports"]:
+        mm = next((m for m in REPORTS if abs(at["stroke_mm"] - m) < 1e-6), None)
+        if mm is not None:
+            r.update({f"force_{mm:g}": at["punch_force_kN"], f"DX_{mm:g}": at["draw_in_mm"]["DX"],
+                      f"DD_{mm:g}": at["draw_in_mm"]["DD"], f"thinning_{mm:g}": at["max_thickness_strain"]})
+    return r
+
+
+def mpiexec() -> str | None:
+    local = Path(sys.executable).parent / "mpiexec"
+    if local.exists():
+        return str(local)
+    from shutil import which
+
+    return which("mpiexec")
+
+
+def run(out: Path, levels=LEVELS, strokes=None, mpi_level: int | None = MPI_LEVEL) -> list[dict]:
+    """Draw every case one after the other, then the 2-rank case, and write the table and plot."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    strokes = STROKES if strokes is None else strokes
+    cases = [(n, 1) for n in levels]
+    if mpi_level is not None and mpiexec() is not None:
+        cases.append((mpi_level, 2))
+    for n, ranks in cases:
+        say(f"cup-benchmark: n {n} on {ranks} rank(s)")
+        folder = case_folder(out, n, ranks)
+        if ranks == 1:
+            draw_one(n, folder, strokes.get(n))
+        else:
+            cmd = [mpiexec(), "-n", str(ranks), sys.executable, "-m", "shellform.studies.cup_benchmark",
+                   "--n", str(n), "--out", str(folder)]
+            if strokes.get(n) is not None:
+                cmd += ["--stroke", str(strokes[n])]
+            subprocess.run(cmd, check=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
+    rows = [row(out, n, ranks) for n, ranks in cases]
+    write_csv(out / "cup_benchmark.csv", rows, COLUMNS)
+    plot(out / "cup_benchmark.png", rows)
+    for r in rows:
+        say(f"{r['case']:>16s}: {r['cells']:6d} cells, {r['stroke_mm']:.0f} mm in {r['wall_s']:.0f} s, "
+            f"{r['newton_iterations']} iterations of {r['iteration_ms']:.0f} ms (rest {r['rest_ms']:.0f} ms)")
+    return rows
+
+
+def plot(path: Path, rows: list[dict]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    labels = [f"{r['cells']}\n{r['ranks']} rank" + ("s" if r["ranks"] > 1 else "") for r in rows]
+    bottom = [0.0] * len(rows)
+    for p in (*PARTS, "rest"):
+        h = [r[f"{p}_ms"] for r in rows]
+        a.bar(labels, h, bottom=bottom, label=p)
+        bottom = [x + y for x, y in zip(bottom, h)]
+    a.set_yscale("log")
+    a.set_ylabel("ms per Newton iteration (stacked)")
+    a.set_title("one iteration, split")
+    a.legend(fontsize=8)
+    for ranks, marker in ((1, "o-"), (2, "s")):
+        sel = [r for r in rows if r["ranks"] == ranks]
+        b.plot([r["cells"] for r in sel], [r["wall_s"] for r in sel], marker, label=f"{ranks} rank(s)")
+        for r in sel:
+            b.annotate(f"{r['stroke_mm']:.0f} mm", (r["cells"], r["wall_s"]), fontsize=8)
+    b.axhline(120.0, color="gray", ls="--", lw=0.8, label="issue 12: 2,500 cells in 120 s")
+    b.set_xscale("log")
+    b.set_yscale("log")
+    b.set_xlabel("cells (quarter blank)")
+    b.set_ylabel("wall time of the run [s]")
+    b.set_title("NUMISHEET'93 aluminium cup")
+    b.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None) -> None:
+    import shellform  # noqa: F401  (the DOLFINx runtime first)
+
+    parser = argparse.ArgumentParser(description="draw one cup-benchmark case (on the ranks of mpiexec)")
+    parser.add_argument("--n", type=int, required=True)
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--stroke", type=float, default=None)
+    args = parser.parse_args(argv)
+    draw_one(args.n, args.out, args.stroke)
+
+
+if __name__ == "__main__":
+    main()
