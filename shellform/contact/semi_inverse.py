@@ -405,9 +405,10 @@ class SemiInverseDriver(Driver):
             self._refresh_normal(R)  # the reactions with the holder's load, before friction
         R3 -= np.einsum("nij,nj->ni", F, self._friction)
         if K is not None and self.mu > 0:
-            for b in np.flatnonzero(np.abs(self._rate).max(axis=(1, 2)) > 0):
-                rows = [BS * b, BS * b + 1]
-                K.setValuesLocal(rows, rows, self._rate[b], addv=True)
+            b = np.flatnonzero(np.abs(self._rate).max(axis=(1, 2)) > 0)
+            if b.size:
+                rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
+                K.setValuesLocalRCV(rows, rows, self._rate[b].reshape(b.size, 4), addv=True)
             if self._refreshing and self.contact.consistent_friction:
                 self._add_slip_pressure_tangent(K)
         if K is not None and self.contact.tool_curvature:
@@ -434,7 +435,7 @@ class SemiInverseDriver(Driver):
             d(-f_i)/dq = -mu m_i (dp_i/dR0_i) K_(i,n),   dp/dR0 = 1 on a tool, sign(R0) pinched
 
         (the closed holder's share of F through sum max(-R0, 0) is left out). Non-symmetric; added
-        on the free tangent rows of every slipping node."""
+        on the free tangent rows of every slipping node, in the free columns."""
         s, m, n = self.state, self.model, self.n_owned
         coef = np.zeros(self.n_local)
         on = self._slipping & (s.tool != FREE) & (s.normal > 0)
@@ -451,6 +452,9 @@ class SemiInverseDriver(Driver):
         rows = BS * b[:, None] + np.arange(2)  # (pairs, 2): the node's tangent slots in this cell
         g = np.where(fixed[rows], 0.0, g[b])  # none on a row held by symmetry
         row = m.forms.matrices[cells, BS * local + 2]  # (pairs, cell dofs): the normal row
+        # not on the known columns: their corrections are all but zero after the first iterate,
+        # and an entry there beside the known row's unit diagonal makes MUMPS delay that pivot
+        row = np.where(fixed[m.unrolled_dofs[cells]], 0.0, row)
         values = -coef[b][:, None, None] * g[:, :, None] * row[:, None, :]
         K.setValuesLocalRCV(rows.astype(np.int32), m.unrolled_dofs[cells].astype(np.int32),
                             values.reshape(len(b), -1), addv=True)

@@ -124,7 +124,7 @@ class Driver:
             model.forms.vectors[:] = pressure * model.pressure_vectors
             fem_petsc.assemble_vector(self.f_ext, model.forms.vector)
             self.f_ext.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self.A = fem_petsc.create_matrix(model.forms.matrix)
+        self.A = fem_petsc.create_matrix(model.forms.matrix, kind="baij")
         self.b = fem_petsc.create_vector(V)
         self.dq = fem.Function(V)
         self.ksp = PETSc.KSP().create(V.mesh.comm)
