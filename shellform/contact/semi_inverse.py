@@ -164,6 +164,7 @@ class SemiInverseDriver(Driver):
         self._rub = (np.zeros(0, dtype=np.int64), np.zeros(0), self.X[:n].copy(), np.zeros((0, 3, 3)))
         self._refreshing = False  # normal forces from every iterate's reactions (refresh_normal)
         self._curvature = np.zeros((n, 2, 2))  # W of each node's tool in its tangent slots
+        self._net = np.zeros(n)  # the net normal forces of the last refreshed iterate
         self._early, self._step = False, np.inf  # a pass ended early; the last accepted step's largest move
         self.line_search_factors: list[float] = []  # alpha of every accepted Newton step (this increment)
         self.pass_residuals: list[list[float]] = []
@@ -335,7 +336,8 @@ class SemiInverseDriver(Driver):
         self._net = net
         s.pressure = np.maximum(net, 0.0)
         if self.holder is not None and s.closed[0]:
-            self._holder_faces(self._rub[2], None, net)
+            positions = self._rub[2]
+            self._holder_faces(positions, None, net)
         s.normal = s.pressure + s.holder_face
         self._friction_forces()
 
@@ -395,8 +397,10 @@ class SemiInverseDriver(Driver):
         return -self.state.holder_face
 
     def add(self, lam, x, R, K=None):
-        """Driver's nodal hook: R -= friction and open-holder forces (in the nodal frames);
-        K += the friction's stiffness in the tangent slots."""
+        """Driver's nodal hook: R -= friction and open-holder forces (in the nodal frames), the
+        friction's normal forces first taken from R where Newton's iterates update them;
+        K += the friction's stiffness in the tangent slots, the slip force's dp/dq and the
+        frames' turning on curved tools."""
         n = self.n_owned
         F = self.frames[:n]  # identity off the tools
         R3 = R[: n * BS].reshape(-1, BS)[:, :3]
@@ -452,8 +456,7 @@ class SemiInverseDriver(Driver):
         rows = BS * b[:, None] + np.arange(2)  # (pairs, 2): the node's tangent slots in this cell
         g = np.where(fixed[rows], 0.0, g[b])  # none on a row held by symmetry
         row = m.forms.matrices[cells, BS * local + 2]  # (pairs, cell dofs): the normal row
-        # not on the known columns: their corrections are all but zero after the first iterate,
-        # and an entry there beside the known row's unit diagonal makes MUMPS delay that pivot
+        # not on the known columns, whose corrections vanish after a pass's first iterate
         row = np.where(fixed[m.unrolled_dofs[cells]], 0.0, row)
         values = -coef[b][:, None, None] * g[:, :, None] * row[:, None, :]
         K.setValuesLocalRCV(rows.astype(np.int32), m.unrolled_dofs[cells].astype(np.int32),
