@@ -2,7 +2,6 @@
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -11,6 +10,7 @@ import pytest
 
 from shellform import linear
 from shellform.studies import plate, shell
+from shellform.studies.common import mpiexec
 
 SCRIPT = """
 import json, shellform
@@ -22,11 +22,6 @@ w_shell = linear.solve(shell.scene(5.0, 3, "unstructured", refine=2)).value("w")
 if MPI.COMM_WORLD.rank == 0:
     print("RESULT " + json.dumps({"plate": w_plate, "shell": w_shell}))
 """
-
-
-def mpiexec():
-    local = Path(sys.executable).parent / "mpiexec"
-    return str(local) if local.exists() else shutil.which("mpiexec")
 
 
 def on_two_ranks(tmp_path, source) -> dict:

@@ -332,7 +332,7 @@ class SemiInverseDriver(Driver):
         that Newton converges the normal forces with the displacements instead of one pass at a
         time. The contact set stays fixed."""
         s = self.state
-        net = np.where(s.tool != FREE, R[: self.n_owned * BS].reshape(-1, BS)[:, 2], 0.0)
+        net = self.net_normal_forces(R)
         self._net = net
         s.pressure = np.maximum(net, 0.0)
         if self.holder is not None and s.closed[0]:
@@ -554,17 +554,26 @@ class SemiInverseDriver(Driver):
         """Whether the contact set will change at the end of this pass, seen from this iterate:
         a free node penetrating a tool, a node drawn under the closed holder, or a node (not
         pinched) pulled off its tool by more than 1e-3 of the largest normal force."""
-        s, x = self.state, self.positions()
+        x = self.positions()
+        under = self.holder.under(x) if self.holder is not None else np.zeros(self.n_owned, dtype=bool)
+        join, release, _ = self._set_changes(x, lam, under, self.net_normal_forces(), tensile=1e-3)
+        return self.model.mesh.comm.allreduce(int(np.sum(join | release)), op=MPI.SUM) > 0
+
+    def _set_changes(self, x, lam, under, net, tensile: float):
+        """The nodes that join a tool (penetrating it by more than `penetration`, or drawn under
+        the closed holder: onto the die) and those that leave theirs (not pinched, pulled off by
+        more than `tensile` times the largest normal force), among the nodes that may still
+        switch in this increment; with the tool each joining node joins."""
+        s, comm = self.state, self.model.mesh.comm
         on, can = s.tool != FREE, s.toggles < self.contact.max_toggles
-        depth = np.min([g for g, _ in self._gaps(x, lam)], axis=0)
-        join = ~on & (depth < -self.contact.penetration)
-        if self.holder is not None and s.closed[0]:
-            join |= ~on & self.holder.under(x)
-        net = self.net_normal_forces()
-        comm = self.model.mesh.comm
-        scale = comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX)
-        release = on & ~self.pinched & (net < -1e-3 * scale)
-        return comm.allreduce(int(np.sum((join | release) & can)), op=MPI.SUM) > 0
+        scale = max(comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
+        release = on & ~self.pinched & (net < -tensile * scale) & can
+        depth = np.stack([g for g, _ in self._gaps(x, lam)])  # (tools, nodes)
+        deepest = np.argmin(depth, axis=0)
+        enters = under & ~on & s.closed[0]  # the closed holder pinches what comes under it
+        deepest[enters] = self.die
+        join = ~on & ((depth.min(axis=0) < -self.contact.penetration) | enters) & can
+        return join, release, deepest
 
     def _line_search(self, lam, s0, jump):
         """q += alpha dq, alpha first limited by the trust region (no node moves more than
@@ -626,10 +635,11 @@ class SemiInverseDriver(Driver):
         """(n_owned, 3) residual on the u, v, w rows in the nodal frames (tool forces on constrained rows)."""
         return self.residual_full[: self.n_owned * BS].reshape(-1, BS)[:, :3]
 
-    def net_normal_forces(self) -> np.ndarray:
+    def net_normal_forces(self, R=None) -> np.ndarray:
         """Each owned node's net normal force R0 from its tool (die minus holder on a pinched
-        node; 0 off the tools)."""
-        return np.where(self.state.tool != FREE, self.reactions()[:, 2], 0.0)
+        node; 0 off the tools), from the residual R (nodal frames; default: the last one)."""
+        rows = self.reactions() if R is None else R[: self.n_owned * BS].reshape(-1, BS)
+        return np.where(self.state.tool != FREE, rows[:, 2], 0.0)
 
     def _update_pass(self, lam):
         """After a converged pass: normal forces from the reactions, the holder's faces, release
@@ -638,7 +648,6 @@ class SemiInverseDriver(Driver):
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
         comm = self.model.mesh.comm
-        on = s.tool != FREE
         net = self.net_normal_forces()
         s.pressure = np.maximum(net, 0.0)
         changes = 0
@@ -646,15 +655,7 @@ class SemiInverseDriver(Driver):
         if self.holder is not None:
             self._pinch(under, grow=True)
             changes = self._update_holder(x, under, net)
-        scale = max(comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
-        can = s.toggles < self.contact.max_toggles
-        release = on & ~self.pinched & (net < -1e-8 * scale) & can
-        gaps = self._gaps(x, lam)
-        depth = np.stack([g for g, _ in gaps])  # (tools, nodes)
-        deepest = np.argmin(depth, axis=0)
-        enters = under & ~on & s.closed[0]  # the closed holder pinches what comes under it
-        deepest[enters] = self.die
-        join = ~on & ((depth.min(axis=0) < -self.contact.penetration) | enters) & can
+        join, release, deepest = self._set_changes(x, lam, under, net, tensile=1e-8)
         s.tool[release] = FREE
         s.tool[join] = deepest[join]
         if self.holder is not None:

@@ -2,10 +2,18 @@
 log lines are the results stage's: shellform.results)."""
 
 import math
+import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
+
+
+def mpiexec() -> str | None:
+    """The mpiexec beside this Python (the wheel's), else the one on PATH, else None."""
+    local = Path(sys.executable).parent / "mpiexec"
+    return str(local) if local.exists() else shutil.which("mpiexec")
 
 
 def convergence_rates(errors, cells) -> tuple[np.ndarray, float]:

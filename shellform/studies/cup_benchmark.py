@@ -33,6 +33,7 @@ from pathlib import Path
 
 from shellform.results.log import say
 from shellform.results.tables import write_csv
+from shellform.studies.common import mpiexec
 from shellform.studies.cup_hard import variant
 
 SCENE = "numisheet93_aluminium.toml"
@@ -91,15 +92,6 @@ def row(out: Path, n: int, ranks: int) -> dict:
             r.update({f"force_{mm:g}": at["punch_force_kN"], f"DX_{mm:g}": at["draw_in_mm"]["DX"],
                       f"DD_{mm:g}": at["draw_in_mm"]["DD"], f"thinning_{mm:g}": at["max_thickness_strain"]})
     return r
-
-
-def mpiexec() -> str | None:
-    local = Path(sys.executable).parent / "mpiexec"
-    if local.exists():
-        return str(local)
-    from shutil import which
-
-    return which("mpiexec")
 
 
 def run(out: Path, levels=LEVELS, strokes=None, mpi_level: int | None = MPI_LEVEL) -> list[dict]:

@@ -24,7 +24,6 @@ from shellform.results.log import say
 from shellform.results.tables import write_csv
 
 
-
 def navier_centre(terms: int = 2001) -> float:
     """w D / (q a^4) at the centre of the simply supported square plate: the Navier series
     16 / pi^6 sum over odd m, n of (-1)^((m + n)/2 - 1) / (m n (m^2 + n^2)^2)."""
@@ -80,10 +79,13 @@ def interior_penalty_rows(degree: int, levels) -> list[dict]:
                      "n": BASE_N * 2**k, **r, "rel_error": (r["w_center"] - ref) / ref,
                      "abs_error_coeff": r["w_center"] - ref})
         part[-1]["rate"] = observed_rates(part)[-1]
-        r = part[-1]
-        say(f"{r['support']:17s} {r['mesh']:18s} {r['element']:8s} {r['cells']:6d} {r['w_center']:12.8f} "
-            f"{r['rel_error']:10.2e} {r['rate']:5.2f} {r['total_s']:7.3f}")
+        log_row(part[-1])
     return part
+
+
+def log_row(r: dict) -> None:
+    say(f"{r['support']:17s} {r['mesh']:18s} {r['element']:8s} {r['cells']:6d} {r['w_center']:12.8f} "
+        f"{r['rel_error']:10.2e} {r['rate']:5.2f} {r['total_s']:7.3f}")
 
 
 def run(outdir: Path, supports=("simply_supported", "clamped"), kinds=("structured", "unstructured"),
@@ -101,9 +103,7 @@ def run(outdir: Path, supports=("simply_supported", "clamped"), kinds=("structur
         for k in levels:
             part.append(solve_row(support, kind, BASE_N, mapped=mapped, refine=k))
             part[-1]["rate"] = observed_rates(part)[-1]
-            r = part[-1]
-            say(f"{r['support']:17s} {r['mesh']:18s} {r['element']:8s} {r['cells']:6d} {r['w_center']:12.8f} "
-                f"{r['rel_error']:10.2e} {r['rate']:5.2f} {r['total_s']:7.3f}")
+            log_row(part[-1])
         rows += part
         series[f"{support}, {part[0]['mesh']}, {part[0]['element']}"] = part
     if "simply_supported" in supports:
