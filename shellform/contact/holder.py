@@ -18,9 +18,14 @@ The squeeze left to spread is S = F - sum_i max(-R0_i, 0). ``spread`` says how:
 - "rigid": the rigid holder on the thickest rim: s_i = k_i max(top_i - Z, 0) with the
   through-thickness stiffness k_i = E A_i / t and Z fixed by sum s_i = S.
 
-The holder *opens* when the flange pushes it up harder than F holds it down (S < 0), and is
-open whenever F = 0. Open, it presses the flange under it with F spread by area as a load, and
-the nodes there are ordinary die contacts that leave the die when their force turns tensile.
+The holder *opens* when the flange pushes it up harder than F holds it down (S < 0). Open, it
+is still a rigid tool: a face lifted by `lift` above its closed position, with one unknown
+(the lift) and one equation (its nodal forces sum to F), solved with the sheet in each Newton
+iteration (semi_inverse.py). A node under it touches it, the die, or neither, and leaves the
+face it touches when its force turns tensile. With the "area" spread the lifted face conforms
+to the flange's thickness as the closed holder's pressure does (over each node it lies `lift`
+above the node's own top when the node is on the die); with "rigid" it is flat. The holder
+closes again when its lift falls to that closed position. With F = 0 there is no holder.
 """
 
 import numpy as np
@@ -84,13 +89,20 @@ class PinchingHolder:
         h = np.where(pinched, s + np.maximum(-net, 0.0), 0.0)
         return d, h
 
-    def load(self, under: np.ndarray) -> np.ndarray:
-        """An open holder's force on the nodes under it, F spread by area (>= 0, pointing down)."""
-        total = self._sum(self.area[under])
-        h = np.zeros(under.size)
-        if total > 0:
-            h[under] = self.force * self.area[under] / total
-        return h
+    def face_gap(self, x: np.ndarray, half: np.ndarray, thickness: float, lift: float):
+        """Gap and normal of the lifted face to the nodes at x with half thicknesses `half`: the
+        flat face z_face + lift ("rigid"), or over each node z_face + lift + (2 half - t0), which
+        lies `lift` above the node's top when the node rests on the die ("area")."""
+        offset = half if self.spread == "rigid" else thickness - half
+        return self.tool.gap(x, offset, lift)
+
+    def lift_floor(self, tops: np.ndarray) -> float:
+        """The closed position of the lift: 0 for the conforming face, the highest top (all
+        ranks, `tops` of the owned nodes on the die under it) above z_face for the flat one."""
+        if self.spread != "rigid":
+            return 0.0
+        top = self.comm.allreduce(float(np.max(tops, initial=-np.inf)), op=MPI.MAX)
+        return max(top - self.tool.z_face, 0.0)
 
     def total(self, h: np.ndarray) -> float:
         """The holder's force on the sheet, all ranks."""

@@ -18,7 +18,7 @@ from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.model import SheetModel
 from shellform.scene import Scene
 
-PUNCH, DIE = 0, 1
+PUNCH, DIE, HOLDER = 0, 1, 2  # the open holder is the third tool of the contact set
 
 
 @dataclass
@@ -57,7 +57,7 @@ class DrawingProblem:
         """Force of a tool on the sheet (x, y, z), whole blank: contact reactions of its nodes
         rotated back from their frames, plus their friction forces. On the die this includes
         the nodes the closed holder pinches (their net force, die minus holder, and the
-        friction of both faces)."""
+        friction of both faces); the open holder's are its own (HOLDER)."""
         d = self.driver
         on = d.state.tool == tool
         r = d.reactions()[on]
@@ -113,12 +113,16 @@ class DrawingProblem:
         top = float((x[under, 2] + d.half_thickness[under]).max(initial=-np.inf))
         return d.model.mesh.comm.allreduce(top, op=MPI.MAX)
 
+    def holder_lift(self) -> float:
+        """The open holder's lift above its closed position (mm; 0 when closed)."""
+        d = self.driver
+        return 0.0 if d.holder is None or d.state.closed[0] else float(d.state.lift[0])
+
     def force_balance(self) -> float:
         """|sum of the tools' z-forces on the sheet| / punch force: the sheet's equilibrium
         along z (the symmetry planes carry no z-force)."""
         d = self.driver
-        fz = sum(float(self.tool_force(k)[2]) for k in range(len(d.tools)))
-        fz += self.symmetry * d.model.mesh.comm.allreduce(float(d.holder_load().sum()), op=MPI.SUM)
+        fz = sum(float(self.tool_force(k)[2]) for k in range(len(d.tools) + (d.holder is not None)))
         return abs(fz) / max(abs(self.punch_force()), 1e-300)
 
     def max_penetration(self) -> float:
@@ -137,11 +141,13 @@ class DrawingProblem:
         return d.X[: d.n_owned, :2], d.positions(), e33
 
     def in_contact(self) -> dict:
-        """Nodes on the punch, on the die (of which pinched by the holder) and on neither (all ranks)."""
+        """Nodes on the punch, on the die (of which pinched by the holder), on the open holder's
+        face and on none (all ranks)."""
         on = self.driver.count_in_contact()
         total = self.model.V.dofmap.index_map.size_global
-        return {"punch": on[f"tool{PUNCH}"], "die": on[f"tool{DIE}"], "pinched": on["pinched"],
-                "free": total - on[f"tool{PUNCH}"] - on[f"tool{DIE}"]}
+        holder = on.get(f"tool{HOLDER}", 0)
+        return {"punch": on[f"tool{PUNCH}"], "die": on[f"tool{DIE}"], "pinched": on["pinched"], "holder": holder,
+                "free": total - on[f"tool{PUNCH}"] - on[f"tool{DIE}"] - holder}
 
     def free_under_holder(self) -> int:
         """Nodes under the closed holder that are not pinched (all ranks; 0 when it is open)."""

@@ -8,7 +8,7 @@ Writes into the output folder (forces and draw-in for the whole blank):
                              over_the_stroke: the worst penetration, z-balance, holder share
                              and count of free nodes under the closed holder
     reports.json             the reports so far (rewritten at each; a resumed run takes them over)
-    force_stroke.csv, .png   per increment: punch force, holder force, height, largest nodal
+    force_stroke.csv, .png   per increment: punch force, holder force, height, lift, largest nodal
                              share and where it is (initial x y), the share of F that holds
                              pinched nodes down (the holder opens past 1), the tools' z-balance,
                              penetration, free nodes under the closed holder, iterations,
@@ -114,6 +114,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
         hx, hy = p.holder_largest_at()
         curve.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
                       "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
+                      "holder_lift_mm": p.holder_lift(),
                       "max_penetration_mm": p.max_penetration(), "force_balance": p.force_balance(),
                       "holder_largest_share": p.holder_share(), "holder_largest_x_mm": hx, "holder_largest_y_mm": hy,
                       "holder_held_down": p.holder_held_down(), "free_under_closed_holder": p.free_under_holder(),

@@ -13,7 +13,12 @@ Assembled as one DOLFINx system with the known components as Dirichlet rows (the
 
 The blank holder pinches the flange onto the die (holder.py): a node under the closed holder
 stays on the die whatever the sign of its net force; it leaves the pinch when it is drawn off
-the die's flat top, or when the holder opens.
+the die's flat top, or when the holder opens. The open holder is one more tool, whose lift z_H
+is an unknown with its own equation, sum of its nodal forces p_i = F. Each Newton iteration
+solves it with the sheet (a bordered system, one more solve with the same factors):
+
+    dq = dq_a + dz_H dq_b,   dq_b the response to the holder's nodes lifted by 1,
+    dz_H = (F - sum p_i - sum (K dq_a)_i) / sum (K dq_b)_i   (sums over the holder's normal rows)
 
 Friction (Coulomb, mu) is integrated as a return mapping, like non-associated plasticity, on
 every node on a tool and under the holder. With the node's slip increment ds relative to the
@@ -88,7 +93,7 @@ class ContactState:
     of the holder's face, the normal force friction uses (held fixed within a pass; the faces'
     sum, relaxed between passes), the tangential friction force of the last
     converged increment (global x, y, z), the node's switches in this increment; and whether
-    the holder is closed."""
+    the holder is closed and its lift."""
 
     def __init__(self, n: int):
         self.tool = np.full(n, FREE, dtype=np.int8)
@@ -98,6 +103,7 @@ class ContactState:
         self.friction = np.zeros((n, 3))
         self.toggles = np.zeros(n, dtype=np.int32)
         self.closed = np.zeros(1, dtype=bool)
+        self.lift = np.zeros(1)  # the open holder's face above its closed position
         self.holder_toggles = np.zeros(1, dtype=np.int32)
 
     def copy(self):
@@ -146,6 +152,7 @@ class SemiInverseDriver(Driver):
         E = model.material[0]
         self.k_stick = self.contact.stick_stiffness * E * self.area / model.cell_size
         self.holder = None
+        self.holder_tool = len(self.tools)  # the open holder's index in the contact set
         if holder is not None:
             self.holder = PinchingHolder(holder, holder_force, self.area, E * self.area / model.thickness,
                                          model.mesh.comm, self.contact.holder_spread)
@@ -154,6 +161,7 @@ class SemiInverseDriver(Driver):
         self.x_n = self.X[:n].copy()  # positions at the start of the increment
         self.lam_n = 0.0
         self.pinched = np.zeros(n, dtype=bool)
+        self._under = np.zeros(n, dtype=bool)  # under the holder in this increment (_pinch)
         self._previous = None  # the committed state before the last (the predictor's)
         self._r_prev, self._omega = None, 1.0
         self._friction = np.zeros((n, 3))  # tangential force of the current iterate (global)
@@ -166,6 +174,10 @@ class SemiInverseDriver(Driver):
         self._curvature = np.zeros((n, 2, 2))  # W of each node's tool in its tangent slots
         self._net = np.zeros(n)  # the net normal forces of the last refreshed iterate
         self._early, self._step = False, np.inf  # a pass ended early; the last accepted step's largest move
+        self._dlift = 0.0  # the open holder's lift in this Newton iteration
+        self._lift_fn = fem.Function(V)  # the unit lift of the open holder's nodes (known rows)
+        self._slip_rows = None  # (coef, g) of the slip forces' dp/dq (_add_slip_pressure_tangent)
+        self._lift_response = fem.Function(V)
         self.line_search_factors: list[float] = []  # alpha of every accepted Newton step (this increment)
         self.pass_residuals: list[list[float]] = []
         self.times["contact_s"] = 0.0
@@ -179,9 +191,20 @@ class SemiInverseDriver(Driver):
         return self.X[: self.n_owned] + d
 
     def _gaps(self, x, lam):
-        """Gap and normal of every owned node to every tool at load factor lam."""
+        """Gap and normal of every owned node to every tool at load factor lam, the open
+        holder last (an infinite gap when it is closed or has no force)."""
         h = self.half_thickness
-        return [tool.gap(x, h, lam * dz) for tool, dz in zip(self.tools, self.travel)]
+        gaps = [tool.gap(x, h, lam * dz) for tool, dz in zip(self.tools, self.travel)]
+        if self.holder is not None:
+            if self._holder_open():
+                gaps.append(self.holder.face_gap(x, h, self.model.thickness, float(self.state.lift[0])))
+            else:
+                gaps.append((np.full(len(x), np.inf), np.tile([0.0, 0.0, -1.0], (len(x), 1))))
+        return gaps
+
+    def _holder_open(self) -> bool:
+        """The holder is open and presses (a tool with its own lift)."""
+        return self.holder is not None and not self.state.closed[0] and self.holder.force > 0
 
     def _initial_set(self):
         """Nodes touching a tool at the start (gap within the penetration tolerance); the holder
@@ -195,7 +218,7 @@ class SemiInverseDriver(Driver):
             s.closed[0] = self.holder.force > 0
             under = self.holder.under(x)
             self._pinch(under, grow=False)
-            self._holder_faces(x, under, np.zeros(self.n_owned))
+            self._holder_faces(x, np.zeros(self.n_owned))
         s.normal = s.pressure + s.holder_face
         self.committed = s.copy()
 
@@ -220,43 +243,75 @@ class SemiInverseDriver(Driver):
         """The pinched nodes: on the die, under the closed holder (mask `under`). Within an
         increment the set only grows (nodes drawn under the holder are pinched at once); a node
         drawn out from under it leaves at the next increment, so that a node at the holder's edge
-        cannot switch between pinched and free from one pass to the next."""
+        cannot switch between pinched and free from one pass to the next. The nodes under the
+        open holder, whose slopes it holds flat, follow the same rule."""
         s = self.state
         now = s.closed[0] & under & (s.tool == self.die)
         self.pinched = (self.pinched | now) if grow else now
         self.pinched &= s.closed[0] & (s.tool == self.die)
+        self._under = (self._under | under) if grow else under.copy()  # the same lag, for the open holder
 
-    def _holder_faces(self, x, under, net):
-        """The frozen face forces of the holder (and of the die under it) from the nodes' net
-        normal forces `net` (die minus holder), at positions x with `under` the holder."""
+    def _holder_faces(self, x, net):
+        """The face forces of the holder (and of the die under it) from the nodes' net normal
+        forces `net` (die minus holder on a pinched node), at positions x: the closed holder's
+        split (holder.py); the open holder's face takes the force of the nodes on it."""
         s, h = self.state, self.holder
         if s.closed[0]:
             tops = x[:, 2] + self.half_thickness
             d, s.holder_face = h.faces(self.pinched, net, tops)
             s.pressure[self.pinched] = d[self.pinched]
         else:
-            s.holder_face = h.load(under)
+            on = s.tool == self.holder_tool
+            s.holder_face = np.where(on, np.maximum(net, 0.0), 0.0)
+            s.pressure[on] = 0.0
 
     def _update_holder(self, x, under, net) -> int:
-        """Open the holder if the flange lifts it (the squeeze left is negative), close it again
-        once the flange under it lies on the die; then its face forces. Returns the changes."""
+        """After a converged pass: open the holder if the flange lifts it (the squeeze left is
+        negative): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
+        the die, the face at its closed position. Close it once its lift is below that position
+        (within a pass the lift may pass it); lower an open holder that touches nothing onto the
+        nearest node. Then its face forces. `net`, the nodes' net normal forces, is updated where
+        a node changes faces. Returns the changes (all ranks)."""
         s, h = self.state, self.holder
         comm = self.model.mesh.comm
         changes = 0
-        if s.holder_toggles[0] < self.contact.max_toggles:
+        if s.holder_toggles[0] < self.contact.max_toggles and h.force > 0:
             if s.closed[0] and h.squeeze_left(self.pinched, net) < 0:
                 s.closed[0] = False
+                tops = (x[:, 2] + self.half_thickness)[self.pinched]
+                s.lift[0] = h.lift_floor(tops)
+                held = self.pinched & (net < 0)
+                s.tool[held] = self.holder_tool
+                net[held] *= -1  # now the force of the face they lie on, along its normal
                 changes = 1
-            elif not s.closed[0] and h.force > 0:
-                off_die = comm.allreduce(int(np.sum(under & (s.tool != self.die))), op=MPI.SUM)
-                lifting = h.squeeze_left(under, net - s.holder_face)  # the load is in the residual
-                if off_die == 0 and lifting >= 0:
-                    s.closed[0] = True
+            elif not s.closed[0] and s.lift[0] < self._lift_floor(x, under):
+                s.closed[0] = True
+                held = s.tool == self.holder_tool
+                s.tool[held] = self.die  # then pinched (the face is at the sheet)
+                net[held] *= -1  # die minus holder
+                changes = 1
+            elif not s.closed[0] and comm.allreduce(int(np.sum(s.tool == self.holder_tool)), op=MPI.SUM) == 0:
+                gap = self._gaps(x, self._lam_trial)[self.holder_tool][0]
+                nearest = comm.allreduce(float(gap[under].min(initial=np.inf)), op=MPI.MIN)
+                if np.isfinite(nearest) and s.lift[0] - nearest <= self._lift_floor(x, under):
+                    s.closed[0] = True  # down to the sheet on the die: closed
+                    changes = 1
+                elif np.isfinite(nearest):
+                    s.lift[0] -= nearest  # the face comes down onto the nearest node
+                    s.tool[under & (gap <= nearest + self.contact.penetration) & (s.tool == FREE)] = self.holder_tool
                     changes = 1
             s.holder_toggles[0] += changes
+            if self.contact.trace and changes:
+                say(f"    holder: {'closed' if s.closed[0] else 'open'}, lift {s.lift[0]:.3e} mm, "
+                    f"{comm.allreduce(int(np.sum(s.tool == self.holder_tool)), op=MPI.SUM)} nodes on its face")
         self._pinch(under, grow=True)
-        self._holder_faces(x, under, net)
+        self._holder_faces(x, net)
         return changes
+
+    def _lift_floor(self, x, under) -> float:
+        """The open holder's closed position (holder.lift_floor) over the nodes on the die under it."""
+        on_die = under & (self.state.tool == self.die)
+        return self.holder.lift_floor((x[:, 2] + self.half_thickness)[on_die])
 
     # -- constraints of one iterate -----------------------------------------------------------
     def _constraints(self, lam):
@@ -271,7 +326,7 @@ class SemiInverseDriver(Driver):
         flags = np.zeros((n_own, BS))
         shift = np.zeros(n_own)  # z-travel of each node's tool in this increment
         self._curvature = np.zeros((n_own, 2, 2))
-        for k in range(len(self.tools)):
+        for k in range(len(gaps)):
             off = (s.tool == k) & ~np.isfinite(gaps[k][0])  # slid off the tool's extent
             s.tool[off], s.pressure[off], s.normal[off] = FREE, 0.0, s.holder_face[off]
             on = np.flatnonzero(s.tool == k)
@@ -279,15 +334,21 @@ class SemiInverseDriver(Driver):
                 continue
             gap, normal = gaps[k][0][on], gaps[k][1][on]
             frames[on] = nodal_frames(normal)
-            if self.contact.tool_curvature:
-                self._curvature[on] = self._shape_operator(k, x[on], frames[on], normal, lam)
             known[on, 2] = -gap  # the normal correction that closes the gap
             flags[on, 2] = 1.0
+            if k == self.holder_tool:
+                continue  # flat, and still in plan
+            if self.contact.tool_curvature:
+                self._curvature[on] = self._shape_operator(k, x[on], frames[on], normal, lam)
             shift[on] = (lam - self.lam_n) * self.travel[k]
-        # the closed holder holds the flange flat: the pinched nodes' slopes of w are known too
+        # the holder's flat faces hold the flange flat: the slopes of w are known too on the
+        # pinched nodes, and on every node under the open holder (on a face or between them)
+        flat = self.pinched.copy()
+        if self._holder_open():
+            flat |= self._under
         slopes = self.q.x.array.reshape(-1, BS)[:n_own, W_SLOPES]
-        known[self.pinched, W_SLOPES.start:W_SLOPES.stop] = -slopes[self.pinched]
-        flags[self.pinched, W_SLOPES.start:W_SLOPES.stop] = 1.0
+        known[flat, W_SLOPES.start:W_SLOPES.stop] = -slopes[flat]
+        flags[flat, W_SLOPES.start:W_SLOPES.stop] = 1.0
         rub = np.flatnonzero((s.tool != FREE) | (s.normal > 0))
         self._rub = (rub, shift[rub], x, frames[rub])
         self._friction_forces()
@@ -335,9 +396,8 @@ class SemiInverseDriver(Driver):
         net = self.net_normal_forces(R)
         self._net = net
         s.pressure = np.maximum(net, 0.0)
-        if self.holder is not None and s.closed[0]:
-            positions = self._rub[2]
-            self._holder_faces(positions, None, net)
+        if self.holder is not None:
+            self._holder_faces(self._rub[2], net)
         s.normal = s.pressure + s.holder_face
         self._friction_forces()
 
@@ -389,24 +449,64 @@ class SemiInverseDriver(Driver):
         delta[d] = self.g[d] - self.q.x.array[d]
         return delta
 
-    def holder_load(self) -> np.ndarray:
-        """The open holder's force on the nodes under it along z (<= 0); zero when it is closed
-        (then the net force of a pinched node is its die reaction)."""
-        if self.holder is None or self.state.closed[0]:
-            return np.zeros(self.n_owned)
-        return -self.state.holder_face
+    def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
+        """Driver's residual, its norm with the open holder's equation F - sum p_i."""
+        norm, scale, ev = super().residual(lam, tangent, elastic_tangent)
+        return float(np.hypot(norm, self._holder_imbalance())), scale, ev
+
+    def _holder_imbalance(self) -> float:
+        """F - sum p_i over the open holder's nodes (all ranks), 0 when it has none: the
+        derivative of the energy with respect to its lift."""
+        if not self._holder_open():
+            return 0.0
+        on = self.state.tool == self.holder_tool
+        comm = self.model.mesh.comm
+        if comm.allreduce(int(on.sum()), op=MPI.SUM) == 0:
+            return 0.0
+        return self.holder.force - comm.allreduce(float(self.net_normal_forces()[on].sum()), op=MPI.SUM)
+
+    def _lift_step(self) -> float:
+        """The open holder's lift in this Newton iteration, solved with the sheet (module
+        docstring): dq (frame coordinates, from the solve) becomes dq_a + dz_H dq_b."""
+        if not self._holder_open():
+            return 0.0
+        comm = self.model.mesh.comm
+        on = np.flatnonzero(self.state.tool == self.holder_tool)
+        if comm.allreduce(int(on.size), op=MPI.SUM) == 0:
+            return 0.0
+        rows = BS * on + 2  # their normal rows (the frame's normal points down)
+        unit = self._lift_fn.x.array
+        unit[:] = 0.0
+        unit[rows] = -1.0  # the face up by 1: each node 1 up, -1 along its normal
+        self._lift_fn.x.scatter_forward()
+        extra = None
+        if self._slip_rows is not None:  # the slip forces' dp/dq on these known columns
+            coef, g = self._slip_rows
+            Ku = self.apply_tangent(unit)[: self.n_owned * BS].reshape(-1, BS)[:, 2]
+            extra = np.zeros(self.n_owned * BS)
+            extra.reshape(-1, BS)[:, :2] = (coef * Ku)[:, None] * g
+        if not self.solve_lifted(unit, self._lift_response, extra):
+            return np.nan
+        dqa, dqb = self.dq.x.array, self._lift_response.x.array
+        change = comm.allreduce(np.array([self.apply_tangent(dqa)[rows].sum(), self.apply_tangent(dqb)[rows].sum()]),
+                                op=MPI.SUM)
+        dz = (self._holder_imbalance() - change[0]) / change[1]
+        dqa += dz * dqb
+        self.dq.x.scatter_forward()
+        return float(dz)
 
     def add(self, lam, x, R, K=None):
-        """Driver's nodal hook: R -= friction and open-holder forces (in the nodal frames), the
+        """Driver's nodal hook: R -= friction forces (in the nodal frames), the
         friction's normal forces first taken from R where Newton's iterates update them;
         K += the friction's stiffness in the tangent slots, the slip force's dp/dq and the
         frames' turning on curved tools."""
         n = self.n_owned
         F = self.frames[:n]  # identity off the tools
         R3 = R[: n * BS].reshape(-1, BS)[:, :3]
-        R3 -= F[:, :, 2] * self.holder_load()[:, None]
+        if K is not None:
+            self._slip_rows = None
         if self._refreshing and self.mu > 0:
-            self._refresh_normal(R)  # the reactions with the holder's load, before friction
+            self._refresh_normal(R)  # the reactions before friction
         R3 -= np.einsum("nij,nj->ni", F, self._friction)
         if K is not None and self.mu > 0:
             b = np.flatnonzero(np.abs(self._rate).max(axis=(1, 2)) > 0)
@@ -447,6 +547,7 @@ class SemiInverseDriver(Driver):
         coef[:n][on] = np.where(self.pinched[on], np.sign(net[on]), (net[on] > 0).astype(float))
         g = np.zeros((self.n_local, 2))
         g[:n][on] = np.einsum("nij,nj->ni", self.frames[:n][on][:, :2], self._friction[on]) / s.normal[on, None]
+        self._slip_rows = (coef[:n].copy(), np.where(self.sym_fixed[:, :2], 0.0, g[:n]))  # for the holder's lift
         fixed = np.zeros(self.n_local * BS, dtype=bool)
         fixed[self.bc_dofs] = True
         cells, local = np.nonzero(coef[m.dofs] != 0)
@@ -532,11 +633,13 @@ class SemiInverseDriver(Driver):
                 break
             R0 = self.b.copy()
             ok = self._solve(jump if jump > 0 else 0.0)
-            if not ok:
+            self._dlift = self._lift_step() if ok else 0.0
+            if not ok or not np.isfinite(self._dlift):
                 R0.destroy()
                 self._cause = "the linear solve failed (singular tangent or a non-finite correction)"
                 return False, it, residuals, ev
-            s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) < 0: the energy slope (frame coordinates)
+            # dq . R(q) + dz_H (F - sum p) < 0: the energy slope (frame coordinates)
+            s0 = self.dq.x.petsc_vec.dot(R0) + self._dlift * self._holder_imbalance()
             R0.destroy()
             from_frames(self.dq.x.array, self.rotated, self.frames)
             self._refreshing = self.contact.refresh_normal
@@ -590,10 +693,11 @@ class SemiInverseDriver(Driver):
         alpha = min(1.0, self.contact.trust * self.model.thickness / max(move, 1e-300))
         if jump > max(self.contact.gap_tol, 1e-2 * move):
             s0 = None  # the step mostly moves nodes onto the tools
-        x0 = self.q.x.array.copy()
+        x0, lift0 = self.q.x.array.copy(), float(self.state.lift[0])
         norm = scale = ev = jump = None
         for _ in range(c.line_search + 1):
             self.q.x.array[:] = x0 + alpha * dq
+            self.state.lift[0] = lift0 + alpha * self._dlift
             jump = self._constraints(lam)
             norm, scale, ev = self.residual(lam, tangent=True)
             if not np.isfinite(norm) or ev.failed:
@@ -626,10 +730,12 @@ class SemiInverseDriver(Driver):
                 f"{self._friction[i].round(2)} ({'slip' if self._slipping[i] else 'stick'})")
 
     def _global_slope(self, dq) -> float:
-        """dq . R over all ranks, with R (free rows, nodal frames) rotated back to x, y, z."""
+        """dq . R over all ranks, with R (free rows, nodal frames) rotated back to x, y, z, and
+        the open holder's share dz_H (F - sum p)."""
         R = self.b.getArray(readonly=True).copy()
         from_frames(R, self.rotated, self.frames)
-        return self.model.mesh.comm.allreduce(float(np.dot(dq[: R.size], R)), op=MPI.SUM)
+        return self.model.mesh.comm.allreduce(float(np.dot(dq[: R.size], R)), op=MPI.SUM) + \
+            self._dlift * self._holder_imbalance()
 
     def reactions(self) -> np.ndarray:
         """(n_owned, 3) residual on the u, v, w rows in the nodal frames (tool forces on constrained rows)."""
@@ -711,7 +817,7 @@ class SemiInverseDriver(Driver):
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
 
     # -- checkpoints -------------------------------------------------------------------------
-    STATE = ("tool", "pressure", "holder_face", "normal", "friction", "closed")
+    STATE = ("tool", "pressure", "holder_face", "normal", "friction", "closed", "lift")
 
     def checkpoint_state(self) -> dict:
         """The sheet's state and the contact's: the committed contact set, forces and friction
@@ -732,7 +838,8 @@ class SemiInverseDriver(Driver):
             raise InputError("resume", "the checkpoint's contact state does not fit this model")
         c = ContactState(self.n_owned)
         for k in self.STATE:
-            getattr(c, k)[...] = data[f"contact_{k}"]
+            if f"contact_{k}" in data:  # (a checkpoint from before the lift: closed or no force)
+                getattr(c, k)[...] = data[f"contact_{k}"]
         self.committed, self.state = c, c.copy()
         self.pinched = data["contact_pinched"].copy()
         self.x_n = data["contact_x_n"].copy()
@@ -754,12 +861,13 @@ class SemiInverseDriver(Driver):
         alphas = self.line_search_factors
         return {"passes": self._passes, "set_changes": self._changes, "frozen": self._frozen,
                 "in_contact": self.count_in_contact(), "min_line_search": min(alphas) if alphas else 1.0,
-                "holder_closed": bool(self.state.closed[0])}
+                "holder_closed": bool(self.state.closed[0]), "holder_lift": float(self.state.lift[0])}
 
     def count_in_contact(self) -> dict:
-        """Nodes on each tool and pinched by the holder, all ranks: {"tool0": ..., "pinched": ...}."""
+        """Nodes on each tool (the open holder last) and pinched by the holder, all ranks:
+        {"tool0": ..., "pinched": ...}."""
         comm = self.model.mesh.comm
         counts = {f"tool{k}": comm.allreduce(int((self.state.tool == k).sum()), op=MPI.SUM)
-                  for k in range(len(self.tools))}
+                  for k in range(len(self.tools) + (self.holder is not None))}
         counts["pinched"] = comm.allreduce(int(self.pinched.sum()), op=MPI.SUM)
         return counts

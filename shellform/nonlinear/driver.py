@@ -206,28 +206,53 @@ class Driver:
         self._set_dirichlet(self.lam)
         self.residual(self.lam, tangent=False)
 
+    def apply_tangent(self, v: np.ndarray) -> np.ndarray:
+        """K v on the owned rows with the element tangents as they are (no Dirichlet rows; v a
+        local array with ghosts): the change of the residual, reactions included, along v."""
+        m = self.model
+        m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, v[m.unrolled_dofs])
+        Kv = fem_petsc.assemble_vector(m.forms.vector)
+        Kv.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        out = Kv.getArray(readonly=True).copy()
+        Kv.destroy()
+        return out
+
+    def _lift(self, delta: np.ndarray) -> None:
+        """b -= K_fD delta on the free rows, b = delta on the Dirichlet rows (the known jump)."""
+        arr = self.b.getArray(readonly=False)
+        arr -= self.apply_tangent(delta)
+        owned = self.bc_dofs[self.bc_dofs < arr.size]
+        arr[owned] = delta[owned]
+        del arr
+
     def _solve(self, jump):
         """dq = -K^-1 R with dq_D = g - q_D (lifted: the free rows see -K_fD (g - q_D))."""
         t0 = time.perf_counter()
         self.b.scale(-1.0)
         if jump > 0:
-            delta = self._correction()
-            m = self.model
-            m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, delta[m.unrolled_dofs])
-            lift = fem_petsc.assemble_vector(m.forms.vector)
-            lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            self.b.axpy(-1.0, lift)
-            lift.destroy()
+            self._lift(self._correction())
+        return self._linear_solve(self.dq, t0)
+
+    def solve_lifted(self, delta: np.ndarray, out, extra: np.ndarray | None = None) -> bool:
+        """The free rows' response to a jump `delta` on the Dirichlet rows alone (no residual),
+        with the factorised tangent: out = K^-1 (-K_fD delta + extra) with out_D = delta
+        (`extra`, owned rows: what K_fD delta misses of the assembled tangent's columns)."""
+        t0 = time.perf_counter()
+        self.b.set(0.0)
+        self._lift(delta)
+        if extra is not None:
             arr = self.b.getArray(readonly=False)
-            owned = self.bc_dofs[self.bc_dofs < arr.size]
-            arr[owned] = delta[owned]
+            arr += extra
             del arr
-        self.ksp.solve(self.b, self.dq.x.petsc_vec)
+        return self._linear_solve(out, t0)
+
+    def _linear_solve(self, out, t0) -> bool:
+        self.ksp.solve(self.b, out.x.petsc_vec)
         self.times["solve_s"] += time.perf_counter() - t0
         if self.ksp.getConvergedReason() < 0:
             return False
-        self.dq.x.scatter_forward()
-        return bool(np.all(np.isfinite(self.dq.x.array)))
+        out.x.scatter_forward()
+        return bool(np.all(np.isfinite(out.x.array)))
 
     # -- one increment -------------------------------------------------------------------------
     def _newton(self, lam, reversal=False):
