@@ -76,10 +76,12 @@ from shellform.contact.problem import DrawingProblem
 from shellform.results.cup import draw_in, peak_thinning
 s = scene.load("demos/square_cup.toml")
 s.mesh.n = 8
+s.tools.blank_holder_force = BHF
 p = DrawingProblem.from_scene(s, verbose=False)
 p.driver.run(1.5 / s.tools.stroke)
 out = {"force": p.punch_force(), "DD": draw_in(p)["DD"], "e33": peak_thinning(p)["max_thickness_strain"],
-       "holder": p.holder_force(), "pinched": p.in_contact()["pinched"], "increments": len(p.driver.history)}
+       "holder": p.holder_force(), "pinched": p.in_contact()["pinched"], "on_holder": p.in_contact()["holder"],
+       "lift": p.holder_lift(), "increments": len(p.driver.history)}
 if MPI.COMM_WORLD.rank == 0:
     print("RESULT " + json.dumps(out))
 """
@@ -87,19 +89,24 @@ if MPI.COMM_WORLD.rank == 0:
 
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
-def test_short_cup_two_ranks_match_serial(tmp_path):
-    """The square cup (8 x 8 quarter blank, friction and the pinching holder) drawn 1.5 mm on two
-    ranks: the same punch force, draw-in and thinning as serial to the solver tolerance, the
-    same contact set and increments."""
+@pytest.mark.parametrize("bhf", [19600.0, 400.0])
+def test_short_cup_two_ranks_match_serial(tmp_path, bhf):
+    """The square cup (8 x 8 quarter blank, friction and the holder) drawn 1.5 mm on two ranks:
+    the same punch force, draw-in and thinning as serial to the solver tolerance, the same
+    contact set and increments; with the scene's 19.6 kN holder (closed, pinching) and a 400 N
+    one that the flange lifts (open, its lift solved with the sheet)."""
     import runpy
 
     root = Path(__file__).resolve().parents[1]
-    parallel = on_two_ranks(tmp_path, CUP.replace("demos/", f"{root}/demos/"))
+    source = CUP.replace("demos/", f"{root}/demos/").replace("BHF", repr(bhf))
+    parallel = on_two_ranks(tmp_path, source)
     serial = {}
-    source = CUP.replace("demos/", f"{root}/demos/").replace('print("RESULT " + json.dumps(out))', "RESULT.update(out)")
+    source = source.replace('print("RESULT " + json.dumps(out))', "RESULT.update(out)")
     runpy.run_path(_write(tmp_path / "serial.py", source), init_globals={"RESULT": serial})
-    assert parallel["increments"] == serial["increments"] and parallel["pinched"] == serial["pinched"]
-    for key in ("force", "DD", "e33", "holder"):
+    for key in ("increments", "pinched", "on_holder"):
+        assert parallel[key] == serial[key], key
+    assert (serial["on_holder"] > 0) == (bhf < 1000)  # the light holder is open
+    for key in ("force", "DD", "e33", "holder", "lift"):
         assert parallel[key] == pytest.approx(serial[key], rel=1e-6, abs=1e-9), key
 
 

@@ -269,8 +269,8 @@ class SemiInverseDriver(Driver):
         """After a converged pass: open the holder if the flange lifts it (the squeeze left is
         negative): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
         the die, the face at its closed position. Close it once its lift is below that position
-        (within a pass the lift may pass it); lower an open holder that touches nothing onto the
-        nearest node. Then its face forces. `net`, the nodes' net normal forces, is updated where
+        by more than `penetration` (the tolerance of every contact; within a pass the lift may
+        pass it); lower an open holder that touches nothing onto the nearest node. Then its face forces. `net`, the nodes' net normal forces, is updated where
         a node changes faces. Returns the changes (all ranks)."""
         s, h = self.state, self.holder
         comm = self.model.mesh.comm
@@ -284,7 +284,8 @@ class SemiInverseDriver(Driver):
                 s.tool[held] = self.holder_tool
                 net[held] *= -1  # now the force of the face they lie on, along its normal
                 changes = 1
-            elif not s.closed[0] and s.lift[0] < self._lift_floor(x, under):
+            elif not s.closed[0] and s.lift[0] < self._lift_floor(x, under) - self.contact.penetration:
+                # the face presses into the flange on the die by more than a tool may: closed
                 s.closed[0] = True
                 held = s.tool == self.holder_tool
                 s.tool[held] = self.die  # then pinched (the face is at the sheet)
