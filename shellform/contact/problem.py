@@ -73,9 +73,15 @@ class DrawingProblem:
         return -float(self.tool_force(PUNCH)[2])
 
     def holder_force(self) -> float:
-        """The sum of the holder's nodal forces on the sheet (N, pressing down), whole blank."""
+        """The sum of the holder's nodal forces on the sheet (N, pressing down), whole blank: the
+        closed holder's face forces, or the open holder's reactions (a node frozen on its face
+        after its switches in an increment may pull it, which friction does not see)."""
         d = self.driver
-        return self.symmetry * d.holder.total(d.state.holder_face) if d.holder is not None else 0.0
+        if d.holder is None:
+            return 0.0
+        if not d.state.closed[0] and d.holder.force > 0:
+            return -float(self.tool_force(HOLDER)[2])
+        return self.symmetry * d.holder.total(d.state.holder_face)
 
     def holder_share(self) -> float:
         """The largest force one node takes from the holder, as a fraction of the holder's force."""

@@ -269,9 +269,10 @@ class SemiInverseDriver(Driver):
         """After a converged pass: open the holder if the flange lifts it (the squeeze left is
         negative): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
         the die, the face at its closed position. Close it once its lift is below that position
-        by more than `penetration` (the tolerance of every contact; within a pass the lift may
-        pass it); lower an open holder that touches nothing onto the nearest node. Then its face forces. `net`, the nodes' net normal forces, is updated where
-        a node changes faces. Returns the changes (all ranks)."""
+        by more than `gap_tol` (within a pass the lift may pass it); lower an open holder that
+        touches nothing onto the nearest node. Then its
+        face forces. `net`, the nodes' net normal forces, is updated where a node changes
+        faces. Returns the changes (all ranks)."""
         s, h = self.state, self.holder
         comm = self.model.mesh.comm
         changes = 0
@@ -284,8 +285,8 @@ class SemiInverseDriver(Driver):
                 s.tool[held] = self.holder_tool
                 net[held] *= -1  # now the force of the face they lie on, along its normal
                 changes = 1
-            elif not s.closed[0] and s.lift[0] < self._lift_floor(x, under) - self.contact.penetration:
-                # the face presses into the flange on the die by more than a tool may: closed
+            elif not s.closed[0] and s.lift[0] < self._lift_floor(x, under) - self.contact.gap_tol:
+                # the face presses into the flange on the die: closed
                 s.closed[0] = True
                 held = s.tool == self.holder_tool
                 s.tool[held] = self.die  # then pinched (the face is at the sheet)
@@ -676,7 +677,10 @@ class SemiInverseDriver(Driver):
         deepest = np.argmin(depth, axis=0)
         enters = under & ~on & s.closed[0]  # the closed holder pinches what comes under it
         deepest[enters] = self.die
-        join = ~on & ((depth.min(axis=0) < -self.contact.penetration) | enters) & can
+        allowed = np.full(len(x), self.contact.penetration)
+        if self._holder_open():  # between the open holder's faces: as tight as the pinch it opened
+            allowed[self._under] = self.contact.gap_tol
+        join = ~on & ((depth.min(axis=0) < -allowed) | enters) & can
         return join, release, deepest
 
     def _line_search(self, lam, s0, jump):
