@@ -269,8 +269,9 @@ class SemiInverseDriver(Driver):
         """After a converged pass: open the holder if the flange lifts it (the squeeze left is
         negative): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
         the die, the face at its closed position. Close it once its lift is below that position
-        by more than `gap_tol` (within a pass the lift may pass it); lower an open holder that
-        touches nothing onto the nearest node. Then its
+        by more than `gap_tol` (within a pass the lift may pass it), unless that would spend its
+        last switch of the increment; lower an open holder that touches nothing onto the
+        nearest node. Then its
         face forces. `net`, the nodes' net normal forces, is updated where a node changes
         faces. Returns the changes (all ranks)."""
         s, h = self.state, self.holder
@@ -285,8 +286,11 @@ class SemiInverseDriver(Driver):
                 s.tool[held] = self.holder_tool
                 net[held] *= -1  # now the force of the face they lie on, along its normal
                 changes = 1
-            elif not s.closed[0] and s.lift[0] < self._lift_floor(x, under) - self.contact.gap_tol:
-                # the face presses into the flange on the die: closed
+            elif (not s.closed[0] and s.holder_toggles[0] + 1 < self.contact.max_toggles
+                  and s.lift[0] < self._lift_floor(x, under) - self.contact.gap_tol):
+                # the face presses into the flange on the die: closed (if it may still open
+                # again in this increment: closed with its switches spent, it could be left
+                # holding more than F)
                 s.closed[0] = True
                 held = s.tool == self.holder_tool
                 s.tool[held] = self.die  # then pinched (the face is at the sheet)
