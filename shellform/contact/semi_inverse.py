@@ -206,6 +206,11 @@ class SemiInverseDriver(Driver):
         """The holder is open and presses (a tool with its own lift)."""
         return self.holder is not None and not self.state.closed[0] and self.holder.force > 0
 
+    def _on_holder(self):
+        """The owned nodes on the open holder's face, and their number on all ranks."""
+        on = self.state.tool == self.holder_tool
+        return on, self.model.mesh.comm.allreduce(int(on.sum()), op=MPI.SUM)
+
     def _initial_set(self):
         """Nodes touching a tool at the start (gap within the penetration tolerance); the holder
         closes on the flange when it has a force."""
@@ -296,7 +301,7 @@ class SemiInverseDriver(Driver):
                 s.tool[held] = self.die  # then pinched (the face is at the sheet)
                 net[held] *= -1  # die minus holder
                 changes = 1
-            elif not s.closed[0] and comm.allreduce(int(np.sum(s.tool == self.holder_tool)), op=MPI.SUM) == 0:
+            elif not s.closed[0] and self._on_holder()[1] == 0:
                 gap = self._gaps(x, self._lam_trial)[self.holder_tool][0]
                 nearest = comm.allreduce(float(gap[under].min(initial=np.inf)), op=MPI.MIN)
                 if np.isfinite(nearest) and s.lift[0] - nearest <= self._lift_floor(x, under):
@@ -309,7 +314,7 @@ class SemiInverseDriver(Driver):
             s.holder_toggles[0] += changes
             if self.contact.trace and changes:
                 say(f"    holder: {'closed' if s.closed[0] else 'open'}, lift {s.lift[0]:.3e} mm, "
-                    f"{comm.allreduce(int(np.sum(s.tool == self.holder_tool)), op=MPI.SUM)} nodes on its face")
+                    f"{self._on_holder()[1]} nodes on its face")
         self._pinch(under, grow=True)
         self._holder_faces(x, net)
         return changes
@@ -465,11 +470,10 @@ class SemiInverseDriver(Driver):
         derivative of the energy with respect to its lift."""
         if not self._holder_open():
             return 0.0
-        on = self.state.tool == self.holder_tool
-        comm = self.model.mesh.comm
-        if comm.allreduce(int(on.sum()), op=MPI.SUM) == 0:
+        on, count = self._on_holder()
+        if count == 0:
             return 0.0
-        return self.holder.force - comm.allreduce(float(self.net_normal_forces()[on].sum()), op=MPI.SUM)
+        return self.holder.force - self.model.mesh.comm.allreduce(float(self.net_normal_forces()[on].sum()), op=MPI.SUM)
 
     def _lift_step(self) -> float:
         """The open holder's lift in this Newton iteration, solved with the sheet (module
@@ -477,10 +481,10 @@ class SemiInverseDriver(Driver):
         if not self._holder_open():
             return 0.0
         comm = self.model.mesh.comm
-        on = np.flatnonzero(self.state.tool == self.holder_tool)
-        if comm.allreduce(int(on.size), op=MPI.SUM) == 0:
+        on, count = self._on_holder()
+        if count == 0:
             return 0.0
-        rows = BS * on + 2  # their normal rows (the frame's normal points down)
+        rows = BS * np.flatnonzero(on) + 2  # their normal rows (the frame's normal points down)
         unit = self._lift_fn.x.array
         unit[:] = 0.0
         unit[rows] = -1.0  # the face up by 1: each node 1 up, -1 along its normal
