@@ -276,9 +276,8 @@ class SemiInverseDriver(Driver):
         the die, the face at its closed position. Close it once its lift is below that position
         by more than `gap_tol` (within a pass the lift may pass it), unless that would spend its
         last switch of the increment; lower an open holder that touches nothing onto the
-        nearest node. Then its
-        face forces. `net`, the nodes' net normal forces, is updated where a node changes
-        faces. Returns the changes (all ranks)."""
+        nearest node. Then its face forces. `net`, the nodes' net normal forces, is updated
+        where a node changes faces. Returns the changes (all ranks)."""
         s, h = self.state, self.holder
         comm = self.model.mesh.comm
         changes = 0
