@@ -11,7 +11,13 @@ because eps enters only through U(eps) - lam : eps and lam only linearly. Elimin
 
     eps = G^-1 C q = B q,        K = Kqq + B^T H B,        lam = G^-1 H eps.
 
-G is factored once per cell (Cholesky); no saddle-point solve is needed.
+No saddle-point solve is needed. On an affine triangle with constant material, G and H are the reference cell's blocks times
+|det J| (the assumed strains and multipliers are the same polynomials on every cell). Then
+
+    K = C^T X C / |det J|,   X = G_ref^-1 H_ref G_ref^-1 = L L^T  (once per mesh; Kqq = 0)
+
+and only C, the string-net and interior coupling of the multipliers to the nodal values,
+is tabulated per cell (``scaled_condensed_matrix``).
 """
 
 import numpy as np
@@ -54,67 +60,42 @@ def cholesky_solve(L, X):
 
 
 @jit.njit
-def blocks(Az, iq, ie, il):
-    """G, C, H, Kqq from the element matrix of the mixed reference element."""
-    ne, nq = ie.size, iq.size
-    G = np.empty((ne, ne))
-    H = np.empty((ne, ne))
-    C = np.empty((ne, nq))
-    Kqq = np.empty((nq, nq))
-    for i in range(ne):
-        for j in range(ne):
-            G[i, j] = -Az[il[i], ie[j]]
-            H[i, j] = Az[ie[i], ie[j]]
-        for j in range(nq):
-            C[i, j] = Az[il[i], iq[j]]
-    for i in range(nq):
-        for j in range(nq):
-            Kqq[i, j] = Az[iq[i], iq[j]]
-    return G, C, H, Kqq
+def reference_operators(G, H):
+    """(L, G^-1, G^-1 H) of the reference cell's blocks, L L^T = G^-1 H G^-1."""
+    n = G.shape[0]
+    Ginv = np.eye(n)
+    cholesky_solve(cholesky(G), Ginv)
+    R = Ginv @ H
+    X = R @ Ginv
+    return cholesky(0.5 * (X + X.T)), Ginv, R
 
 
 @jit.njit
-def strain_operator(Az, iq, ie, il):
-    """B = G^-1 C (assumed-strain coefficients per reference nodal dof) and H."""
-    G, C, H, Kqq = blocks(Az, iq, ie, il)
-    cholesky_solve(cholesky(G), C)
-    return C, H, Kqq
-
-
-@jit.njit
-def condensed_matrix(Az, iq, ie, il):
-    """K_ref = Kqq + B^T H B."""
-    B, H, K = strain_operator(Az, iq, ie, il)
-    ne, nq = B.shape
-    HB = np.zeros((ne, nq))
+def scaled_condensed_matrix(C, L, det, cols, coef, K):
+    """K = T^T C^T (L L^T) C T / det in the carrier values (T: the slope map, its rows given by
+    cols and coef as in slope_map); K is overwritten."""
+    ne, nq = C.shape
+    nc = K.shape[0]
+    CT = np.zeros((ne, nc))
+    for r in range(nq):
+        for k in range(cols.shape[1]):
+            col = cols[r, k]
+            if col >= 0:
+                v = coef[r, k]
+                for i in range(ne):
+                    CT[i, col] += C[i, r] * v
+    Y = np.zeros((ne, nc))  # L^T C T
     for i in range(ne):
-        for k in range(ne):
-            h = H[i, k]
-            if h != 0.0:
-                for j in range(nq):
-                    HB[i, j] += h * B[k, j]
-    for i in range(nq):
-        for k in range(ne):
-            b = B[k, i]
-            if b != 0.0:
-                for j in range(nq):
-                    K[i, j] += b * HB[k, j]
-    return K
-
-
-@jit.njit
-def recover(Az, iq, ie, il, q_ref):
-    """Assumed strains eps = B q and multipliers lam = G^-1 H eps of one element."""
-    G, C, H, _ = blocks(Az, iq, ie, il)
-    L = cholesky(G)
-    ne = ie.size
-    x = np.zeros((ne, 2))
-    for i in range(ne):
-        for j in range(iq.size):
-            x[i, 0] += C[i, j] * q_ref[j]
-    cholesky_solve(L, x[:, 0:1])
-    for i in range(ne):
-        for k in range(ne):
-            x[i, 1] += H[i, k] * x[k, 0]
-    cholesky_solve(L, x[:, 1:2])
-    return x[:, 0].copy(), x[:, 1].copy()
+        for k in range(i, ne):
+            lk = L[k, i]
+            if lk != 0.0:
+                for j in range(nc):
+                    Y[i, j] += lk * CT[k, j]
+    s = 1.0 / det
+    for a in range(nc):
+        for b in range(a, nc):
+            v = 0.0
+            for i in range(ne):
+                v += Y[i, a] * Y[i, b]
+            K[a, b] = v * s
+            K[b, a] = v * s

@@ -14,6 +14,10 @@ Reference element (one triangle, fields of forms.fields.HybridFields), a basix m
     local:       eps_p, eps_b       assumed strains (DG1 symmetric tensors)
                  N, M               their multipliers (same spaces, same order)
 
+The same fields also come as three mixed elements of their own, ``nodal`` (u, w, g), ``strains``
+(eps_p, eps_b) and ``multipliers`` (N, M), in which the condensation's blocks are separate
+forms (shellform.assembly.kernels); their dofs are in the order of q, eps and lam above.
+
 The map carrier -> q is linear with per-cell coefficients (identity or entries of J), at most
 two nonzeros per reference row; it is tabulated here as index tables for shellform.assembly.slope_map.
 """
@@ -63,6 +67,9 @@ class HybridElement:
         self.carrier_components = tuple(comps)
         self.sub_names = tuple(n for n, _ in subs)
         self.mixed = basix.ufl.mixed_element([e for _, e in subs])
+        nodal = [(n, e) for n, e in subs if n in ("u", "w", "g")]
+        self.parts = {"nodal": nodal, "strains": [(strain_name[gr], sym) for gr in self.groups],
+                      "multipliers": [(mult_name[gr], sym) for gr in self.groups]}
         self.offsets, start = {}, 0
         for name, e in subs:
             self.offsets[name] = slice(start, start + e.dim)
@@ -72,6 +79,11 @@ class HybridElement:
         self.eps = np.concatenate([self._range(strain_name[gr]) for gr in self.groups])
         self.lam = np.concatenate([self._range(mult_name[gr]) for gr in self.groups])
         self.sym_dim = sym.dim
+
+    def part(self, kind: str):
+        """(names, element) of the nodal, strain or multiplier fields alone."""
+        names, elements = zip(*self.parts[kind])
+        return names, basix.ufl.mixed_element(list(elements))
 
     def _range(self, name):
         s = self.offsets[name]

@@ -1,18 +1,23 @@
 """FFCx kernels of the UFL functional, wrapped as DOLFINx forms on the carrier space.
 
-For every owned cell the wrapper kernel (a numba cfunc with the UFCx signature)
-  1. tabulates the second variation of pi_g on the mixed reference element: the FFCx cell
-     kernel once and the FFCx ``ds`` kernel once per local facet (the element's own boundary,
-     where the string-net terms live);
-  2. condenses the assumed strains and multipliers (condensation.condensed_matrix);
-  3. pulls the result back to the physical carrier values with T(J) (slope_map).
-DOLFINx then assembles, applies boundary conditions and lifts as for any form, in serial or MPI.
+The second variation of pi_g splits into blocks between the nodal values q, the assumed strains
+eps and the multipliers lam (shellform.assembly.condensation). Each block the condensation needs
+is its own FFCx form, on the fields it couples (HybridElement.part):
+
+    C = d2 pi / d lam d q     per cell: cell integral + the string-net integrals on its 3 facets
+    G = -d2 pi / d lam d eps, H = d2 pi / d eps2     once per mesh, on the reference triangle
+
+For every owned cell the wrapper kernel (a numba cfunc with the UFCx signature) tabulates C,
+condenses (K = C^T X C / |det J|, X from G and H) and pulls the result back to the physical
+carrier values with T(J) (slope_map). DOLFINx then assembles, applies boundary conditions and
+lifts as for any form, in serial or MPI.
 
 The cfuncs are compiled at every start (they hold the addresses of this process's FFCx
-kernels); the numerical work they call is cached by numba.
+kernels); the numerical work they call is cached by numba. FFCx compiles at -O3.
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import basix.ufl
 import cffi
@@ -23,25 +28,47 @@ from dolfinx import fem
 from dolfinx.fem import IntegralType, form_cpp_class
 from dolfinx.mesh import CellType
 from dolfinx.jit import ffcx_jit
+from ufl.algorithms import expand_derivatives
 
 from shellform.forms import functional
 from shellform.forms.fields import HybridFields, ShellParameters
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.errors import InputError
+from shellform import _jit as jit
 
 try:  # the module moves in FFCx 0.12
-    from ffcx.codegeneration.utils import empty_void_pointer, numba_ufcx_kernel_signature
+    from ffcx.codegeneration.utils import numba_ufcx_kernel_signature
 except ImportError:  # pragma: no cover
-    from ffcx.codegeneration.numba.utils import empty_void_pointer, numba_ufcx_kernel_signature
+    from ffcx.codegeneration.numba.utils import numba_ufcx_kernel_signature
 
 _ffi = cffi.FFI()
+JIT_OPTIONS = {"cffi_extra_compile_args": ["-O3", "-g0"]}  # FFCx's default is -O2
 _signature = numba_ufcx_kernel_signature(np.float64, np.float64)
 
 
 def reference_fields(element: HybridElement, z) -> HybridFields:
+    """The fields of one coefficient on the whole mixed element (the sheet's weak Hessian)."""
     parts = dict(zip(element.sub_names, ufl.split(z)))
     return HybridFields(**{k: parts.get(k) for k in ("u", "w", "g", "eps_p", "eps_b", "N", "M")})
+
+
+def part_fields(element: HybridElement, domain) -> tuple[dict, HybridFields]:
+    """One coefficient each on the nodal, strain and multiplier elements, and the fields of
+    forms.fields split from them."""
+    coefficients, parts = {}, {}
+    for kind in ("nodal", "strains", "multipliers"):
+        names, el = element.part(kind)
+        z = ufl.Coefficient(ufl.FunctionSpace(domain, el))
+        coefficients[kind] = z
+        parts.update(zip(names, ufl.split(z)))
+    return coefficients, HybridFields(**{k: parts.get(k) for k in ("u", "w", "g", "eps_p", "eps_b", "N", "M")})
+
+
+def second_variation(pi, a, b) -> ufl.Form:
+    """d2 pi / da db: test functions on a's element (rows), trial functions on b's (columns)."""
+    return ufl.derivative(ufl.derivative(pi, a, ufl.TestFunction(a.ufl_function_space())), b,
+                          ufl.TrialFunction(b.ufl_function_space()))
 
 
 @dataclass
@@ -55,7 +82,7 @@ class CompiledForm:
 
     @classmethod
     def compile(cls, comm, form: ufl.Form):
-        ufcx, _, _ = ffcx_jit(comm, form, form_compiler_options={"scalar_type": "float64"})
+        ufcx, _, _ = ffcx_jit(comm, form, form_compiler_options={"scalar_type": "float64"}, jit_options=JIT_OPTIONS)
         off = [ufcx.form_integral_offsets[i] for i in range(3)]
         kern = lambda i: ufcx.form_integrals[i].tabulate_tensor_float64  # noqa: E731
         cell = kern(off[0]) if off[1] > off[0] else None
@@ -87,7 +114,9 @@ class ElementKernels:
     """The cfuncs of one element configuration, compiled once and shared by every mesh.
 
     FFCx kernels depend on the reference cell and the coordinate element only, not on a mesh;
-    the UFL forms are therefore built on a mesh-free domain with placeholder constants.
+    the UFL forms are therefore built on a mesh-free domain with placeholder constants. The
+    wrapper forms' constants are the parameters (in _PARAMETERS order) followed by the mesh's
+    condensation operators (``operators``).
     """
 
     _cache: dict = {}
@@ -104,16 +133,21 @@ class ElementKernels:
         domain = ufl.Mesh(basix.ufl.element("Lagrange", "triangle", 1, shape=(2,)))
         placeholders = {name: ufl.Constant(domain, shape=shape) for name, shape in param_signature}
         params = ShellParameters(**{n: placeholders.get(n) for n in _PARAMETERS})
-        Z = ufl.FunctionSpace(domain, element.mixed)
-        z = ufl.Coefficient(Z)
-        dz, tz = ufl.TestFunction(Z), ufl.TrialFunction(Z)
-        fields = reference_fields(element, z)
+        z, fields = part_fields(element, domain)
         n = ufl.FacetNormal(domain)
         pi = functional.hybrid_functional(fields, params, element.effects, n)
-        self._a = CompiledForm.compile(comm, ufl.derivative(ufl.derivative(pi, z, dz), z, tz))
+        q, eps, lam = z["nodal"], z["strains"], z["multipliers"]
+        if not expand_derivatives(second_variation(pi, q, q)).empty():
+            raise NotImplementedError("the condensation assumes pi_g couples the nodal values only to the "
+                                      "multipliers (no nodal-nodal block)")
+        self._C = CompiledForm.compile(comm, second_variation(pi, lam, q))
+        self._G = CompiledForm.compile(comm, -second_variation(pi, lam, eps))
+        self._H = CompiledForm.compile(comm, second_variation(pi, eps, eps))
         work = functional.external_work(fields, params, element.effects)
-        self._L = CompiledForm.compile(comm, ufl.derivative(work, z, dz)) if work else None
-        for f in (self._a, self._L):
+        self._L = None
+        if work:
+            self._L = CompiledForm.compile(comm, ufl.derivative(work, q, ufl.TestFunction(q.ufl_function_space())))
+        for f in (self._C, self._G, self._H, self._L):
             if f is not None and f.num_coefficients:
                 raise NotImplementedError("state-dependent forms need the nonlinear driver")
         # Packed constants of the wrapper forms: every parameter, in _PARAMETERS order.
@@ -123,115 +157,194 @@ class ElementKernels:
             size = int(np.prod(shape)) if shape else 1
             layout[id(placeholders[name])] = (start, start + size)
             start += size
-        self._nconst = max(start, 1)
+        self._nparams = start
         self._layout = layout
+        self.ne, self.nq = len(element.lam), len(element.q)
         self.matrix = self._matrix_kernel()
         self.vector = self._vector_kernel() if self._L else None
-        self.recovery = self._recovery_kernel()
+
+    # -- per mesh ---------------------------------------------------------------------------
+    def operators(self, parameters: np.ndarray) -> np.ndarray:
+        """The condensation operators (L, G^-1, G^-1 H) of the reference triangle for these
+        parameter values, flattened (the wrappers' last constant).
+
+        They hold on every affine cell once scaled by |det J|; that is checked here on a sheared
+        cell, so that a form whose assumed-strain blocks depend on the cell's shape or position
+        is refused instead of condensed wrongly.
+        """
+        scaled = []
+        for coords in (_REFERENCE, _SHEARED):
+            det = abs(slope_map.determinant(slope_map.jacobian(coords)))
+            _, G, H = self.blocks(parameters, coords)
+            scaled.append((G / det, H / det))
+        (G, H), (G2, H2) = scaled
+        for X, X2, name in ((G, G2, "G"), (H, H2, "H")):
+            if not np.allclose(X, X2, rtol=1e-10, atol=1e-12 * np.abs(X).max()):
+                raise NotImplementedError(f"the assumed-strain block {name} of this functional does not scale with "
+                                          "the cell's area; the condensation needs it to")
+        return np.concatenate([M.ravel() for M in condensation.reference_operators(G, H)])
+
+    def blocks(self, parameters: np.ndarray, coords: np.ndarray):
+        """(C, G, H) of one cell (coordinate dofs, 3 x 3 flattened) for these parameter values."""
+        ne, nq = self.ne, self.nq
+        return tuple(tabulate(f, parameters[f.gather(self._layout)], coords, shape)
+                     for f, shape in ((self._C, (ne, nq)), (self._G, (ne, ne)), (self._H, (ne, ne))))
 
     # -- cfuncs -------------------------------------------------------------------------------
-    def _tabulate(self):
-        """A numba function filling the mixed element matrix Az of one cell."""
-        cell, facet = self._a.cell, self._a.facet
-        gather, nconst, nz = self._a.gather(self._layout), self._nconst, self.element.dim
-        ffi = _ffi
-        nfacets = 3 if facet is not None else 0  # membrane alone has no string-net terms
-        facet = facet if facet is not None else cell  # typed placeholder, never called
-
-        @numba.njit
-        def tabulate(c_, coords_, perm):
-            c = numba.carray(c_, (nconst,))
-            ck = np.zeros(max(gather.size, 1))
-            for i in range(gather.size):
-                ck[i] = c[gather[i]]
-            Az = np.zeros((nz, nz))
-            wz = np.zeros(1)
-            local = np.zeros(1, dtype=np.int32)
-            cell(ffi.from_buffer(Az), ffi.from_buffer(wz), ffi.from_buffer(ck), coords_,
-                 ffi.from_buffer(local), perm, empty_void_pointer())
-            for f in range(nfacets):  # the element's own boundary: the string-net integrals
-                local[0] = f
-                facet(ffi.from_buffer(Az), ffi.from_buffer(wz), ffi.from_buffer(ck), coords_,
-                      ffi.from_buffer(local), perm, empty_void_pointer())
-            return Az
-
-        return tabulate
+    # Each cfunc binds this configuration's kernel addresses and tables and calls a cached numba
+    # function with them, so that only the thin cfunc is compiled in every process.
+    def _bound(self):
+        e, C = self.element, self._C
+        cols, codes = e.slope_map_tables()
+        address = lambda k: jit.kernel_address(k) if k is not None else 0  # noqa: E731
+        return (address(C.cell), address(C.facet), C.gather(self._layout), cols, codes, self.mapped,
+                self._nparams, self.ne, self.nq)
 
     def _matrix_kernel(self):
-        tabulate = self._tabulate()
-        e = self.element
-        iq, ie, il = e.q, e.eps, e.lam
-        cols, codes = e.slope_map_tables()
-        nc, mapped = e.carrier_dim, self.mapped
+        bound = self._bound()
+        nc, nconst = self.element.carrier_dim, self._nparams + 3 * self.ne * self.ne
 
         @numba.cfunc(_signature, nopython=True)
         def kernel(A_, w_, c_, coords_, local, perm, data):
-            A = numba.carray(A_, (nc, nc))
-            coords = numba.carray(coords_, (9,))
-            K_ref = condensation.condensed_matrix(tabulate(c_, coords_, perm), iq, ie, il)
-            coef = slope_map.coefficients(slope_map.jacobian(coords), codes, mapped)
-            A[:, :] = 0.0
-            slope_map.pull_back_matrix(K_ref, cols, coef, A)
+            condensed_matrix(*bound, numba.carray(c_, (nconst,)), numba.carray(coords_, (9,)),
+                             numba.carray(A_, (nc, nc)))
 
         return kernel
 
     def _vector_kernel(self):
-        cell = self._L.cell
-        gather, nconst, nz = self._L.gather(self._layout), self._nconst, self.element.dim
-        e = self.element
-        iq = e.q
-        cols, codes = e.slope_map_tables()
-        nc, mapped = e.carrier_dim, self.mapped
-        ffi = _ffi
+        _, _, _, cols, codes, mapped, _, ne, nq = self._bound()
+        # a tuple, so that numba types the values as such (captured one by one they would be
+        # literals, and the cached function would be compiled again in every process)
+        bound = (jit.kernel_address(self._L.cell), self._L.gather(self._layout), cols, codes, mapped, nq)
+        nc, nconst = self.element.carrier_dim, self._nparams + 3 * ne * ne
 
         @numba.cfunc(_signature, nopython=True)
         def kernel(b_, w_, c_, coords_, local, perm, data):
-            b = numba.carray(b_, (nc,))
-            coords = numba.carray(coords_, (9,))
-            c = numba.carray(c_, (nconst,))
-            ck = np.zeros(max(gather.size, 1))
-            for i in range(gather.size):
-                ck[i] = c[gather[i]]
-            bz = np.zeros(nz)
-            wz = np.zeros(1)
-            cell(ffi.from_buffer(bz), ffi.from_buffer(wz), ffi.from_buffer(ck), coords_, local,
-                 perm, empty_void_pointer())
-            b_ref = np.empty(iq.size)  # the loads act on nodal fields only: no condensation
-            for i in range(iq.size):
-                b_ref[i] = bz[iq[i]]
-            coef = slope_map.coefficients(slope_map.jacobian(coords), codes, mapped)
-            b[:] = 0.0
-            slope_map.pull_back_vector(b_ref, cols, coef, b)
+            load_vector(*bound, numba.carray(c_, (nconst,)), numba.carray(coords_, (9,)), numba.carray(b_, (nc,)))
 
         return kernel
 
-    def _recovery_kernel(self):
-        tabulate = self._tabulate()
+    @cached_property
+    def recovery(self):
+        """Centroid values of the assumed strains eps = G^-1 C q and the multipliers
+        lam = G^-1 H eps, per group (xx, yy, xy of each); compiled when first asked for."""
+        bound = self._bound()
         e = self.element
-        iq, ie, il = e.q, e.eps, e.lam
-        cols, codes = e.slope_map_tables()
-        nc, mapped, ngroups, ns = e.carrier_dim, self.mapped, len(e.groups), e.sym_dim
+        nc, nconst, ngroups = e.carrier_dim, self._nparams + 3 * self.ne * self.ne, len(e.groups)
         avg = e.centroid_average()
 
         @numba.cfunc(_signature, nopython=True)
         def kernel(b_, w_, c_, coords_, local, perm, data):
-            out = numba.carray(b_, (6 * ngroups,))
-            q = numba.carray(w_, (nc,))
-            coords = numba.carray(coords_, (9,))
-            coef = slope_map.coefficients(slope_map.jacobian(coords), codes, mapped)
-            q_ref = np.empty(iq.size)
-            slope_map.push_forward(q, cols, coef, q_ref)
-            eps, lam = condensation.recover(tabulate(c_, coords_, perm), iq, ie, il, q_ref)
-            for g in range(ngroups):
-                for k in range(3):
-                    s, r = 0.0, 0.0
-                    for j in range(ns):
-                        s += avg[k, j] * eps[g * ns + j]
-                        r += avg[k, j] * lam[g * ns + j]
-                    out[6 * g + k] = s
-                    out[6 * g + 3 + k] = r
+            recovered(*bound, avg, numba.carray(c_, (nconst,)), numba.carray(coords_, (9,)),
+                      numba.carray(w_, (nc,)), numba.carray(b_, (6 * ngroups,)))
 
         return kernel
+
+
+# -- the cell work of the cfuncs (cached: the kernels come in as addresses) ----------------------
+@jit.njit
+def constraint(cell, facet, gather, npar, ne, nq, c, coords):
+    """C (ne x nq) of one cell: the cell integral and the string-net integrals on its facets
+    (a flat plate's C has no cell part, a membrane's no facet part: address 0)."""
+    ck = np.zeros(max(gather.size, 1))
+    for i in range(gather.size):
+        ck[i] = c[gather[i]]
+    C = np.zeros((ne, nq))
+    wz = np.zeros(1)
+    local = np.zeros(1, dtype=np.int32)
+    perm = np.zeros(1, dtype=np.uint8)
+    if cell != 0:
+        jit.call_kernel(cell, C, wz, ck, coords, local, perm)
+    if facet != 0:
+        for f in range(3):  # the element's own boundary: the string-net integrals
+            local[0] = f
+            jit.call_kernel(facet, C, wz, ck, coords, local, perm)
+    return C
+
+
+@jit.njit
+def condensed_matrix(cell, facet, gather, cols, codes, mapped, npar, ne, nq, c, coords, A):
+    """The condensed, mapped element matrix A (carrier values) of one cell."""
+    C = constraint(cell, facet, gather, npar, ne, nq, c, coords)
+    J = slope_map.jacobian(coords)
+    coef = slope_map.coefficients(J, codes, mapped)
+    L = c[npar: npar + ne * ne].reshape((ne, ne))
+    condensation.scaled_condensed_matrix(C, L, abs(slope_map.determinant(J)), cols, coef, A)
+
+
+@jit.njit
+def load_vector(cell, gather, cols, codes, mapped, nq, c, coords, b):
+    """b = T^T b_ref: the loads act on the nodal fields only (no condensation)."""
+    ck = np.zeros(max(gather.size, 1))
+    for i in range(gather.size):
+        ck[i] = c[gather[i]]
+    b_ref = np.zeros(nq)
+    wz = np.zeros(1)
+    local = np.zeros(1, dtype=np.int32)
+    perm = np.zeros(1, dtype=np.uint8)
+    jit.call_kernel(cell, b_ref, wz, ck, coords, local, perm)
+    coef = slope_map.coefficients(slope_map.jacobian(coords), codes, mapped)
+    b[:] = 0.0
+    slope_map.pull_back_vector(b_ref, cols, coef, b)
+
+
+@jit.njit
+def recovered(cell, facet, gather, cols, codes, mapped, npar, ne, nq, avg, c, coords, q, out):
+    """Centroid (xx, yy, xy) of eps = G^-1 C T q / |det J| and lam = G^-1 H eps, per group."""
+    J = slope_map.jacobian(coords)
+    coef = slope_map.coefficients(J, codes, mapped)
+    q_ref = np.empty(nq)
+    slope_map.push_forward(q, cols, coef, q_ref)
+    Cq = np.zeros(ne)
+    C = constraint(cell, facet, gather, npar, ne, nq, c, coords)
+    for i in range(ne):
+        for j in range(nq):
+            Cq[i] += C[i, j] * q_ref[j]
+    s = 1.0 / abs(slope_map.determinant(J))
+    Ginv = c[npar + ne * ne: npar + 2 * ne * ne].reshape((ne, ne))
+    R = c[npar + 2 * ne * ne: npar + 3 * ne * ne].reshape((ne, ne))
+    eps, lam = np.zeros(ne), np.zeros(ne)
+    for i in range(ne):
+        for j in range(ne):
+            eps[i] += Ginv[i, j] * Cq[j] * s
+    for i in range(ne):
+        for j in range(ne):
+            lam[i] += R[i, j] * eps[j]
+    ns = avg.shape[1]
+    for g in range(ne // ns):
+        for k in range(3):
+            a, r = 0.0, 0.0
+            for j in range(ns):
+                a += avg[k, j] * eps[g * ns + j]
+                r += avg[k, j] * lam[g * ns + j]
+            out[6 * g + k] = a
+            out[6 * g + 3 + k] = r
+
+
+_REFERENCE = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0])
+_SHEARED = np.array([0.3, -0.2, 0.0, 2.1, 0.4, 0.0, -0.5, 1.6, 0.0])
+
+
+@jit.njit
+def _tabulate_into(address, A, ck, coords, local_index):
+    wz = np.zeros(1)
+    local = np.full(1, local_index, dtype=np.int32)
+    perm = np.zeros(1, dtype=np.uint8)
+    jit.call_kernel(address, A, wz, ck, coords, local, perm)
+
+
+def tabulate(form: CompiledForm, ck: np.ndarray, coords: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """The element matrix of `form` on one cell: its cell integral and its facet integrals on
+    the cell's three facets (constants ck in the form's own order)."""
+    A = np.zeros(shape)
+    ck = np.ascontiguousarray(ck, dtype=np.float64) if ck.size else np.zeros(1)
+    coords = np.ascontiguousarray(coords, dtype=np.float64)
+    if form.cell is not None:
+        _tabulate_into(jit.kernel_address(form.cell), A, ck, coords, 0)
+    if form.facet is not None:
+        for f in range(3):
+            _tabulate_into(jit.kernel_address(form.facet), A, ck, coords, f)
+    return A
 
 
 def check_mesh(mesh) -> None:
@@ -245,13 +358,20 @@ def check_mesh(mesh) -> None:
 
 
 class HybridShellForms:
-    """Stiffness, load and recovery forms of the hybrid shell element on one mesh."""
+    """Stiffness, load and recovery forms of the hybrid shell element on one mesh.
+
+    The parameters' values are read here, for the condensation operators: forms built before
+    a parameter changes keep the old operators.
+    """
 
     def __init__(self, mesh, element: HybridElement, params: ShellParameters, mapped: bool = True):
         check_mesh(mesh)
         self.mesh, self.element, self.params, self.mapped = mesh, element, params, mapped
         self.kernels = ElementKernels.get(element, params, mapped, mesh.comm)
         self.constants = [getattr(params, name) for name in self.kernels.constant_names]
+        values = [np.atleast_1d(np.asarray(c.value, dtype=np.float64)).ravel() for c in self.constants]
+        ops = self.kernels.operators(np.concatenate(values) if values else np.zeros(0))
+        self.constants.append(fem.Constant(mesh, ops))
         self.V = fem.functionspace(mesh, ("Lagrange", 1, (element.block_size,)))
         self.cells = np.arange(mesh.topology.index_map(mesh.topology.dim).size_local, dtype=np.int32)
         self.stiffness = self._form([self.V, self.V], self.kernels.matrix, [])

@@ -27,7 +27,7 @@ from dolfinx.jit import ffcx_jit
 
 from shellform.forms import kirchhoff_love as kl
 from shellform.assembly import condensation, slope_map
-from shellform.assembly.kernels import reference_fields
+from shellform.assembly.kernels import JIT_OPTIONS, reference_fields
 from shellform.assembly.sheet_element import NDOF, SheetElement, build_q, congruence
 from shellform import _jit as jit
 from shellform._jit import kernel_address
@@ -36,7 +36,7 @@ _OPTIONS = {"scalar_type": "float64"}
 
 
 def _cell_kernel(comm, form):
-    ufcx, _, _ = ffcx_jit(comm, form, form_compiler_options=_OPTIONS)
+    ufcx, _, _ = ffcx_jit(comm, form, form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
     if ufcx.form_integral_offsets[1] != 1:
         raise RuntimeError(f"expected one cell integral, FFCx made {ufcx.form_integral_offsets[1]}")
     return ufcx.form_integrals[0].tabulate_tensor_float64, ufcx
@@ -115,7 +115,8 @@ class SheetKernels:
         self.tangent_offsets = packed_offsets(ufcx_t, ftangent, [z, Sq, Dq])
         p = ufl.Constant(domain)
         self.pressure, _ = _cell_kernel(comm, ufl.derivative(kl.dead_pressure(p, U, dx), z, dz))
-        ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS)
+        ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS,
+                                jit_options=JIT_OPTIONS)
         self.strain = ufcx_e.tabulate_tensor_float64
         self.nconst = 4 if shallow else 0  # kappa0 in every kernel that sees it
 

@@ -3,7 +3,8 @@
 A vertex slope in the carrier is physical, (w_x, w_y); the reduced cubic's slope dofs are
 reference derivatives, (dw/dX, dw/dY) = J^T (w_x, w_y) with J = dx/dX of the affine cell map.
 So q_ref = T q_carrier with T = blockdiag(1, J^T) on w and the identity elsewhere, and the
-element matrix and vector pull back as K = T^T K_ref T, b = T^T b_ref.
+element matrix and vector pull back as K = T^T K_ref T, b = T^T b_ref (the matrix inside the
+condensation, shellform.assembly.condensation.scaled_condensed_matrix).
 
 T is stored sparsely (hybrid_element.slope_map_tables): row r of q_ref has at most two entries,
 columns ``cols[r]`` with coefficients given by ``codes[r]`` (0 none, 1 one, 2 + 2a + b: J[a, b]).
@@ -26,6 +27,11 @@ def jacobian(coords):
 
 
 @jit.njit
+def determinant(J):
+    return J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+
+
+@jit.njit
 def coefficients(J, codes, mapped):
     coef = np.zeros(codes.shape)
     for r in range(codes.shape[0]):
@@ -37,25 +43,6 @@ def coefficients(J, codes, mapped):
                 a, b = (c - 2) // 2, (c - 2) % 2
                 coef[r, k] = J[a, b] if mapped else (1.0 if a == b else 0.0)
     return coef
-
-
-@jit.njit
-def pull_back_matrix(K_ref, cols, coef, K):
-    """K += T^T K_ref T."""
-    nq = K_ref.shape[0]
-    KT = np.zeros((nq, K.shape[1]))
-    for s in range(nq):
-        for k in range(cols.shape[1]):
-            c = cols[s, k]
-            if c >= 0:
-                for r in range(nq):
-                    KT[r, c] += K_ref[r, s] * coef[s, k]
-    for r in range(nq):
-        for k in range(cols.shape[1]):
-            c = cols[r, k]
-            if c >= 0:
-                for d in range(K.shape[1]):
-                    K[c, d] += coef[r, k] * KT[r, d]
 
 
 @jit.njit
