@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import basix.ufl
-import cffi
 import numba
 import numpy as np
 import ufl
@@ -42,7 +41,6 @@ try:  # the module moves in FFCx 0.12
 except ImportError:  # pragma: no cover
     from ffcx.codegeneration.numba.utils import numba_ufcx_kernel_signature
 
-_ffi = cffi.FFI()
 JIT_OPTIONS = {"cffi_extra_compile_args": ["-O3", "-g0"]}  # FFCx's default is -O2
 _signature = numba_ufcx_kernel_signature(np.float64, np.float64)
 
@@ -196,8 +194,7 @@ class ElementKernels:
     def _bound(self):
         e, C = self.element, self._C
         cols, codes = e.slope_map_tables()
-        address = lambda k: jit.kernel_address(k) if k is not None else 0  # noqa: E731
-        return (address(C.cell), address(C.facet), C.gather(self._layout), cols, codes, self.mapped,
+        return (_address(C.cell), _address(C.facet), C.gather(self._layout), cols, codes, self.mapped,
                 self._nparams, self.ne, self.nq)
 
     def _matrix_kernel(self):
@@ -215,7 +212,7 @@ class ElementKernels:
         _, _, _, cols, codes, mapped, _, ne, nq = self._bound()
         # a tuple, so that numba types the values as such (captured one by one they would be
         # literals, and the cached function would be compiled again in every process)
-        bound = (jit.kernel_address(self._L.cell), self._L.gather(self._layout), cols, codes, mapped, nq)
+        bound = (_address(self._L.cell), self._L.gather(self._layout), cols, codes, mapped, nq)
         nc, nconst = self.element.carrier_dim, self._nparams + 3 * ne * ne
 
         @numba.cfunc(_signature, nopython=True)
@@ -243,29 +240,41 @@ class ElementKernels:
 
 # -- the cell work of the cfuncs (cached: the kernels come in as addresses) ----------------------
 @jit.njit
-def constraint(cell, facet, gather, npar, ne, nq, c, coords):
-    """C (ne x nq) of one cell: the cell integral and the string-net integrals on its facets
-    (a flat plate's C has no cell part, a membrane's no facet part: address 0)."""
+def gathered(gather, c):
+    """A kernel's own constants from the wrappers' packed ones."""
     ck = np.zeros(max(gather.size, 1))
     for i in range(gather.size):
         ck[i] = c[gather[i]]
-    C = np.zeros((ne, nq))
+    return ck
+
+
+@jit.njit
+def element_tensor(cell, facet, ck, coords, A):
+    """A += the cell integral and the facet integrals on the cell's three facets, the element's
+    own boundary where the string-net terms live (address 0: the form has no such integral)."""
     wz = np.zeros(1)
     local = np.zeros(1, dtype=np.int32)
     perm = np.zeros(1, dtype=np.uint8)
     if cell != 0:
-        jit.call_kernel(cell, C, wz, ck, coords, local, perm)
+        jit.call_kernel(cell, A, wz, ck, coords, local, perm)
     if facet != 0:
-        for f in range(3):  # the element's own boundary: the string-net integrals
+        for f in range(3):
             local[0] = f
-            jit.call_kernel(facet, C, wz, ck, coords, local, perm)
+            jit.call_kernel(facet, A, wz, ck, coords, local, perm)
+
+
+@jit.njit
+def constraint(cell, facet, gather, ne, nq, c, coords):
+    """C (ne x nq) of one cell (a flat plate's C has no cell part, a membrane's no facet part)."""
+    C = np.zeros((ne, nq))
+    element_tensor(cell, facet, gathered(gather, c), coords, C)
     return C
 
 
 @jit.njit
 def condensed_matrix(cell, facet, gather, cols, codes, mapped, npar, ne, nq, c, coords, A):
     """The condensed, mapped element matrix A (carrier values) of one cell."""
-    C = constraint(cell, facet, gather, npar, ne, nq, c, coords)
+    C = constraint(cell, facet, gather, ne, nq, c, coords)
     J = slope_map.jacobian(coords)
     coef = slope_map.coefficients(J, codes, mapped)
     L = c[npar: npar + ne * ne].reshape((ne, ne))
@@ -275,14 +284,8 @@ def condensed_matrix(cell, facet, gather, cols, codes, mapped, npar, ne, nq, c, 
 @jit.njit
 def load_vector(cell, gather, cols, codes, mapped, nq, c, coords, b):
     """b = T^T b_ref: the loads act on the nodal fields only (no condensation)."""
-    ck = np.zeros(max(gather.size, 1))
-    for i in range(gather.size):
-        ck[i] = c[gather[i]]
     b_ref = np.zeros(nq)
-    wz = np.zeros(1)
-    local = np.zeros(1, dtype=np.int32)
-    perm = np.zeros(1, dtype=np.uint8)
-    jit.call_kernel(cell, b_ref, wz, ck, coords, local, perm)
+    element_tensor(cell, 0, gathered(gather, c), coords, b_ref)
     coef = slope_map.coefficients(slope_map.jacobian(coords), codes, mapped)
     b[:] = 0.0
     slope_map.pull_back_vector(b_ref, cols, coef, b)
@@ -296,7 +299,7 @@ def recovered(cell, facet, gather, cols, codes, mapped, npar, ne, nq, avg, c, co
     q_ref = np.empty(nq)
     slope_map.push_forward(q, cols, coef, q_ref)
     Cq = np.zeros(ne)
-    C = constraint(cell, facet, gather, npar, ne, nq, c, coords)
+    C = constraint(cell, facet, gather, ne, nq, c, coords)
     for i in range(ne):
         for j in range(nq):
             Cq[i] += C[i, j] * q_ref[j]
@@ -325,25 +328,16 @@ _REFERENCE = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0])
 _SHEARED = np.array([0.3, -0.2, 0.0, 2.1, 0.4, 0.0, -0.5, 1.6, 0.0])
 
 
-@jit.njit
-def _tabulate_into(address, A, ck, coords, local_index):
-    wz = np.zeros(1)
-    local = np.full(1, local_index, dtype=np.int32)
-    perm = np.zeros(1, dtype=np.uint8)
-    jit.call_kernel(address, A, wz, ck, coords, local, perm)
+def _address(kernel) -> int:
+    """A kernel's address for the cached cell work (0: the form has no such integral)."""
+    return jit.kernel_address(kernel) if kernel is not None else 0
 
 
 def tabulate(form: CompiledForm, ck: np.ndarray, coords: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    """The element matrix of `form` on one cell: its cell integral and its facet integrals on
-    the cell's three facets (constants ck in the form's own order)."""
+    """The element matrix of `form` on one cell (constants ck in the form's own order)."""
     A = np.zeros(shape)
-    ck = np.ascontiguousarray(ck, dtype=np.float64) if ck.size else np.zeros(1)
-    coords = np.ascontiguousarray(coords, dtype=np.float64)
-    if form.cell is not None:
-        _tabulate_into(jit.kernel_address(form.cell), A, ck, coords, 0)
-    if form.facet is not None:
-        for f in range(3):
-            _tabulate_into(jit.kernel_address(form.facet), A, ck, coords, f)
+    element_tensor(_address(form.cell), _address(form.facet), np.ascontiguousarray(ck, dtype=np.float64)
+                   if ck.size else np.zeros(1), np.ascontiguousarray(coords, dtype=np.float64), A)
     return A
 
 
