@@ -11,8 +11,9 @@ because eps enters only through U(eps) - lam : eps and lam only linearly. Elimin
 
     eps = G^-1 C q = B q,        K = Kqq + B^T H B,        lam = G^-1 H eps.
 
-No saddle-point solve is needed. On an affine triangle with constant material, G and H are the reference cell's blocks times
-|det J| (the assumed strains and multipliers are the same polynomials on every cell). Then
+No saddle-point solve is needed. On an affine triangle with constant material, G and H are the
+reference cell's blocks times |det J| (the assumed strains and multipliers are the same
+polynomials on every cell). Then
 
     K = C^T X C / |det J|,   X = G_ref^-1 H_ref G_ref^-1 = L L^T  (once per mesh; Kqq = 0)
 

@@ -158,6 +158,7 @@ class ElementKernels:
         self._nparams = start
         self._layout = layout
         self.ne, self.nq = len(element.lam), len(element.q)
+        self._nconst = start + 3 * self.ne * self.ne  # the wrappers' constants: parameters, then operators
         self.matrix = self._matrix_kernel()
         self.vector = self._vector_kernel() if self._L else None
 
@@ -199,7 +200,7 @@ class ElementKernels:
 
     def _matrix_kernel(self):
         bound = self._bound()
-        nc, nconst = self.element.carrier_dim, self._nparams + 3 * self.ne * self.ne
+        nc, nconst = self.element.carrier_dim, self._nconst
 
         @numba.cfunc(_signature, nopython=True)
         def kernel(A_, w_, c_, coords_, local, perm, data):
@@ -209,11 +210,11 @@ class ElementKernels:
         return kernel
 
     def _vector_kernel(self):
-        _, _, _, cols, codes, mapped, _, ne, nq = self._bound()
         # a tuple, so that numba types the values as such (captured one by one they would be
         # literals, and the cached function would be compiled again in every process)
-        bound = (_address(self._L.cell), self._L.gather(self._layout), cols, codes, mapped, nq)
-        nc, nconst = self.element.carrier_dim, self._nparams + 3 * ne * ne
+        bound = (_address(self._L.cell), self._L.gather(self._layout), *self.element.slope_map_tables(),
+                 self.mapped, self.nq)
+        nc, nconst = self.element.carrier_dim, self._nconst
 
         @numba.cfunc(_signature, nopython=True)
         def kernel(b_, w_, c_, coords_, local, perm, data):
@@ -227,7 +228,7 @@ class ElementKernels:
         lam = G^-1 H eps, per group (xx, yy, xy of each); compiled when first asked for."""
         bound = self._bound()
         e = self.element
-        nc, nconst, ngroups = e.carrier_dim, self._nparams + 3 * self.ne * self.ne, len(e.groups)
+        nc, nconst, ngroups = e.carrier_dim, self._nconst, len(e.groups)
         avg = e.centroid_average()
 
         @numba.cfunc(_signature, nopython=True)
