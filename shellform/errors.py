@@ -5,5 +5,5 @@ class InputError(ValueError):
     """A scene or argument is invalid; raised before any computation starts."""
 
     def __init__(self, field: str, message: str):
-        self.field = field
+        self.field, self.message = field, message
         super().__init__(f"{field}: {message}")

@@ -17,7 +17,8 @@ from shellform.forms.fields import ShellParameters
 from shellform import loads, supports
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.assembly.kernels import HybridShellForms
-from shellform.mesh import rectangle
+from shellform.edge_frames import EdgeConstraints
+from shellform.mesh import blank
 from shellform.scene import Scene
 
 
@@ -27,6 +28,7 @@ class LinearResult:
     forms: HybridShellForms
     q: fem.Function  # carrier solution: per vertex the active components
     timings: dict = field(default_factory=dict)
+    size: float = 1.0  # the blank's extent (a length scale for tolerances)
 
     @property
     def components(self) -> tuple[str, ...]:
@@ -42,7 +44,7 @@ class LinearResult:
 
     def value(self, name: str, x: float = 0.0, y: float = 0.0) -> float:
         """A nodal value (e.g. 'w') at the vertex (x, y)."""
-        tol = 1e-9 * max(self.scene.geometry.lx, self.scene.geometry.ly)
+        tol = 1e-9 * self.size
         return loads.value_at(self.q, self.components, name, x, y, tol)
 
     def cell_fields(self) -> dict[str, fem.Function]:
@@ -81,10 +83,7 @@ def parameters(mesh, scene: Scene) -> ShellParameters:
 
 
 def mesh(scene: Scene, comm=MPI.COMM_WORLD):
-    g, m = scene.geometry, scene.mesh
-    points = [(p.x, p.y) for p in scene.loads.point]
-    return rectangle(comm, g.lx, g.ly, region=g.region, kind=m.kind, n=m.n, diagonal=m.diagonal, points=points,
-                     refine=m.refine)
+    return blank(comm, scene, [(p.x, p.y) for p in scene.loads.point])
 
 
 def compile_forms(scene: Scene, msh) -> HybridShellForms:
@@ -94,8 +93,7 @@ def compile_forms(scene: Scene, msh) -> HybridShellForms:
 
 def boundary_conditions(scene: Scene, rect, forms: HybridShellForms):
     """The scene's named supports on the sides of the meshed rectangle."""
-    return supports.boundary_conditions(forms.V, forms.element.carrier_components, rect.facet_tags,
-                                        vars(scene.supports))
+    return supports.boundary_conditions(forms.V, forms.element.carrier_components, rect, scene.supports)
 
 
 def assemble_system(forms: HybridShellForms, bcs, point_loads=(), tol=1e-9):
@@ -131,19 +129,27 @@ def lu_solve(A, b, V) -> fem.Function:
     return q
 
 
-def solve(scene: Scene, comm=MPI.COMM_WORLD) -> LinearResult:
+def solve(scene: Scene, comm=MPI.COMM_WORLD, blank_mesh=None) -> LinearResult:
+    """The scene solved on its own mesh, or on `blank_mesh` (a BlankMesh with the scene's groups)."""
     t = time.perf_counter()
-    rect = mesh(scene, comm)
+    rect = blank_mesh or mesh(scene, comm)
     t0 = time.perf_counter()
     forms = compile_forms(scene, rect.mesh)
     t1 = time.perf_counter()
-    bcs = boundary_conditions(scene, rect, forms)
-    A, b = assemble_system(forms, bcs, scene.loads.point, 1e-9 * max(scene.geometry.lx, scene.geometry.ly))
+    tol = 1e-9 * rect.size
+    if scene.geometry.shape == "rectangle":  # edges along x and y: Dirichlet conditions on components
+        A, b = assemble_system(forms, boundary_conditions(scene, rect, forms), scene.loads.point, tol)
+        edges = None
+    else:  # edges of any direction: in their own frames
+        edges = EdgeConstraints(forms.V, forms.element.carrier_components, rect, scene.supports)
+        A, b = edges.apply(*assemble_system(forms, [], scene.loads.point, tol))
     t2 = time.perf_counter()
     q = lu_solve(A, b, forms.V)
+    if edges is not None:
+        edges.recover(q)
     t3 = time.perf_counter()
     if not np.all(np.isfinite(q.x.array)):
         raise FloatingPointError("the solution has non-finite values: is the structure supported?")
     timings = {"mesh_s": t0 - t, "compile_s": t1 - t0, "assemble_s": t2 - t1, "solve_s": t3 - t2,
                "total_s": t3 - t}
-    return LinearResult(scene, forms, q, timings)
+    return LinearResult(scene, forms, q, timings, rect.size)

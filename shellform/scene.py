@@ -18,14 +18,18 @@ from pathlib import Path
 
 from shellform.forms.functional import EFFECTS, NONLINEAR_EFFECTS
 from shellform.errors import InputError
+from shellform.mesh import outline
 
+TOOL_SHAPES = ("square", "round")
+SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
 CONTACT_EFFECTS = ("contact", "friction")  # the rigid tools of [tools] (shellform/contact/)
 
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
 NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
 SIDES = ("left", "right", "bottom", "top")
-REGIONS = ("full", "quarter")
+REGIONS = ("full", "quarter")  # rectangle
+CIRCLE_REGIONS = ("full", "half", "quarter")
 MESH_KINDS = ("structured", "unstructured")
 DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
 HARDENING = ("none", "power", "swift")
@@ -34,9 +38,14 @@ CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "
 
 @dataclass
 class Geometry:
-    lx: float = 1.0  # blank size along x
-    ly: float = 1.0  # blank size along y
-    region: str = "full"  # "quarter": x, y >= 0 with symmetry at x = 0 and y = 0
+    shape: str = "rectangle"  # rectangle, circle, polygon or file (shellform/mesh/outline.py)
+    lx: float = 1.0  # rectangle: blank size along x
+    ly: float = 1.0  # rectangle: blank size along y
+    region: str = "full"  # rectangle, circle: "quarter" x, y >= 0; circle: "half" y >= 0
+    radius: float = 0.0  # circle (0: unset)
+    vertices: list[list[float]] = field(default_factory=list, metadata={"items": "points"})  # polygon
+    edges: list[str] = field(default_factory=list, metadata={"items": "names"})  # polygon: a name per edge
+    file: str = ""  # file: a gmsh .msh, .geo (or CAD) file, relative to the scene's folder
 
 
 @dataclass
@@ -90,14 +99,6 @@ class Loads:
 
 
 @dataclass
-class Supports:
-    left: str = "free"
-    right: str = "free"
-    bottom: str = "free"
-    top: str = "free"
-
-
-@dataclass
 class Solver:
     mapped: bool = True  # False: no Jacobian map of the slopes (plain DOLFINx); for studies only
 
@@ -119,8 +120,13 @@ class Process:
 
 @dataclass
 class ToolsSpec:
-    """Rigid tools of the square-cup deep drawing (shellform.contact.tools), NUMISHEET'93."""
+    """Rigid tools of cup deep drawing (shellform.contact.tools): square (NUMISHEET'93) or round.
+    A round punch is the square one with plan corner radius = half-width = punch_radius (its
+    plan is a circle), a round die the same with die_radius."""
 
+    shape: str = "square"  # "square" or "round"
+    punch_radius: float = 0.0  # round: the punch's radius (0: unset)
+    die_radius: float = 0.0  # round: the die opening's radius (0: unset)
     punch_half_width: float = 35.0  # 70 mm square punch
     punch_corner_radius: float = 10.0  # plan corner radius
     punch_profile_radius: float = 8.0  # nose radius
@@ -132,6 +138,11 @@ class ToolsSpec:
     friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
     stroke: float = 30.0  # punch travel, mm
     holder_spread: str = "area"  # how the closed holder spreads its force: "area" or "rigid" (contact/holder.py)
+
+    def __post_init__(self):
+        if self.shape == "round":  # circles: corner radius = half-width = radius
+            self.punch_half_width = self.punch_corner_radius = self.punch_radius
+            self.die_half_width = self.die_corner_radius = self.die_radius
 
 
 @dataclass
@@ -149,7 +160,7 @@ class Scene:
     surface: Surface = field(default_factory=Surface)
     mesh: MeshSpec = field(default_factory=MeshSpec)
     material: Material = field(default_factory=Material)
-    supports: Supports = field(default_factory=Supports)
+    supports: dict[str, str] = field(default_factory=dict)  # boundary group -> support; unnamed: free
     loads: Loads = field(default_factory=Loads)
     solver: Solver = field(default_factory=Solver)
     process: Process = field(default_factory=Process)
@@ -162,6 +173,14 @@ class Scene:
     @property
     def kappa0(self) -> tuple[float, float]:
         return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
+
+    @property
+    def symmetry_copies(self) -> int:
+        """How many copies of the meshed region make the whole blank (4 for a quarter)."""
+        g = self.geometry
+        if g.shape in ("rectangle", "circle"):
+            return {"full": 1, "half": 2, "quarter": 4}[g.region]
+        return 2 ** sum(v == "symmetry" for v in self.supports.values())
 
     @property
     def nonlinear(self) -> bool:
@@ -186,7 +205,7 @@ class Scene:
 # -- reading ---------------------------------------------------------------------------------
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
-    "supports": Supports, "solver": Solver, "process": Process, "output": Output, "tools": ToolsSpec,
+    "solver": Solver, "process": Process, "output": Output, "tools": ToolsSpec,
 }
 
 
@@ -201,6 +220,30 @@ def _numbers(value, name) -> list[float]:
     if not isinstance(value, list):
         raise InputError(name, f"must be a list of numbers, got {value!r}")
     return [_number(v, name) for v in value]
+
+
+def _points(value, name) -> list[list[float]]:
+    if not isinstance(value, list) or not all(isinstance(p, list) and len(p) == 2 for p in value):
+        raise InputError(name, f"must be a list of points [x, y], got {value!r}")
+    return [_numbers(p, name) for p in value]
+
+
+def _names(value, name) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+        raise InputError(name, f"must be a list of names, got {value!r}")
+    return list(value)
+
+
+_LIST_ITEMS = {"numbers": _numbers, "points": _points, "names": _names}
+
+
+def _supports(data) -> dict[str, str]:
+    if not isinstance(data, dict):
+        raise InputError("supports", "must be a table of boundary group = support")
+    for key, value in data.items():
+        if not isinstance(value, str):
+            raise InputError(f"supports.{key}", f"must be a support name (a string), got {value!r}")
+    return dict(data)
 
 
 def _records(cls, tables, name) -> list:
@@ -225,8 +268,8 @@ def _record(cls, data, name):
             value = _number(value, f"{name}.{key}", integer=isinstance(default, int))
         elif isinstance(default, str) and not isinstance(value, str):
             raise InputError(f"{name}.{key}", f"must be a string, got {value!r}")
-        elif isinstance(default, list):  # lists of numbers (process.path, process.report)
-            value = _numbers(value, f"{name}.{key}")
+        elif isinstance(default, list):
+            value = _LIST_ITEMS[known[key].metadata.get("items", "numbers")](value, f"{name}.{key}")
         values[key] = value
     return cls(**values)
 
@@ -238,6 +281,14 @@ def from_dict(data: dict) -> Scene:
         if key not in known:
             raise InputError(key, f"unknown key; known keys: {', '.join(sorted(known))}")
     kwargs = {name: _record(cls, data[name], name) for name, cls in _SECTIONS.items() if name in data}
+    if "supports" in data:
+        kwargs["supports"] = _supports(data["supports"])
+    tools = data.get("tools")
+    if isinstance(tools, dict) and tools.get("shape") == "round":
+        for key in SQUARE_TOOL_KEYS:
+            if key in tools:
+                raise InputError(f"tools.{key}", "is a key of square tools: round tools take punch_radius and "
+                                 "die_radius")
     if "loads" in data:
         loads = dict(data["loads"]) if isinstance(data["loads"], dict) else data["loads"]
         if not isinstance(loads, dict):
@@ -264,6 +315,9 @@ def load(path: str | Path) -> Scene:
         data = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise InputError("scene", f"{path} is not valid TOML: {err}") from None
+    geometry = data.get("geometry")
+    if isinstance(geometry, dict) and isinstance(geometry.get("file"), str) and geometry["file"]:
+        data["geometry"] = {**geometry, "file": str(path.parent / geometry["file"])}  # relative to the scene
     return from_dict(data)
 
 
@@ -275,11 +329,8 @@ def _require(cond, name, message):
 
 def validate(s: Scene) -> None:
     _validate_effects(s)
-    g, m = s.geometry, s.mesh
-    for name in ("lx", "ly"):
-        v = getattr(g, name)
-        _require(math.isfinite(v) and v > 0, f"geometry.{name}", f"must be > 0, got {v}")
-    _require(g.region in REGIONS, "geometry.region", f"must be one of {REGIONS}, got {g.region!r}")
+    _validate_geometry(s)
+    m = s.mesh
     for name in ("R1", "R2"):
         v = getattr(s.surface, name)
         _require(v != 0 and not math.isnan(v), f"surface.{name}", f"must be non-zero (inf for flat), got {v}")
@@ -291,10 +342,12 @@ def validate(s: Scene) -> None:
     _require(m.refine >= 0, "mesh.refine", f"must be >= 0, got {m.refine}")
     _require(m.diagonal in DIAGONALS, "mesh.diagonal", f"must be one of {DIAGONALS}, got {m.diagonal!r}")
     _validate_material(s)
-    for side in SIDES:
-        v = getattr(s.supports, side)
-        _require(v in SUPPORTS, f"supports.{side}", f"unknown support {v!r}; known supports: {', '.join(SUPPORTS)}")
-        _require(v not in NONLINEAR_SUPPORTS or s.nonlinear, f"supports.{side}", f"{v!r} is a support of the "
+    groups = outline.group_names(s.geometry)
+    for group, v in s.supports.items():
+        _require(group in groups, f"supports.{group}",
+                 f"the blank has no boundary group {group!r}; its groups: {', '.join(groups)}")
+        _require(v in SUPPORTS, f"supports.{group}", f"unknown support {v!r}; known supports: {', '.join(SUPPORTS)}")
+        _require(v not in NONLINEAR_SUPPORTS or s.nonlinear, f"supports.{group}", f"{v!r} is a support of the "
                  f"nonlinear sheet: needs one of the effects {', '.join(NONLINEAR_EFFECTS)}")
     _validate_loads(s)
     _validate_process(s)
@@ -302,12 +355,55 @@ def validate(s: Scene) -> None:
     _validate_size(s)
 
 
+def _validate_geometry(s: Scene) -> None:
+    g, m = s.geometry, s.mesh
+    _require(g.shape in outline.SHAPES, "geometry.shape", f"must be one of {outline.SHAPES}, got {g.shape!r}")
+    own = {"rectangle": (), "circle": ("radius",), "polygon": ("vertices", "edges"), "file": ("file",)}
+    for shape, keys in own.items():
+        for key in keys:
+            _require(shape == g.shape or not getattr(g, key), f"geometry.{key}",
+                     f"is a key of shape = {shape!r}, but the shape is {g.shape!r}")
+    if g.shape == "rectangle":
+        for name in ("lx", "ly"):
+            v = getattr(g, name)
+            _require(math.isfinite(v) and v > 0, f"geometry.{name}", f"must be > 0, got {v}")
+        _require(g.region in REGIONS, "geometry.region", f"rectangle: must be one of {REGIONS}, got {g.region!r}")
+        return
+    _require(m.kind == "unstructured", "mesh.kind",
+             f"a {g.shape} blank is meshed by gmsh: set kind = 'unstructured', got {m.kind!r}")
+    if g.shape == "circle":
+        _require(math.isfinite(g.radius) and g.radius > 0, "geometry.radius", f"must be > 0, got {g.radius}")
+        _require(g.region in CIRCLE_REGIONS, "geometry.region",
+                 f"circle: must be one of {CIRCLE_REGIONS}, got {g.region!r}")
+        return
+    _require(g.region == "full", "geometry.region",
+             f"a {g.shape} blank is the region meshed: name its symmetry lines in [supports] instead")
+    if g.shape == "polygon":
+        _require(all(math.isfinite(c) for p in g.vertices for c in p), "geometry.vertices", "must be finite")
+        problem = outline.polygon_problem(g.vertices)
+        _require(problem is None, "geometry.vertices", str(problem))
+        _require(not g.edges or len(g.edges) == len(g.vertices), "geometry.edges",
+                 f"needs one name per edge ({len(g.vertices)}), got {len(g.edges)}")
+        return
+    path = Path(g.file)
+    _require(bool(g.file), "geometry.file", "shape = 'file' needs a file name")
+    _require(path.suffix.lower() in outline.FILE_SUFFIXES, "geometry.file",
+             f"must be a gmsh file ({', '.join(outline.FILE_SUFFIXES)}), got {g.file!r}")
+    _require(path.is_file(), "geometry.file", f"no such file: {g.file}")
+
+
 def _validate_size(s: Scene) -> None:
     """A mesh whose estimated memory exceeds what the machine allows is refused before it is built."""
     from shellform.mesh import budget
 
     g, m = s.geometry, s.mesh
-    cells = budget.estimated_cells(g.lx, g.ly, g.region, m.kind, m.n, m.refine)
+    if g.shape == "file":
+        return  # a .msh file is the size its author made it
+    if g.shape == "rectangle":
+        cells = budget.estimated_cells(g.lx, g.ly, g.region, m.kind, m.n, m.refine)
+    else:
+        x0, x1, _, _ = outline.region_bounds(g)
+        cells = budget.gmsh_cells(outline.region_area(g), (x1 - x0) / m.n, m.refine)
     need, have = budget.estimated_bytes(cells, s.nonlinear or s.tools is not None), budget.available_bytes()
     _require(need <= have, "mesh.n", f"n = {m.n} (refine {m.refine}) makes about {cells:,} cells, which need about "
              f"{need / 1e9:.3g} GB; this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
@@ -379,11 +475,13 @@ def _validate_loads(s: Scene) -> None:
             _require(math.isfinite(getattr(p, name)), f"loads.point[{i}].{name}", "must be finite")
     needs_w = loads.pressure != 0 or any(p.fz != 0 for p in loads.point)
     _require(not needs_w or "bending" in s.effects, "loads", "transverse loads need the effect 'bending'")
-    x0, x1, y0, y1 = bounds(s)
-    tol = 1e-12 * max(g.lx, g.ly)
+    box = bounds(s) if g.shape != "file" else None
     for i, p in enumerate(loads.point):
-        _require(x0 - tol <= p.x <= x1 + tol and y0 - tol <= p.y <= y1 + tol, f"loads.point[{i}]",
-                 f"({p.x}, {p.y}) lies outside the blank [{x0}, {x1}] x [{y0}, {y1}]")
+        if box is not None:
+            x0, x1, y0, y1 = box
+            tol = 1e-12 * max(x1 - x0, y1 - y0)
+            _require(x0 - tol <= p.x <= x1 + tol and y0 - tol <= p.y <= y1 + tol, f"loads.point[{i}]",
+                     f"({p.x}, {p.y}) lies outside the blank [{x0}, {x1}] x [{y0}, {y1}]")
         _require((p.fx == 0 and p.fy == 0) or "membrane" in s.effects, f"loads.point[{i}]",
                  "in-plane forces (fx, fy) need the effect 'membrane'")
         _require((p.fx == 0 and p.fy == 0) or s.nonlinear, f"loads.point[{i}]",
@@ -394,6 +492,7 @@ def _validate_loads(s: Scene) -> None:
         _require(math.isfinite(mo.m), f"loads.moment[{i}].m", f"must be finite, got {mo.m}")
         _require(s.nonlinear, f"loads.moment[{i}]", "edge moments are loads of the nonlinear sheet: "
                  f"need one of the effects {', '.join(NONLINEAR_EFFECTS)}")
+        _require(g.shape == "rectangle", f"loads.moment[{i}]", "edge moments act on the sides of a rectangle")
 
 
 def _validate_process(s: Scene) -> None:
@@ -428,10 +527,18 @@ def _validate_tools(s: Scene) -> None:
         _require("contact" not in s.effects, "tools", "the effect 'contact' needs a [tools] table")
         return
     _require("contact" in s.effects, "effects", "a [tools] table needs the effect 'contact'")
+    _require(t.shape in TOOL_SHAPES, "tools.shape", f"must be one of {TOOL_SHAPES}, got {t.shape!r}")
+    if t.shape == "round":
+        for name in ("punch_radius", "die_radius"):
+            _require(getattr(t, name) > 0, f"tools.{name}", f"round tools need {name} > 0, got {getattr(t, name)}")
+    else:
+        for name in ("punch_radius", "die_radius"):
+            _require(getattr(t, name) == 0, f"tools.{name}", "is a key of shape = 'round' (square tools: "
+                     "punch_half_width, punch_corner_radius, die_half_width, die_corner_radius)")
     _require(t.holder_spread in SPREADS, "tools.holder_spread", f"must be one of {SPREADS}, got {t.holder_spread!r}")
     for f in fields(ToolsSpec):
         v = getattr(t, f.name)
-        if f.name != "holder_spread":
+        if f.name not in ("holder_spread", "shape"):
             _require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
     for name in ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "stroke"):
         v = getattr(t, name)
@@ -455,22 +562,33 @@ def _validate_tools(s: Scene) -> None:
              f"must be >= 0 (the punch would overlap the blank), got {t.punch_gap}")
     g = s.geometry
     flat = t.die_half_width + t.die_profile_radius  # where the die's flat top and the holder start
-    side = "lx" if g.lx <= g.ly else "ly"
-    _require(min(g.lx, g.ly) / 2 > flat, f"geometry.{side}",
-             f"the blank does not reach the blank holder and the die's flat top: half its size "
-             f"{getattr(g, side) / 2} must exceed die_half_width + die_profile_radius = {flat}")
+    if g.shape == "rectangle":
+        side = "lx" if g.lx <= g.ly else "ly"
+        _require(min(g.lx, g.ly) / 2 > flat, f"geometry.{side}",
+                 f"the blank does not reach the blank holder and the die's flat top: half its size "
+                 f"{getattr(g, side) / 2} must exceed die_half_width + die_profile_radius = {flat}")
+    elif g.shape == "circle":
+        _require(g.radius > flat, "geometry.radius",
+                 f"the blank does not reach the blank holder and the die's flat top: its radius {g.radius} "
+                 f"must exceed die_half_width + die_profile_radius = {flat}")
     if t.friction > 0:
         _require("friction" in s.effects, "tools.friction", f"friction = {t.friction} needs the effect 'friction'")
     else:
         _require("friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
-    outer = ("right", "top") if g.region == "quarter" else SIDES
+    if g.shape == "rectangle":
+        outer = ("right", "top") if g.region == "quarter" else SIDES
+    else:  # an outline's edges are free or symmetry lines
+        outer = tuple(k for k, v in s.supports.items() if v != "symmetry")
     for side in outer:
-        v = getattr(s.supports, side)
+        v = s.supports.get(side, "free")
         _require(v == "free", f"supports.{side}",
-                 f"the tools hold the blank: its outer sides must be 'free', got {v!r}")
+                 f"the tools hold the blank: its outer edges must be 'free', got {v!r}")
 
 
 def bounds(s: Scene) -> tuple[float, float, float, float]:
-    """x_min, x_max, y_min, y_max of the meshed region (the blank is centred at the origin)."""
+    """x_min, x_max, y_min, y_max of the meshed region (a rectangle or circle is centred at the
+    origin; a polygon is where its vertices are; a file's region is known once it is read)."""
+    if s.geometry.shape in ("circle", "polygon"):
+        return outline.region_bounds(s.geometry)
     hx, hy = s.geometry.lx / 2, s.geometry.ly / 2
     return (0.0, hx, 0.0, hy) if s.geometry.region == "quarter" else (-hx, hx, -hy, hy)

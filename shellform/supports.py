@@ -1,6 +1,9 @@
-"""Named supports on the sides of the blank, as Dirichlet conditions on carrier components.
+"""Named supports on the edges of the blank, as Dirichlet conditions on carrier components.
 
-On a side with in-plane normal n and tangent s (left/right: n = x; bottom/top: n = y):
+This is the route of edges along x or y, where n and s are the axes themselves: every edge of a
+rectangle, the symmetry lines of a circle or polygon. (Curved and oblique edges of the linear
+plate and shell turn their DOFs into the edge's frame: shellform.edge_frames.)
+On an edge with in-plane normal n and tangent s (left/right: n = x; bottom/top: n = y):
 
     simply_supported  w = 0, w,s = 0 (w vanishes along the side), u_s = 0 (shell diaphragm)
     clamped           w = 0, w,x = w,y = 0, u = v = 0
@@ -21,9 +24,10 @@ a value fixed along a side fixes its derivative along the side too:
 import numpy as np
 from dolfinx import fem
 
-from shellform.mesh import SIDE_TAG
+from mpi4py import MPI
 
-NORMAL = {"left": "x", "right": "x", "bottom": "y", "top": "y"}
+from shellform.edge_frames import facet_normals
+from shellform.errors import InputError
 
 _FIXED = {  # support -> components fixed, in terms of the side's normal (n) and tangent (s)
     "simply_supported": ("w", "w,s", "u_s"),
@@ -41,8 +45,8 @@ def _component(role: str, normal: str) -> str:
     }[role]
 
 
-def fixed_components(support: str, side: str) -> tuple[str, ...]:
-    return tuple(_component(r, NORMAL[side]) for r in _FIXED[support])
+def fixed_components(support: str, normal: str) -> tuple[str, ...]:
+    return tuple(_component(r, normal) for r in _FIXED[support])
 
 
 _SHEET_FIXED = {  # roles: displacement (u_n, u_s, w) with a derivative suffix ",n" or ",s"
@@ -54,9 +58,8 @@ _SHEET_FIXED = {  # roles: displacement (u_n, u_s, w) with a derivative suffix "
 }
 
 
-def sheet_fixed_components(support: str, side: str) -> tuple[str, ...]:
-    """The nonlinear sheet's carrier components fixed by a support on a side."""
-    normal = NORMAL[side]
+def sheet_fixed_components(support: str, normal: str) -> tuple[str, ...]:
+    """The nonlinear sheet's carrier components fixed by a support on an edge of that normal axis."""
     tangent = "y" if normal == "x" else "x"
     name = {"u_n": "u" if normal == "x" else "v", "u_s": "v" if normal == "x" else "u", "w": "w"}
     out = []
@@ -66,13 +69,28 @@ def sheet_fixed_components(support: str, side: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def boundary_conditions(V, components, facet_tags, supports, fixed=fixed_components) -> list[fem.DirichletBC]:
-    """Homogeneous Dirichlet conditions for the supports {side: name} on the carrier V."""
-    fdim = facet_tags.dim
+def normal_axis(blank, group: str, tol: float = 1e-9) -> str:
+    """'x' or 'y': the axis every facet normal of a boundary group lies along (on all ranks)."""
+    _, _, n = facet_normals(blank, blank.facets(group))
+    along = (bool(np.all(np.abs(n[:, 1]) <= tol)), bool(np.all(np.abs(n[:, 0]) <= tol)))
+    along = tuple(blank.mesh.comm.allreduce(int(a), op=MPI.MIN) > 0 for a in along)
+    if along[0]:
+        return "x"
+    if along[1]:
+        return "y"
+    raise InputError(f"supports.{group}", "this edge is curved or oblique: only the linear plate and shell "
+                     "support such edges (in the edge's frame); the nonlinear sheet needs edges along x or y")
+
+
+def boundary_conditions(V, components, blank, supports, fixed=fixed_components) -> list[fem.DirichletBC]:
+    """Homogeneous Dirichlet conditions for the supports {group: name} of a BlankMesh on the carrier V."""
+    fdim = blank.facet_tags.dim
     dofs: dict[str, list[np.ndarray]] = {}
-    for side, support in supports.items():
-        facets = facet_tags.find(SIDE_TAG[side])
-        for comp in fixed(support, side):
+    for group, support in supports.items():
+        if support == "free":
+            continue
+        facets = blank.facets(group)
+        for comp in fixed(support, normal_axis(blank, group)):
             if comp in components:
                 sub = V.sub(components.index(comp))
                 dofs.setdefault(comp, []).append(fem.locate_dofs_topological(sub, fdim, facets))

@@ -77,7 +77,7 @@ def _plate(n=8, L=100.0, t=1.0):
     rect = rectangle(MPI.COMM_WORLD, L, L, region="quarter", n=n)
     model = SheetModel(rect.mesh, Hill79Material(E=210000.0, nu=0.3).pack(), t, ("geometric_nonlinearity",))
     sup = {"left": "symmetry", "bottom": "symmetry", "right": "simply_supported", "top": "simply_supported"}
-    bcs = named_supports.boundary_conditions(model.V, model.components, rect.facet_tags, sup,
+    bcs = named_supports.boundary_conditions(model.V, model.components, rect, sup,
                                              fixed=named_supports.sheet_fixed_components)
     return rect, model, bcs
 

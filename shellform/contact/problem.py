@@ -13,7 +13,7 @@ from mpi4py import MPI
 from shellform import supports as named_supports
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.tools import square_cup_tools
-from shellform.mesh import rectangle
+from shellform.mesh import blank
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.model import SheetModel
 from shellform.scene import Scene
@@ -31,14 +31,13 @@ class DrawingProblem:
 
     @classmethod
     def from_scene(cls, s: Scene, comm=MPI.COMM_WORLD, checkpoint_dir=None, verbose=True, trace=False):
-        g, m, pr, t = s.geometry, s.mesh, s.process, s.tools
-        rect = rectangle(comm, g.lx, g.ly, region=g.region, kind=m.kind, n=m.n, diagonal=m.diagonal,
-                         refine=m.refine)
+        pr, t = s.process, s.tools
+        rect = blank(comm, s)
         model = SheetModel(rect.mesh, s.hill79().pack(), s.material.thickness, s.effects, pr.thickness_points)
-        bcs = named_supports.boundary_conditions(model.V, model.components, rect.facet_tags, vars(s.supports),
+        bcs = named_supports.boundary_conditions(model.V, model.components, rect, s.supports,
                                                  fixed=named_supports.sheet_fixed_components)
         tools = square_cup_tools(t, s.material.thickness)
-        symmetry = 4 if g.region == "quarter" else 1
+        symmetry = s.symmetry_copies
         controls = Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
                             max_iterations=pr.max_iterations, rtol=pr.rtol)
         mu = t.friction if "friction" in s.effects else 0.0

@@ -14,7 +14,8 @@ Writes into the output folder (forces and draw-in for the whole blank):
                              penetration, free nodes under the closed holder, iterations,
                              smallest line-search factor, contacts
     thickness_diagonal.csv   initial distance from the centre along x = y, thickness strain
-    thickness_transverse.csv the same along the transverse centre line y = 0
+    thickness_transverse.csv the same along the transverse centre line y = 0 (round tools:
+                             thickness_0deg.csv along y = 0, thickness_90deg.csv along x = 0)
     cup.bp, cup_cells.bp     VTX time series at the reports: displacement and nodal thickness
                              strain; per cell the equivalent plastic strain and the major and
                              minor logarithmic surface strains
@@ -144,9 +145,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
     if series is not None:
         series.close()
     d = p.driver
-    diagonal, transverse = cup.thickness_lines(p)
-    write_csv(outdir / "thickness_diagonal.csv", diagonal, ["initial_position_mm", "thickness_strain"])
-    write_csv(outdir / "thickness_transverse.csv", transverse, ["initial_position_mm", "thickness_strain"])
+    for name, line in cup.thickness_lines(p).items():
+        write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
     write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
     cup.plot_force(outdir / "force_stroke.png", curve, s.title)
     if s.output.png:

@@ -1,5 +1,8 @@
-"""Meshes: the rectangular blank (full or quarter, structured or gmsh) and the patch-test mesh."""
+"""Meshes of the blank: a rectangle (structured or gmsh), a circle, a polygon or a gmsh file, with
+its boundary in named groups (BlankMesh); and the patch-test mesh."""
 
-from shellform.mesh.rectangle import SIDE_TAG, SIDES, RectangleMesh, distorted_patch, rectangle
+from shellform.mesh.blank_mesh import BlankMesh
+from shellform.mesh.outline import blank
+from shellform.mesh.rectangle import SIDE_TAG, SIDES, distorted_patch, rectangle
 
-__all__ = ["SIDES", "SIDE_TAG", "RectangleMesh", "rectangle", "distorted_patch"]
+__all__ = ["SIDES", "SIDE_TAG", "BlankMesh", "blank", "rectangle", "distorted_patch"]

@@ -33,9 +33,14 @@ def estimated_cells(lx: float, ly: float, region: str, kind: str, n: int, refine
     w, h = (lx, ly) if region == "full" else (lx / 2, ly / 2)
     if kind == "structured":
         base = 2 * n * structured_ny(lx, ly, region, n)
-    else:  # equilateral triangles of side w / n: area sqrt(3)/4 (w/n)^2 each
-        base = math.ceil(w * h / (math.sqrt(3) / 4 * (w / n) ** 2))
+    else:
+        return gmsh_cells(w * h, w / n, refine)
     return int(base * 4**refine)
+
+
+def gmsh_cells(area: float, size: float, refine: int) -> int:
+    """Triangles gmsh makes of that area at that size: equilateral, sqrt(3)/4 size^2 each."""
+    return int(math.ceil(area / (math.sqrt(3) / 4 * size**2)) * 4**refine)
 
 
 def available_bytes() -> float:

@@ -5,15 +5,15 @@ one quarter of it (region "quarter", symmetry on x = 0 and y = 0); region "full"
 Exterior facets are tagged by side (SIDE_TAG) for boundary conditions.
 """
 
-from contextlib import contextmanager
-from dataclasses import dataclass
 from numbers import Integral, Real
 
 import numpy as np
 
 import dolfinx.mesh
 from shellform.errors import InputError
+from shellform.mesh.blank_mesh import BlankMesh
 from shellform.mesh.budget import structured_ny
+from shellform.mesh.gmsh_model import mesh_on_root, partitioner
 
 SIDES = ("left", "right", "bottom", "top")  # x = x_min, x = x_max, y = y_min, y = y_max
 SIDE_TAG = {"left": 1, "right": 2, "bottom": 3, "top": 4}
@@ -26,19 +26,6 @@ DIAGONALS = {
     "right/left": dolfinx.mesh.DiagonalType.right_left,
     "left/right": dolfinx.mesh.DiagonalType.left_right,
 }
-
-
-@dataclass
-class RectangleMesh:
-    """A mesh of the blank (or its quarter) with its boundary facets tagged by side."""
-
-    mesh: dolfinx.mesh.Mesh
-    facet_tags: dolfinx.mesh.MeshTags
-    bounds: tuple[float, float, float, float]  # x_min, x_max, y_min, y_max
-
-
-def _partitioner():
-    return dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet, 2)
 
 
 def _positive(field, value):
@@ -103,7 +90,7 @@ def rectangle(comm, lx, ly, region="full", kind="structured", n=8, diagonal="rig
         )
     else:
         msh = _gmsh_rectangle(comm, bounds, (bounds[1] - bounds[0]) / n, [(0.0, 0.0)] + pts, refine)
-    return RectangleMesh(msh, _tag_sides(msh, bounds, tol), bounds)
+    return BlankMesh(msh, _tag_sides(msh, bounds, tol), bounds, dict(SIDE_TAG))
 
 
 def _tag_sides(msh, bounds, tol):
@@ -123,83 +110,25 @@ def _tag_sides(msh, bounds, tol):
     return dolfinx.mesh.meshtags(msh, tdim - 1, facets[order].astype(np.int32), values[order])
 
 
-_GMSH_OPTIONS = {
-    "General.Terminal": 0,
-    "General.Verbosity": 0,
-    "General.NumThreads": 1,
-    "Mesh.Algorithm": 6,  # Frontal-Delaunay
-    "Mesh.RandomSeed": 1,
-    "Mesh.ElementOrder": 1,
-    "Mesh.RecombineAll": 0,
-    "Mesh.MeshSizeFromCurvature": 0,
-    "Mesh.MeshSizeExtendFromBoundary": 1,
-    "Mesh.MeshSizeFromPoints": 1,
-    "Mesh.MeshSizeMin": 0.0,
-}
-
-
-@contextmanager
-def _gmsh_model():
-    """A fresh gmsh model with shellform's options; restores gmsh's previous state afterwards."""
-    import gmsh
-
-    owner = not gmsh.isInitialized()
-    if owner:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-    saved = {k: gmsh.option.getNumber(k) for k in (*_GMSH_OPTIONS, "Mesh.MeshSizeMax")}
-    previous = gmsh.model.getCurrent() if not owner else None
-    try:
-        for k, v in _GMSH_OPTIONS.items():
-            gmsh.option.setNumber(k, v)
-        gmsh.model.add("shellform_rectangle")
-        yield gmsh
-    finally:
-        if owner:
-            gmsh.finalize()
-        else:
-            gmsh.model.remove()
-            if previous:
-                gmsh.model.setCurrent(previous)
-            for k, v in saved.items():
-                gmsh.option.setNumber(k, v)
-
-
 def _gmsh_rectangle(comm, bounds, h, points, refine=0):
     """Unstructured triangles of the rectangle `bounds`, size h, with `points` as vertices."""
-    from dolfinx.io.gmsh import model_to_mesh
-
     x0, x1, y0, y1 = bounds
-    root = 0
-    session = _gmsh_model() if comm.rank == root else _nothing()
-    with session as gmsh:
-        error = None
-        if comm.rank == root:
-            try:
-                occ = gmsh.model.occ
-                surface = occ.addRectangle(x0, y0, 0.0, x1 - x0, y1 - y0)
-                unique = sorted(set(points))
-                occ.fragment([(2, surface)], [(0, occ.addPoint(x, y, 0.0)) for x, y in unique])
-                occ.synchronize()
-                surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
-                gmsh.model.addPhysicalGroup(2, surfaces, 1, name="blank")
-                gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-                gmsh.model.mesh.setSize(gmsh.model.getEntities(0), h)
-                gmsh.model.mesh.generate(2)
-                for _ in range(refine):
-                    gmsh.model.mesh.refine()
-            except Exception as exc:  # noqa: BLE001  (re-raised on every rank below)
-                error = f"gmsh failed to mesh the region {bounds}: {exc}"
-        error = comm.bcast(error, root=root)
-        if error:
-            raise RuntimeError(error)
-        model = gmsh.model if comm.rank == root else None
-        data = model_to_mesh(model, comm, root, gdim=2, partitioner=_partitioner())
-    return data.mesh
 
+    def build(gmsh):
+        occ = gmsh.model.occ
+        surface = occ.addRectangle(x0, y0, 0.0, x1 - x0, y1 - y0)
+        unique = sorted(set(points))
+        occ.fragment([(2, surface)], [(0, occ.addPoint(x, y, 0.0)) for x, y in unique])
+        occ.synchronize()
+        surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+        gmsh.model.addPhysicalGroup(2, surfaces, 1, name="blank")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.model.mesh.setSize(gmsh.model.getEntities(0), h)
+        gmsh.model.mesh.generate(2)
+        for _ in range(refine):
+            gmsh.model.mesh.refine()
 
-@contextmanager
-def _nothing():
-    yield None
+    return mesh_on_root(comm, build, f"the region {bounds}").mesh
 
 
 _PATCH_VERTICES = np.array(
@@ -226,5 +155,4 @@ def distorted_patch(comm):
         cells, x = _PATCH_CELLS.astype(np.int64), _PATCH_VERTICES.copy()
     else:
         cells, x = np.empty((0, 3), dtype=np.int64), np.empty((0, 2))
-    partitioner = _partitioner() if comm.size > 1 else None
-    return dolfinx.mesh.create_mesh(comm, cells, domain, x, partitioner)
+    return dolfinx.mesh.create_mesh(comm, cells, domain, x, partitioner() if comm.size > 1 else None)

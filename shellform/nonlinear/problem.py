@@ -1,4 +1,4 @@
-"""A nonlinear sheet problem on a rectangular blank: mesh -> model -> supports -> loads -> driver.
+"""A nonlinear sheet problem on a blank (a rectangle, or any BlankMesh): mesh -> model -> supports -> loads -> driver.
 
     p = SheetProblem.on_rectangle(comm, lx, ly, region, n, material, thickness, effects,
                                   supports, loads, prescribed, controls)
@@ -20,7 +20,7 @@ from mpi4py import MPI
 
 from shellform import supports as named_supports
 from shellform.loads import value_at
-from shellform.mesh import SIDE_TAG, rectangle
+from shellform.mesh import rectangle
 from shellform.nonlinear.driver import Controls, Driver
 from shellform.nonlinear.loads import NodalLoads, SheetLoads
 from shellform.nonlinear.model import SheetModel
@@ -37,13 +37,21 @@ class SheetProblem:
     def on_rectangle(cls, comm, lx, ly, n, material, thickness, effects, supports, loads=None,
                      prescribed=None, controls=None, region="full", kind="structured", diagonal="right",
                      thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
-        loads = loads or SheetLoads()
-        points = [(p.x, p.y) for p in loads.points]
+        points = [(p.x, p.y) for p in (loads or SheetLoads()).points]
         rect = rectangle(comm, lx, ly, region=region, kind=kind, n=n, diagonal=diagonal, points=points)
+        return cls.on_blank(rect, material, thickness, effects, supports, loads, prescribed, controls,
+                            thickness_points, kappa0, checkpoint_dir, verbose)
+
+    @classmethod
+    def on_blank(cls, rect, material, thickness, effects, supports, loads=None, prescribed=None, controls=None,
+                 thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
+        """The problem on a meshed blank (shellform.mesh.BlankMesh) whose supported edges lie
+        along x or y."""
+        loads = loads or SheetLoads()
         mat = material.pack() if hasattr(material, "pack") else np.asarray(material, dtype=np.float64)
         model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0)
         V, comps = model.V, model.components
-        bcs = named_supports.boundary_conditions(V, comps, rect.facet_tags, supports,
+        bcs = named_supports.boundary_conditions(V, comps, rect, supports,
                                                  fixed=named_supports.sheet_fixed_components)
         qbar = fem.Function(V)
         pdofs = {}
@@ -53,12 +61,12 @@ class SheetProblem:
             if side == "all":
                 dofs = (V.dofmap.index_map_bs * np.arange(xy.shape[0]) + comps.index(comp)).astype(np.int32)
             else:
-                dofs = fem.locate_dofs_topological(sub, 1, rect.facet_tags.find(SIDE_TAG[side]))
+                dofs = fem.locate_dofs_topological(sub, 1, rect.facets(side))
             at = xy[dofs // V.dofmap.index_map_bs]
             qbar.x.array[dofs] = value(at[:, 0], at[:, 1]) if callable(value) else value
             pdofs[(side, comp)] = dofs
             bcs.append(fem.dirichletbc(np.float64(0), dofs, sub))
-        tol = 1e-9 * max(lx, ly)
+        tol = 1e-9 * rect.size
         nodal = NodalLoads(V, rect.facet_tags, loads, tol) if (loads.points or loads.moments) else None
         driver = Driver(model, bcs, prescribed=qbar if prescribed else None, pressure=loads.pressure,
                         nodal=nodal, controls=controls or Controls(), checkpoint_dir=checkpoint_dir,
@@ -66,15 +74,14 @@ class SheetProblem:
         return cls(rect, model, driver, pdofs)
 
     def value(self, name: str, x: float, y: float) -> float:
-        tol = 1e-9 * max(b - a for a, b in zip(self.rect.bounds[0::2], self.rect.bounds[1::2]))
-        return value_at(self.driver.q, self.model.components, name, x, y, tol)
+        return value_at(self.driver.q, self.model.components, name, x, y, 1e-9 * self.rect.size)
 
     def reaction(self, side: str, comp: str) -> float:
         """Sum over the side of the internal force conjugate to a held component."""
         dofs = self.prescribed_dofs.get((side, comp))
         if dofs is None:
             sub = self.model.V.sub(self.model.components.index(comp))
-            dofs = fem.locate_dofs_topological(sub, 1, self.rect.facet_tags.find(SIDE_TAG[side]))
+            dofs = fem.locate_dofs_topological(sub, 1, self.rect.facets(side))
         owned = self.model.V.dofmap.index_map.size_local * self.model.V.dofmap.index_map_bs
         local = float(np.sum(self.driver.residual_full[dofs[dofs < owned]]))
         return self.model.mesh.comm.allreduce(local, op=MPI.SUM)

@@ -18,6 +18,7 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from shellform.mesh import blank
 from shellform.nonlinear.driver import ConvergenceFailure, Controls
 from shellform.nonlinear.loads import EdgeMoment, PointForce, SheetLoads
 from shellform.nonlinear.problem import SheetProblem
@@ -28,7 +29,7 @@ from shellform.results.tables import write_csv, write_json
 
 
 def problem(s: Scene, comm=MPI.COMM_WORLD, outdir=None) -> SheetProblem:
-    g, m, pr = s.geometry, s.mesh, s.process
+    pr = s.process
     loads = SheetLoads(
         pressure=s.loads.pressure,
         points=[PointForce(p.x, p.y, (p.fx, p.fy, p.fz)) for p in s.loads.point],
@@ -36,10 +37,10 @@ def problem(s: Scene, comm=MPI.COMM_WORLD, outdir=None) -> SheetProblem:
     controls = Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
                         max_iterations=pr.max_iterations, rtol=pr.rtol)
     kappa0 = np.diag(s.kappa0) if "shallow_curvature" in s.effects else None
-    return SheetProblem.on_rectangle(
-        comm, g.lx, g.ly, m.n, s.hill79(), s.material.thickness, s.effects, vars(s.supports), loads,
-        controls=controls, region=g.region, kind=m.kind, diagonal=m.diagonal,
-        thickness_points=pr.thickness_points, kappa0=kappa0, checkpoint_dir=outdir, verbose=True)
+    return SheetProblem.on_blank(
+        blank(comm, s, [(p.x, p.y) for p in s.loads.point]), s.hill79(), s.material.thickness, s.effects,
+        s.supports, loads, controls=controls, thickness_points=pr.thickness_points, kappa0=kappa0,
+        checkpoint_dir=outdir, verbose=True)
 
 
 def cell_functions(p: SheetProblem) -> dict:

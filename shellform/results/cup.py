@@ -1,8 +1,11 @@
 """The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX series, the
 force-stroke plot and the picture of the cup (used by shellform.contact.run).
 
-DX = draw-in of the blank edge at the middle of the side x = L/2 (initial x minus current x),
-DY the same on y = L/2, DD along the diagonal at the corner (initial minus current radius).
+DX = draw-in of the blank edge on the axis y = 0 (initial x minus current x), DY the same on
+x = 0, DD along the diagonal at the edge's node farthest along x + y (the square blank's corner;
+initial minus current radius). A square cup's thickness lines are the diagonal x = y and the
+transverse centre line y = 0; a round cup's the rolling (0 deg, y = 0) and transverse (90 deg,
+x = 0) lines.
 """
 
 from pathlib import Path
@@ -20,18 +23,19 @@ def _gather(comm, *arrays):
 
 
 def draw_in(p) -> dict:
-    """DX, DY, DD (mm) at the blank's edge midpoints and corner (x, y >= 0 quadrant)."""
+    """DX, DY, DD (mm) at the blank's edge on the axes and the diagonal (x, y >= 0 quadrant)."""
     X, x, _ = p.nodal_values()
     X, x = _gather(p.model.mesh.comm, X, x)
-    hx, hy = p.scene.geometry.lx / 2, p.scene.geometry.ly / 2
+    hx, hy = p.rect.bounds[1], p.rect.bounds[3]
 
     def at(px, py):
         i = int(np.argmin(np.hypot(X[:, 0] - px, X[:, 1] - py)))
-        return x[i]
+        return X[i], x[i]
 
-    corner = at(hx, hy)
-    return {"DX": float(hx - at(hx, 0.0)[0]), "DY": float(hy - at(0.0, hy)[1]),
-            "DD": float(np.hypot(hx, hy) - np.hypot(corner[0], corner[1]))}
+    (X0, x0), (X1, x1) = at(hx, 0.0), at(0.0, hy)
+    corner = int(np.argmax(X[:, 0] + X[:, 1]))
+    return {"DX": float(X0[0] - x0[0]), "DY": float(X1[1] - x1[1]),
+            "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
 
 
 def _on_line(X, diagonal: bool, tol: float) -> np.ndarray:
@@ -39,17 +43,25 @@ def _on_line(X, diagonal: bool, tol: float) -> np.ndarray:
     return np.abs(X[:, 0] - X[:, 1]) < tol if diagonal else np.abs(X[:, 1]) < tol
 
 
-def thickness_lines(p) -> tuple[list[dict], list[dict]]:
-    """Thickness strain at the nodes along the diagonal and along y = 0, by initial distance."""
+LINES = {  # the thickness lines of a cup by its tools' shape: name -> nodes on it
+    "square": {"diagonal": lambda X, tol: np.abs(X[:, 0] - X[:, 1]) < tol,
+               "transverse": lambda X, tol: np.abs(X[:, 1]) < tol},
+    "round": {"0deg": lambda X, tol: np.abs(X[:, 1]) < tol, "90deg": lambda X, tol: np.abs(X[:, 0]) < tol},
+}
+
+
+def thickness_lines(p) -> dict[str, list[dict]]:
+    """Thickness strain at the nodes along the cup's lines (LINES), by initial distance."""
     X, _, e33 = p.nodal_values()
     X, e33 = _gather(p.model.mesh.comm, X, e33)
-    tol = 1e-6 * p.scene.geometry.lx
-    lines = []
-    for on in (_on_line(X, True, tol), _on_line(X, False, tol)):
+    tol = 1e-6 * p.rect.size
+    lines = {}
+    for name, line in LINES[p.scene.tools.shape].items():
+        on = line(X, tol)
         r = np.hypot(X[on, 0], X[on, 1])
-        order = np.argsort(r)
-        lines.append([{"initial_position_mm": float(r[i]), "thickness_strain": float(e33[on][i])} for i in order])
-    return lines[0], lines[1]
+        lines[name] = [{"initial_position_mm": float(r[i]), "thickness_strain": float(e33[on][i])}
+                       for i in np.argsort(r)]
+    return lines
 
 
 def peak_thinning(p) -> dict:
@@ -170,7 +182,7 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.add_mesh(grid, scalars=name, show_edges=True, cmap=cmap, clim=clim, edge_color="#555555",
                 line_width=0.5, scalar_bar_args={"title": name})
     pl.add_text(title, font_size=10)
-    L = max(p.scene.geometry.lx, p.scene.geometry.ly)
+    L = 2 * p.rect.size if p.symmetry == 4 else p.rect.size
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
     pl.screenshot(str(path))
     pl.close()

@@ -1,0 +1,198 @@
+"""Supports on curved and oblique edges: the slope and in-plane displacement DOFs of each
+boundary vertex turned into the edge's own normal-tangent frame.
+
+A support fixes, at each vertex of its edge (normal n, tangent s = n rotated by +90 degrees;
+shellform.supports names the roles):
+
+    w                  the deflection
+    w,n / w,s          the slope along n / along s:   grad w . n = 0,  grad w . s = 0
+    u_n / u_s          the in-plane displacement along n / along s
+
+A vertex collects the directions d its edges fix for the slope pair (w_x, w_y) and for the
+displacement pair (u, v). Two non-parallel directions fix the whole pair. One direction d that
+is an axis fixes that component. Any other d turns the pair into the frame (d, d_perp):
+
+    (a_x, a_y) = a_1 d + a_2 d_perp,   i.e.   q = R q',   R = [[d_x, -d_y], [d_y, d_x]] per pair,
+
+and fixes a_1. The system becomes R^T K R q' = R^T f with the fixed rows and columns of q'
+replaced by the identity, and q = R q'. Imposing w,s = 0 with the true tangent of a circle
+(and leaving w,n free) is what makes a simply supported curved edge converge to the curved
+plate, not to the polygon's (the Babuska paradox; a C1 element that fixed both slopes at the
+vertices of the polygon would clamp it).
+
+Normals: exact where the outline is known (BlankMesh.normals: the circle's rim), else the mean
+of the unit outward normals of the group's facets at the vertex, summed over all ranks.
+"""
+
+import dolfinx.mesh
+import numpy as np
+from dolfinx import la
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from shellform.errors import InputError
+
+_ROLES = {  # support -> roles fixed (linear plate and shell)
+    "simply_supported": ("w", "w,s", "u_s"),
+    "clamped": ("w", "w,n", "w,s", "u_n", "u_s"),
+    "symmetry": ("w,n", "u_n"),
+    "free": (),
+}
+_PAIRS = {"slope": ("w_x", "w_y"), "disp": ("u", "v")}
+
+
+def facet_normals(blank, facets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices (n, 2), end points (n, 2, 2) and unit outward normals (n, 2) of boundary facets."""
+    msh = blank.mesh
+    top = msh.topology
+    for d0, d1 in ((1, 0), (1, 2)):
+        top.create_connectivity(d0, d1)
+    f2v, f2c = top.connectivity(1, 0), top.connectivity(1, 2)
+    x = msh.geometry.x[:, :2]
+    facets = np.asarray(facets, dtype=np.int32)
+    verts = f2v.array.reshape(-1, 2)[facets]
+    ends = x[dolfinx.mesh.entities_to_geometry(msh, 1, facets)]
+    t = ends[:, 1] - ends[:, 0]
+    n = np.column_stack([t[:, 1], -t[:, 0]]) / np.hypot(t[:, 0], t[:, 1])[:, None]
+    cells = np.array([f2c.links(f)[0] for f in facets], dtype=np.int32)
+    centroid = x[dolfinx.mesh.entities_to_geometry(msh, 2, cells)].mean(axis=1)
+    flip = np.sum(n * (ends.mean(axis=1) - centroid), axis=1) < 0
+    n[flip] *= -1
+    return verts, ends, n
+
+
+def _vertex_blocks(V) -> np.ndarray:
+    """Dof block of each local mesh vertex of the P1 carrier V."""
+    top = V.mesh.topology
+    c2v = top.connectivity(2, 0).array.reshape(-1, 3)
+    out = np.empty(top.index_map(0).size_local + top.index_map(0).num_ghosts, dtype=np.int32)
+    out[c2v.ravel()] = V.dofmap.list.ravel()
+    return out
+
+
+def group_vertex_normals(V, blank, group) -> dict[int, np.ndarray]:
+    """Owned dof block -> unit outward normal, for the vertices of a boundary group."""
+    facets = blank.facets(group)
+    facets = facets[facets < blank.mesh.topology.index_map(1).size_local]  # owned: counted once
+    verts, _, n = facet_normals(blank, facets)
+    blocks = _vertex_blocks(V)
+    acc = la.vector(V.dofmap.index_map, 3)
+    a = acc.array.reshape(-1, 3)
+    for k in (0, 1):
+        np.add.at(a, blocks[verts[:, k]], np.column_stack([n, np.ones(len(n))]))
+    acc.scatter_reverse(la.InsertMode.add)
+    owned = V.dofmap.index_map.size_local
+    hit = np.flatnonzero(a[:owned, 2] > 0)
+    normal = a[hit, :2] / np.hypot(a[hit, 0], a[hit, 1])[:, None]
+    exact = blank.normals.get(group)
+    if exact is not None:
+        xy = V.tabulate_dof_coordinates()[hit, :2]
+        normal = np.column_stack(exact(xy[:, 0], xy[:, 1]))
+    return dict(zip(hit.tolist(), normal))
+
+
+class EdgeConstraints:
+    """The supports {group: support} of a BlankMesh on the linear carrier V, in edge frames."""
+
+    def __init__(self, V, components, blank, supports: dict[str, str], tol: float = 1e-10):
+        self.V, self.bs = V, V.dofmap.index_map_bs
+        col = {c: i for i, c in enumerate(components)}
+        fixed: set[int] = set()
+        directions: dict[tuple[int, str], list[np.ndarray]] = {}
+        for group, support in supports.items():
+            roles = _ROLES[support]
+            if not roles:
+                continue
+            for block, n in group_vertex_normals(V, blank, group).items():
+                s = np.array([-n[1], n[0]])
+                for role in roles:
+                    base, _, along = role.partition(",")
+                    if role == "w" and "w" in col:
+                        fixed.add(block * self.bs + col["w"])
+                    elif base == "w" and along and "w_x" in col:
+                        directions.setdefault((block, "slope"), []).append(n if along == "n" else s)
+                    elif base in ("u_n", "u_s") and "u" in col:
+                        directions.setdefault((block, "disp"), []).append(n if base == "u_n" else s)
+        frames = {}
+        for (block, pair), ds in directions.items():
+            ix, iy = (block * self.bs + col[c] for c in _PAIRS[pair])
+            d = ds[0]
+            if any(abs(d[0] * e[1] - d[1] * e[0]) > tol for e in ds[1:]):
+                fixed.update((ix, iy))  # two directions: the whole pair
+            elif abs(d[1]) <= tol:
+                fixed.add(ix)
+            elif abs(d[0]) <= tol:
+                fixed.add(iy)
+            else:
+                frames[(ix, iy)] = d / np.hypot(*d)
+                fixed.add(ix)  # a_1, the component along d, sits in the x slot
+        self.fixed = np.array(sorted(fixed), dtype=np.int32)  # owned local dofs, frame basis
+        self.frames = frames
+        self.rotation = None
+
+    def _rotation(self, A):
+        """R: identity but for the 2 x 2 frame blocks, in A's parallel layout."""
+        imap = self.V.dofmap.index_map
+        start = imap.local_range[0] * self.bs
+        R = PETSc.Mat().createAIJ(A.getSizes(), nnz=2, comm=A.getComm())
+        R.setUp()
+        for i in range(imap.size_local * self.bs):
+            R.setValue(start + i, start + i, 1.0)
+        for (ix, iy), d in self.frames.items():
+            gx, gy = start + ix, start + iy
+            R.setValues([gx, gy], [gx, gy], [[d[0], -d[1]], [d[1], d[0]]])
+        R.assemble()
+        return R
+
+    def apply(self, A, b):
+        """The frame system R^T A R, R^T b with the fixed rows and columns set to the identity
+        (A and b, unconstrained, are replaced)."""
+        frames_anywhere = A.getComm().tompi4py().allreduce(len(self.frames)) > 0
+        if frames_anywhere:
+            self.rotation = self._rotation(A)
+            Ar = A.PtAP(self.rotation)
+            br = b.duplicate()
+            self.rotation.multTranspose(b, br)
+            A.destroy(), b.destroy()
+            A, b = Ar, br
+        rows = (self.V.dofmap.index_map.local_range[0] * self.bs + self.fixed).astype(PETSc.IntType)
+        A.zeroRowsColumns(rows, diag=1.0)
+        with b.localForm() as local:
+            local.array[self.fixed] = 0.0
+        return A, b
+
+    def recover(self, q) -> None:
+        """q = R q' in place (the carrier back in x, y components)."""
+        if self.rotation is None:
+            return
+        v = q.x.petsc_vec
+        out = v.duplicate()
+        self.rotation.mult(v, out)
+        out.copy(v)
+        q.x.scatter_forward()
+        out.destroy()
+
+
+def check_symmetry_lines(blank, supports: dict[str, str], tol: float = 1e-9) -> None:
+    """A symmetry support needs a straight edge with the whole blank on one side of it."""
+    comm = blank.mesh.comm
+    x = blank.mesh.geometry.x[:, :2]
+    for group, support in supports.items():
+        if support != "symmetry":
+            continue
+        _, ends, n = facet_normals(blank, blank.facets(group))
+        ref = comm.allgather((n[0], ends[0, 0]) if len(n) else None)
+        ref = next((r for r in ref if r is not None), None)
+        if ref is None:
+            continue
+        n0, p0 = ref
+        bent = len(n) and np.abs(n[:, 0] * n0[1] - n[:, 1] * n0[0]).max() > tol
+        off = len(n) and np.abs((ends.reshape(-1, 2) - p0) @ n0).max() > tol * blank.size
+        beyond = np.max((x - p0) @ n0, initial=-np.inf) > tol * blank.size
+        bad = comm.allreduce(int(bool(bent) or bool(off)) | 2 * int(beyond), op=MPI.BOR)
+        if bad & 1:
+            raise InputError(f"supports.{group}", "a symmetry line must be straight: this edge is curved or bent")
+        if bad & 2:
+            raise InputError(f"supports.{group}", "the blank crosses this symmetry line: a symmetric part must "
+                             "lie on one side of it")
+

@@ -1,0 +1,198 @@
+"""Blanks of any outline (shellform/mesh/outline.py) and supports on curved and oblique edges
+(shellform/edge_frames.py): closed forms of circular and triangular plates, a .msh square
+against the built-in rectangle, rotation invariance, and the errors that name the field."""
+
+import math
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from shellform import linear, scene
+from shellform.errors import InputError
+from shellform.mesh import SIDE_TAG, outline
+from shellform.mesh.gmsh_model import gmsh_session
+from shellform.nonlinear.problem import SheetProblem
+from shellform.material import Hill79Material
+
+NU = 0.3
+PLATE = {"effects": ["bending"], "material": {"E": 12 * (1 - NU**2), "nu": NU, "thickness": 1.0},
+         "loads": {"pressure": 1.0}}  # D = 1, q = 1
+
+
+def circle_scene(support, n=4, refine=0, region="quarter", effects=("bending",)):
+    sym = {"quarter": {"left": "symmetry", "bottom": "symmetry"}, "half": {"bottom": "symmetry"}, "full": {}}
+    return scene.from_dict({**PLATE, "effects": list(effects),
+                            "geometry": {"shape": "circle", "radius": 1.0, "region": region},
+                            "mesh": {"kind": "unstructured", "n": n, "refine": refine},
+                            "supports": {"rim": support, **sym[region]}})
+
+
+@pytest.mark.parametrize("support, reference", [
+    ("clamped", 1 / 64), ("simply_supported", (5 + NU) / (1 + NU) / 64)])
+def test_circular_plate_converges_at_second_order_to_timoshenko(support, reference):
+    """Nested gmsh meshes of the quarter disc: errors fall by 4 per refinement."""
+    errors = [abs(linear.solve(circle_scene(support, 4, k)).value("w") / reference - 1) for k in range(3)]
+    rates = [math.log2(a / b) for a, b in zip(errors, errors[1:])]
+    assert min(rates) > 1.9, (errors, rates)
+    assert errors[-1] < (2e-4 if support == "simply_supported" else 1.2e-3), errors
+
+
+@pytest.mark.parametrize("region", ["full", "half"])
+def test_full_and_half_discs_agree_with_the_quarter(region):
+    """The same closed form from the whole disc and from its half (symmetry on y = 0 only)."""
+    w = linear.solve(circle_scene("simply_supported", 16, 0, region)).value("w")
+    assert w == pytest.approx((5 + NU) / (1 + NU) / 64, rel=2e-3)
+
+
+def test_simply_supported_triangle_matches_its_closed_form():
+    """An equilateral triangle of height a (oblique edges): w_centroid = q a^4 / (972 D)."""
+    v = [[-1 / 3, -1 / math.sqrt(3)], [2 / 3, 0.0], [-1 / 3, 1 / math.sqrt(3)]]
+    errors = []
+    for n in (8, 16, 32):
+        s = scene.from_dict({**PLATE, "geometry": {"shape": "polygon", "vertices": v, "edges": ["e"] * 3},
+                             "mesh": {"kind": "unstructured", "n": n}, "supports": {"e": "simply_supported"}})
+        errors.append(abs(linear.solve(s).value("w") * 972 - 1))
+    assert errors[-1] < 1e-3 and errors[0] > 3 * errors[-1], errors
+
+
+def _write_msh(blank, path):
+    """The mesh and side groups of a BlankMesh as a gmsh .msh file (serial)."""
+    msh = blank.mesh
+    x = msh.geometry.x
+    cells = msh.geometry.dofmaps[0]
+    msh.topology.create_connectivity(1, 0)
+    c2v = msh.topology.connectivity(2, 0).array.reshape(-1, 3)
+    node = np.empty(len(x), dtype=np.int64)
+    node[c2v.ravel()] = cells.ravel()  # vertex -> geometry node
+    f2v = msh.topology.connectivity(1, 0).array.reshape(-1, 2)
+    with gmsh_session() as gmsh:
+        gmsh.model.addDiscreteEntity(2, 1)
+        gmsh.model.mesh.addNodes(2, 1, np.arange(1, len(x) + 1), x.ravel())
+        gmsh.model.mesh.addElementsByType(1, 2, [], (cells + 1).ravel())
+        for side, tag in SIDE_TAG.items():
+            gmsh.model.addDiscreteEntity(1, tag)
+            gmsh.model.mesh.addElementsByType(tag, 1, [], (node[f2v[blank.facets(side)]] + 1).ravel())
+            gmsh.model.addPhysicalGroup(1, [tag], tag, name=side)
+        gmsh.model.addPhysicalGroup(2, [1], 10, name="blank")
+        gmsh.write(str(path))
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="writes the mesh of one rank")
+def test_square_from_a_msh_file_equals_the_builtin_rectangle(tmp_path):
+    """The built-in 2 x 1 rectangle written to .msh and read back as shape = 'file': the same
+    deflections at every vertex to 1e-12, though the file goes through the edge-frame route."""
+    base = {**PLATE, "effects": ["bending", "membrane"], "mesh": {"n": 6, "diagonal": "crossed"},
+            "supports": {"left": "simply_supported", "right": "clamped", "bottom": "simply_supported"}}
+    built_in = scene.from_dict({**base, "geometry": {"lx": 2.0, "ly": 1.0}})
+    _write_msh(linear.mesh(built_in), tmp_path / "square.msh")
+    from_file = scene.from_dict({**base, "mesh": {"kind": "unstructured"},
+                                 "geometry": {"shape": "file", "file": str(tmp_path / "square.msh")}})
+    a, b = linear.solve(built_in), linear.solve(from_file)
+    assert a.num_cells == b.num_cells == 96
+    wa = {tuple(np.round(p, 9)): v for p, v in zip(a.forms.V.tabulate_dof_coordinates()[:, :2],
+                                                    a.q.x.array.reshape(-1, 5))}
+    xb = b.forms.V.tabulate_dof_coordinates()[:, :2]
+    qb = b.q.x.array.reshape(-1, 5)
+    scale = np.abs(a.q.x.array).max()
+    diff = max(np.abs(wa[tuple(np.round(p, 9))] - v).max() for p, v in zip(xb, qb)) / scale
+    assert diff < 1e-12, diff
+
+
+@pytest.mark.parametrize("support", ["clamped", "simply_supported"])
+def test_circular_plate_is_rotation_invariant(support):
+    """The full disc's mesh rotated by 0.7 rad: the same centre deflection to 1e-10 (the simply
+    supported rim turns every rim vertex into its own frame, which turns with the mesh)."""
+    s = circle_scene(support, 6, 0, "full", effects=("bending", "membrane"))
+    w = []
+    for theta in (0.0, 0.7):
+        blank = outline.circle(MPI.COMM_WORLD, 1.0, "full", 6)
+        c, sn = math.cos(theta), math.sin(theta)
+        x = blank.mesh.geometry.x
+        x[:, :2] = x[:, :2] @ np.array([[c, -sn], [sn, c]]).T
+        w.append(linear.solve(s, blank_mesh=blank).value("w"))
+    assert abs(w[1] / w[0] - 1) < 1e-10, w
+
+
+def test_geo_file_groups_are_its_physical_curves(tmp_path):
+    geo = tmp_path / "strip.geo"
+    geo.write_text('Point(1) = {0, 0, 0}; Point(2) = {2, 0, 0}; Point(3) = {2, 1, 0}; Point(4) = {0, 1, 0};\n'
+                   'Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n'
+                   'Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n'
+                   'Physical Curve("clamp") = {4}; Physical Curve("tip") = {2}; Physical Surface("s") = {1};\n')
+    s = scene.from_dict({**PLATE, "loads": {}, "geometry": {"shape": "file", "file": str(geo)},
+                         "mesh": {"kind": "unstructured", "n": 8}, "supports": {"clamp": "clamped"}})
+    blank = linear.mesh(s)
+    assert set(blank.groups) == {"clamp", "tip"}
+    assert blank.bounds == pytest.approx((0.0, 2.0, 0.0, 1.0))
+
+
+def test_nonlinear_sheet_runs_on_a_circle_and_refuses_a_curved_support():
+    """The nonlinear sheet takes supports on the circle's symmetry lines; a clamped rim (a
+    curved edge) is an error naming the support."""
+    mat = Hill79Material(E=1.0, nu=0.3)
+    blank = outline.circle(MPI.COMM_WORLD, 1.0, "quarter", 4)
+    effects = ("bending", "membrane", "geometric_nonlinearity")
+    p = SheetProblem.on_blank(blank, mat, 0.01, effects, {"left": "symmetry", "bottom": "symmetry"})
+    assert p.model.mesh.topology.index_map(2).size_global > 20
+    with pytest.raises(InputError) as err:
+        SheetProblem.on_blank(blank, mat, 0.01, effects, {"rim": "clamped"})
+    assert err.value.field == "supports.rim"
+
+
+def _names_field(data, field):
+    with pytest.raises(InputError) as err:
+        scene.from_dict(data)
+    assert err.value.field == field, str(err.value)
+
+
+CIRCLE = {"shape": "circle", "radius": 1.0}
+UNSTRUCTURED = {"kind": "unstructured"}
+
+
+@pytest.mark.parametrize("data, field", [
+    ({"geometry": {"shape": "ellipse"}}, "geometry.shape"),
+    ({"geometry": {"shape": "circle", "radius": -1.0}, "mesh": UNSTRUCTURED}, "geometry.radius"),
+    ({"geometry": CIRCLE}, "mesh.kind"),  # gmsh meshes outlines
+    ({"geometry": {**CIRCLE, "region": "eighth"}, "mesh": UNSTRUCTURED}, "geometry.region"),
+    ({"geometry": {"radius": 2.0}}, "geometry.radius"),  # a circle's key on a rectangle
+    ({"geometry": CIRCLE, "mesh": UNSTRUCTURED, "supports": {"left": "clamped"}}, "supports.left"),  # no such group
+    ({"geometry": {"shape": "polygon", "vertices": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "mesh": UNSTRUCTURED},
+     "geometry.vertices"),  # self-intersecting
+    ({"geometry": {"shape": "polygon", "vertices": [[0, 0], [1, 0]]}, "mesh": UNSTRUCTURED}, "geometry.vertices"),
+    ({"geometry": {"shape": "polygon", "vertices": [[0, 0], [1, 0], [0, 1]], "edges": ["a", "b"]},
+      "mesh": UNSTRUCTURED}, "geometry.edges"),
+    ({"geometry": {"shape": "polygon", "vertices": [[0, 0], [1, 0], "x"]}, "mesh": UNSTRUCTURED}, "geometry.vertices"),
+    ({"geometry": {"shape": "file", "file": "/no/such/blank.msh"}, "mesh": UNSTRUCTURED}, "geometry.file"),
+    ({"geometry": {"shape": "file", "file": "blank.stl"}, "mesh": UNSTRUCTURED}, "geometry.file"),
+    ({"geometry": CIRCLE, "mesh": {"kind": "unstructured", "n": 10**6}}, "mesh.n"),  # too large for the machine
+    ({"supports": {"left": 3}}, "supports.left"),
+])
+def test_outline_errors_name_the_field(data, field):
+    _names_field({"effects": ["bending"], **data}, field)
+
+
+def test_a_symmetry_line_the_blank_crosses_is_an_error():
+    """An L-shaped polygon: the line of its inner edge 'notch' cuts through the blank."""
+    v = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
+    s = scene.from_dict({**PLATE, "geometry": {"shape": "polygon", "vertices": v,
+                                               "edges": ["b", "r", "notch", "notch2", "t", "l"]},
+                         "mesh": UNSTRUCTURED, "supports": {"notch": "symmetry"}})
+    with pytest.raises(InputError) as err:
+        linear.mesh(s)
+    assert err.value.field == "supports.notch" and "crosses" in str(err.value)
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial file writing")
+def test_a_mesh_of_quadrilaterals_is_an_error(tmp_path):
+    path = tmp_path / "quads.msh"
+    with gmsh_session() as gmsh:
+        gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.RecombineAll", 1)
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(path))
+    s = scene.from_dict({**PLATE, "geometry": {"shape": "file", "file": str(path)}, "mesh": UNSTRUCTURED})
+    with pytest.raises(InputError) as err:
+        linear.mesh(s)
+    assert err.value.field == "geometry.file" and "Quadrilateral" in str(err.value)
