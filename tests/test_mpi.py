@@ -146,3 +146,29 @@ def test_resumed_cup_on_two_ranks_matches_serial(tmp_path):
     assert parallel["force"] == pytest.approx(r["punch_force_kN"], rel=1e-6)
     assert parallel["DD"] == pytest.approx(r["draw_in_mm"]["DD"], rel=1e-6, abs=1e-9)
     assert parallel["e33"] == pytest.approx(r["max_thickness_strain"], rel=1e-6)
+
+
+OUTLINES = """
+import json, shellform
+from mpi4py import MPI
+from shellform import linear, scene
+w = {name: linear.solve(scene.load("demos/" + name + ".toml")).value("w")
+     for name in ("circular_plate", "triangle_plate")}
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps(w))
+"""
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_curved_and_oblique_supports_on_two_ranks_match_serial(tmp_path, monkeypatch):
+    """The edge frames (rim vertex normals summed over ranks, R^T K R in PETSc's parallel
+    layout) give the serial deflections of the circular and triangular plates to 1e-10."""
+    from shellform import scene
+
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(root)
+    parallel = on_two_ranks(tmp_path, OUTLINES)
+    for name, w in parallel.items():
+        serial = linear.solve(scene.load(root / "demos" / f"{name}.toml")).value("w")
+        assert w == pytest.approx(serial, rel=1e-10), name

@@ -223,8 +223,9 @@ def _generate(gmsh, h, refine):
 
 def _bounds(msh):
     x = msh.geometry.x
-    lo = msh.comm.allreduce(x[:, :2].min(axis=0, initial=np.inf), op=MPI.MIN)
-    hi = msh.comm.allreduce(x[:, :2].max(axis=0, initial=-np.inf), op=MPI.MAX)
+    lo, hi = x[:, :2].min(axis=0, initial=np.inf), x[:, :2].max(axis=0, initial=-np.inf)
+    msh.comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    msh.comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
     return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]))
 
 
