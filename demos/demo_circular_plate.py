@@ -71,8 +71,8 @@ import math
 import sys
 
 import shellform  # noqa: F401  (loads the DOLFINx runtime before dolfinx itself)
-from shellform import linear, scene
-from shellform.studies.common import observed_rates
+from shellform.studies.common import deflection_table, observed_rates
+from shellform.studies.outlines import REFERENCE, disc_scene
 
 parser = argparse.ArgumentParser(description="Circular plate: convergence of the centre deflection.")
 parser.add_argument("--support", choices=["simply_supported", "clamped"], default="simply_supported",
@@ -85,34 +85,16 @@ if args.levels < 1:
 if args.base_n < 1:
     parser.error("--base-n must be >= 1")
 
-NU = 0.3
-reference = (1.0 if args.support == "clamped" else (5 + NU) / (1 + NU)) / 64
+reference = REFERENCE[args.support]  # q a^4/(64 D); simply supported: times (5 + nu)/(1 + nu)
 print(f"circular plate, {args.support} rim, base n = {args.base_n}, {args.levels} refinements")
 print(f"closed form w D/(q a^4) = {reference}")
 
+# The scene of one mesh: the quarter disc $a = 1$ with symmetry on $x = 0$ and $y = 0$,
+# $E t^3 = 12(1-\nu^2)$ so that $D = 1$, meshed by gmsh with `--base-n` elements along the
+# radius and refined `k` times (`shellform.studies.outlines.disc_scene`, also behind
+# `shellform study outlines`).
 
-def circular_plate(support: str, n: int, refine: int) -> scene.Scene:
-    """The quarter disc a = 1 with symmetry on x = 0 and y = 0; E t^3 = 12 (1 - nu^2): D = 1."""
-    return scene.from_dict({
-        "effects": ["bending"],
-        "geometry": {"shape": "circle", "radius": 1.0, "region": "quarter"},
-        "mesh": {"kind": "unstructured", "n": n, "refine": refine},
-        "material": {"E": 12 * (1 - NU**2), "nu": NU, "thickness": 1.0},
-        "supports": {"rim": support, "left": "symmetry", "bottom": "symmetry"},
-        "loads": {"pressure": 1.0}})
-
-
-rows = []
-print(f"{'level':>5s} {'cells':>6s} {'w_center':>13s} {'rel_error':>11s} {'rate':>5s} {'time_s':>7s}")
-for k in range(args.levels + 1):
-    result = linear.solve(circular_plate(args.support, args.base_n, k))
-    w = result.value("w", 0.0, 0.0)
-    rows.append({"cells": result.num_cells, "w_center": w, "rel_error": (w - reference) / reference,
-                 "time_s": result.timings["total_s"]})
-    rate = observed_rates(rows)[-1]
-    r = rows[-1]
-    rate_text = "    -" if k == 0 else f"{rate:5.2f}"
-    print(f"{k:5d} {r['cells']:6d} {r['w_center']:13.10f} {r['rel_error']:11.2e} {rate_text} {r['time_s']:7.2f}")
+rows = deflection_table((disc_scene(args.support, args.base_n, k) for k in range(args.levels + 1)), reference)
 
 # ## Checks
 #

@@ -37,9 +37,13 @@ from shellform.forms import string_net
 
 
 def reference_surface(x, kappa0=None):
-    """(grad X0 (3 x 2), X0,ab (the Hessian of z0, 2 x 2)) of X0 = (x, y, -x.kappa0.x/2)."""
+    """(grad X0 (3 x 2), X0,ab (the Hessian of z0, 2 x 2)) of X0 = (x, y, z0): z0 = -x.kappa0.x/2
+    for a constant kappa0, or any z0(x, y) given as a forms.reference_surface.ReferenceSurface."""
     if kappa0 is None:
         return ufl.as_matrix([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]), ufl.zero((2, 2))
+    if hasattr(kappa0, "slopes"):  # a ReferenceSurface
+        gz, hess = kappa0.slopes(x), kappa0.hessian(x)
+        return ufl.as_matrix([[1.0, 0.0], [0.0, 1.0], [gz[0], gz[1]]]), hess
     gz = -ufl.dot(kappa0, x)
     return ufl.as_matrix([[1.0, 0.0], [0.0, 1.0], [gz[0], gz[1]]]), -kappa0
 

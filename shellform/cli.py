@@ -59,7 +59,7 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
 
 
 STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark"]
+           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark", "outlines"]
 
 
 def main(argv=None) -> int:

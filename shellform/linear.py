@@ -75,9 +75,9 @@ class LinearResult:
 def parameters(mesh, scene: Scene) -> ShellParameters:
     c = lambda v: fem.Constant(mesh, np.float64(v))  # noqa: E731
     m = scene.material
-    kappa0 = None
-    if "shallow_curvature" in scene.effects:
-        kappa0 = fem.Constant(mesh, np.diag(scene.kappa0).astype(np.float64))
+    kappa0 = scene.curvature()  # a ReferenceSurface (compiled into the kernels) or principal curvatures
+    if isinstance(kappa0, np.ndarray):
+        kappa0 = fem.Constant(mesh, kappa0)
     pressure = c(scene.loads.pressure) if "bending" in scene.effects else None
     return ShellParameters(E=c(m.E), nu=c(m.nu), thickness=c(m.thickness), kappa0=kappa0, pressure=pressure)
 

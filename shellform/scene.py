@@ -52,6 +52,7 @@ class Geometry:
 class Surface:
     R1: float = math.inf  # principal radius along x of z0 = -(x^2/R1 + y^2/R2)/2
     R2: float = math.inf
+    z0: str = ""  # or any z0(x, y) as text, e.g. "0.1*sin(pi*x)*sin(pi*y)" (forms/reference_surface.py)
 
 
 @dataclass
@@ -173,6 +174,19 @@ class Scene:
     @property
     def kappa0(self) -> tuple[float, float]:
         return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
+
+    def curvature(self):
+        """What the forms take as kappa0 with 'shallow_curvature': the ReferenceSurface of
+        surface.z0, or the principal curvatures diag(1/R1, 1/R2) as an array; None if flat."""
+        import numpy as np
+
+        from shellform.forms.reference_surface import ReferenceSurface
+
+        if "shallow_curvature" not in self.effects:
+            return None
+        if self.surface.z0:
+            return ReferenceSurface(self.surface.z0)
+        return np.diag(self.kappa0).astype(np.float64)
 
     @property
     def symmetry_copies(self) -> int:
@@ -337,6 +351,21 @@ def validate(s: Scene) -> None:
         if math.isfinite(v):
             _require("shallow_curvature" in s.effects, f"surface.{name}",
                      "a curved reference surface needs the effect 'shallow_curvature'")
+            _require(not s.surface.z0, f"surface.{name}", "give either z0 or the radii R1, R2, not both")
+    if s.surface.z0:
+        from shellform.forms.reference_surface import ReferenceSurface
+
+        surface = ReferenceSurface(s.surface.z0)
+        problem = surface.problem()
+        _require(problem is None, "surface.z0", f"{s.surface.z0!r}: {problem}")
+        _require("shallow_curvature" in s.effects, "surface.z0",
+                 "a curved reference surface needs the effect 'shallow_curvature'")
+        _require(s.tools is None, "surface.z0", "tool scenes draw a flat blank")
+        try:
+            value = surface.value(0.123, 0.456)
+        except (ArithmeticError, ValueError) as err:
+            raise InputError("surface.z0", f"{s.surface.z0!r} cannot be evaluated: {err}") from None
+        _require(math.isfinite(value), "surface.z0", f"{s.surface.z0!r} is not finite at (0.123, 0.456)")
     _require(m.kind in MESH_KINDS, "mesh.kind", f"must be one of {MESH_KINDS}, got {m.kind!r}")
     _require(m.n >= 1, "mesh.n", f"must be >= 1, got {m.n}")
     _require(m.refine >= 0, "mesh.refine", f"must be >= 0, got {m.refine}")

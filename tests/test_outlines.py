@@ -196,3 +196,76 @@ def test_a_mesh_of_quadrilaterals_is_an_error(tmp_path):
     with pytest.raises(InputError) as err:
         linear.mesh(s)
     assert err.value.field == "geometry.file" and "Quadrilateral" in str(err.value)
+
+
+# -- reference surfaces z0(x, y) (forms/reference_surface.py) ---------------------------------
+def test_z0_of_a_paraboloid_equals_its_radii():
+    """surface.z0 = -(x^2 + y^2)/(2 R) and R1 = R2 = R: the same kernels' answer (UFL
+    differentiates z0; the linear and the nonlinear route alike)."""
+    from pathlib import Path
+    import tomllib
+
+    data = tomllib.loads((Path(__file__).resolve().parents[1] / "demos" / "shallow_shell.toml").read_text())
+    data["mesh"]["n"] = 6
+    w = []
+    for surface in ({"R1": 5.0, "R2": 5.0}, {"z0": "-(x**2 + y**2)/(2*5.0)"}):
+        w.append(linear.solve(scene.from_dict({**data, "surface": surface})).value("w"))
+    assert w[1] == pytest.approx(w[0], rel=1e-12)
+
+
+def test_hypar_carries_its_load_in_shear():
+    """demos/hypar_shell.toml: membrane theory's N_xy = -q/(2c), N_x = N_y = 0 at the centre."""
+    from pathlib import Path
+
+    s = scene.load(Path(__file__).resolve().parents[1] / "demos" / "hypar_shell.toml")
+    r = linear.solve(s)
+    f = r.cell_fields()["membrane_force"]
+    x = f.function_space.tabulate_dof_coordinates()
+    i = int(np.argmin(np.hypot(x[:, 0], x[:, 1])))
+    nx, ny, nxy = f.x.array.reshape(-1, 3)[i]
+    assert nxy == pytest.approx(-0.5, rel=0.01)
+    assert max(abs(nx), abs(ny)) < 2e-3 * abs(nxy)
+
+
+def test_twisted_surface_is_rotation_invariant():
+    """A cylindrical z0 whose axis turns with the mesh: z0 = -(x cos t + y sin t)^2/(2R) on the
+    disc rotated by t equals z0 = -x^2/(2R) on the disc itself (kappa0 with an xy part)."""
+    w = []
+    for theta in (0.0, 0.7):
+        c, sn = math.cos(theta), math.sin(theta)
+        s = scene.from_dict({**PLATE, "effects": ["bending", "membrane", "shallow_curvature"],
+                             "geometry": {"shape": "circle", "radius": 1.0}, "mesh": {"kind": "unstructured", "n": 6},
+                             "surface": {"z0": f"-(x*{c!r} + y*{sn!r})**2/(2*3.0)"}, "supports": {"rim": "clamped"}})
+        blank = outline.circle(MPI.COMM_WORLD, 1.0, "full", 6)
+        xg = blank.mesh.geometry.x
+        xg[:, :2] = xg[:, :2] @ np.array([[c, -sn], [sn, c]]).T
+        w.append(linear.solve(s, blank_mesh=blank).value("w"))
+    assert abs(w[1] / w[0] - 1) < 1e-10, w
+
+
+SHELL = ["bending", "membrane", "shallow_curvature"]
+
+
+@pytest.mark.parametrize("surface, effects", [
+    ({"z0": "x*"}, SHELL),  # not an expression
+    ({"z0": "z*x"}, SHELL),  # unknown name
+    ({"z0": "__import__('os')"}, SHELL),  # no calls but the listed functions
+    ({"z0": "x.real"}, SHELL),
+    ({"z0": "1/(x - 0.123)"}, SHELL),  # division by zero where it is checked
+    ({"z0": "x*y"}, ["bending", "membrane"]),  # a curved surface needs shallow_curvature
+    ({"z0": "x*y", "R1": 2.0}, SHELL),  # not both
+])
+def test_surface_errors_name_the_field(surface, effects):
+    field = "surface.R1" if "R1" in surface else "surface.z0"
+    _names_field({"effects": effects, "surface": surface}, field)
+
+
+def test_outlines_study_writes_its_table(tmp_path):
+    """`shellform study outlines --quick`: three cases, second order, CSV and plot."""
+    from shellform.studies import outlines
+
+    rows = outlines.run(tmp_path, levels=outlines.QUICK_LEVELS)
+    assert {r["case"] for r in rows} == {"simply_supported", "clamped", "triangle"}
+    disc = [r for r in rows if r["case"] != "triangle"]
+    assert all(r["rate"] > 1.9 for r in disc if not math.isnan(r["rate"])), disc
+    assert (tmp_path / "outlines.csv").is_file() and (tmp_path / "outlines_error_time.png").is_file()

@@ -31,6 +31,7 @@ from ufl.algorithms import expand_derivatives
 
 from shellform.forms import functional
 from shellform.forms.fields import HybridFields, ShellParameters
+from shellform.forms.reference_surface import ReferenceSurface
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.hybrid_element import HybridElement
 from shellform.errors import InputError
@@ -103,7 +104,9 @@ def _signature_of(params: ShellParameters) -> tuple:
     sig = []
     for name in _PARAMETERS:
         c = getattr(params, name)
-        if c is not None:
+        if isinstance(c, ReferenceSurface):  # kappa0 = -grad grad z0, compiled into the kernels
+            sig.append((name, c))
+        elif c is not None:
             sig.append((name, tuple(c.ufl_shape)))
     return tuple(sig)
 
@@ -129,8 +132,11 @@ class ElementKernels:
     def __init__(self, element: HybridElement, param_signature, mapped, comm):
         self.element, self.mapped = element, mapped
         domain = ufl.Mesh(basix.ufl.element("Lagrange", "triangle", 1, shape=(2,)))
-        placeholders = {name: ufl.Constant(domain, shape=shape) for name, shape in param_signature}
-        params = ShellParameters(**{n: placeholders.get(n) for n in _PARAMETERS})
+        placeholders = {name: ufl.Constant(domain, shape=shape) for name, shape in param_signature
+                        if not isinstance(shape, ReferenceSurface)}
+        x = ufl.SpatialCoordinate(domain)
+        surfaces = {name: s.kappa0(x) for name, s in param_signature if isinstance(s, ReferenceSurface)}
+        params = ShellParameters(**{n: placeholders.get(n, surfaces.get(n)) for n in _PARAMETERS})
         z, fields = part_fields(element, domain)
         n = ufl.FacetNormal(domain)
         pi = functional.hybrid_functional(fields, params, element.effects, n)
@@ -149,9 +155,9 @@ class ElementKernels:
             if f is not None and f.num_coefficients:
                 raise NotImplementedError("state-dependent forms need the nonlinear driver")
         # Packed constants of the wrapper forms: every parameter, in _PARAMETERS order.
-        self.constant_names = [name for name, _ in param_signature]
+        self.constant_names = list(placeholders)
         layout, start = {}, 0
-        for name, shape in param_signature:
+        for name, shape in ((n, s) for n, s in param_signature if n in placeholders):
             size = int(np.prod(shape)) if shape else 1
             layout[id(placeholders[name])] = (start, start + size)
             start += size

@@ -70,7 +70,9 @@ class SheetKernels:
     _cache: dict = {}
 
     @classmethod
-    def get(cls, nonlinear: bool, shallow: bool, comm, quadrature_degree: int = 4):
+    def get(cls, nonlinear: bool, shallow, comm, quadrature_degree: int = 4):
+        """shallow: False (flat), True (a constant kappa0 in the kernels' constants) or a
+        forms.reference_surface.ReferenceSurface (z0 compiled into the kernels)."""
         key = (nonlinear, shallow, quadrature_degree)
         if key not in cls._cache:
             cls._cache[key] = cls(nonlinear, shallow, comm, quadrature_degree)
@@ -104,7 +106,7 @@ class SheetKernels:
         dx = ufl.dx(metadata={"quadrature_degree": qdeg})
         parts = ufl.split(z)
         U, H = parts[0], parts[1:]
-        kappa0 = ufl.Constant(domain, shape=(2, 2)) if shallow else None
+        kappa0 = (shallow if hasattr(shallow, "slopes") else ufl.Constant(domain, shape=(2, 2))) if shallow else None
         e = kl.section_strain(U, H, x, kappa0, nonlinear)
         de, te = ufl.derivative(e, z, dz), ufl.derivative(e, z, tz)
         fforce = kl.internal_work(de, Sq, dx)
@@ -118,7 +120,7 @@ class SheetKernels:
         ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS,
                                 jit_options=JIT_OPTIONS)
         self.strain = ufcx_e.tabulate_tensor_float64
-        self.nconst = 4 if shallow else 0  # kappa0 in every kernel that sees it
+        self.nconst = 4 if shallow is True else 0  # a constant kappa0 in every kernel that sees it
 
         self.setup = self._setup_loop()
         self.strain_loop = self._strain_loop()

@@ -82,10 +82,11 @@ class SheetModel:
         if self.finite and not (self.plastic and self.nonlinear):
             raise InputError("effects", "'finite_strain' needs 'plasticity' and 'geometric_nonlinearity'")
         self.shallow = kappa0 is not None
-        self.kernels = SheetKernels.get(self.nonlinear, self.shallow, mesh.comm, quadrature_degree)
+        surface = kappa0 if hasattr(kappa0, "slopes") else self.shallow  # z0(x, y) or a constant kappa0
+        self.kernels = SheetKernels.get(self.nonlinear, surface, mesh.comm, quadrature_degree)
         self.material = np.asarray(material, dtype=np.float64)
         self.thickness = float(thickness)
-        self.consts = np.zeros(4) if kappa0 is None else np.asarray(kappa0, dtype=np.float64).ravel()
+        self.consts = np.zeros(4) if surface is not True else np.asarray(kappa0, dtype=np.float64).ravel()
         self.V = fem.functionspace(mesh, ("Lagrange", 1, (BS,)))
         tdim = mesh.topology.dim
         self.num_cells = mesh.topology.index_map(tdim).size_local

@@ -14,7 +14,6 @@ Writes into the output folder:
 import time
 from pathlib import Path
 
-import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
@@ -36,7 +35,7 @@ def problem(s: Scene, comm=MPI.COMM_WORLD, outdir=None) -> SheetProblem:
         moments=[EdgeMoment(mo.side, mo.m) for mo in s.loads.moment])
     controls = Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
                         max_iterations=pr.max_iterations, rtol=pr.rtol)
-    kappa0 = np.diag(s.kappa0) if "shallow_curvature" in s.effects else None
+    kappa0 = s.curvature()
     return SheetProblem.on_blank(
         blank(comm, s, [(p.x, p.y) for p in s.loads.point]), s.hill79(), s.material.thickness, s.effects,
         s.supports, loads, controls=controls, thickness_points=pr.thickness_points, kappa0=kappa0,

@@ -33,6 +33,24 @@ def observed_rates(rows: list[dict], size="cells", error="rel_error") -> list[fl
     return [math.nan] + [float(x) if np.isfinite(x) else math.nan for x in pairwise]
 
 
+def deflection_table(scenes, reference: float, x: float = 0.0, y: float = 0.0) -> list[dict]:
+    """Solve each linear scene in turn (a sequence of meshes) and print one table row per mesh:
+    level, cells, w at (x, y), its error relative to `reference`, the observed rate, time."""
+    from shellform import linear
+
+    rows = []
+    print(f"{'level':>5s} {'cells':>6s} {'w_center':>13s} {'rel_error':>11s} {'rate':>5s} {'time_s':>7s}")
+    for k, scene in enumerate(scenes):
+        result = linear.solve(scene)
+        w = result.value("w", x, y)
+        rows.append({"cells": result.num_cells, "w_center": w, "rel_error": (w - reference) / reference,
+                     "time_s": result.timings["total_s"]})
+        rate, r = observed_rates(rows)[-1], rows[-1]
+        rate_text = "    -" if k == 0 else f"{rate:5.2f}"
+        print(f"{k:5d} {r['cells']:6d} {r['w_center']:13.10f} {r['rel_error']:11.2e} {rate_text} {r['time_s']:7.2f}")
+    return rows
+
+
 def plot_error_time(path: Path, series: dict[str, list[dict]], title: str, error="rel_error",
                     ylabel=None) -> None:
     """Log-log |error| against total wall time, one line per series."""
