@@ -91,6 +91,22 @@ def _side_sum(driver, rect, sides, comp):
     return MPI.COMM_WORLD.allreduce(float(driver.residual_full[dofs[dofs < owned]].sum()), op=MPI.SUM)
 
 
+def test_a_support_in_a_turned_frame_is_corrected_towards_its_value():
+    """On y = 0 under a face whose normal points down, nodal_frames turns slot 1 to -e_y: the
+    symmetry row's known correction must move v back to 0 (global: -v), not double it."""
+    rect, model, bcs = _plate()
+    d = SemiInverseDriver(model, bcs, [FlatTool(0.5, 15.0, 15.0)], [-2.0], verbose=False)
+    bottom = np.flatnonzero((d.state.tool == 0) & d.sym_fixed[:, 1] & ~d.sym_fixed[:, 0])
+    assert bottom.size > 0
+    q = d.q.x.array.reshape(-1, BS)
+    q[bottom, 1] = 1e-3  # off the symmetry plane
+    assert d._constraints(0.0) >= 1e-3
+    assert np.all(d.frames[bottom, 1] == [0.0, -1.0, 0.0])
+    delta = d._correction()
+    from_frames(delta, d.rotated, d.frames)  # the correction in x, y, z
+    assert np.allclose(delta.reshape(-1, BS)[bottom, 1], -1e-3, rtol=1e-12)
+
+
 def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading():
     """A flat rigid punch pushes a simply supported plate 2 mm down and goes back: the punch's
     contact force equals the support reactions (to 1e-8), no node penetrates, the contact set

@@ -454,9 +454,18 @@ class SemiInverseDriver(Driver):
         rotate_cell_arrays(m.dofs, self.rotated, self.frames, m.forms.vectors, m.forms.matrices, tangent)
 
     def _correction(self):
+        """The known corrections in the solve's coordinates: the tools' (nodal frames) and the
+        supports'. q and g hold global components, but on a node in a frame a support's row is
+        the frame's slot k, F_k . d, which nodal_frames keeps on +-e_k (a symmetry plane keeps
+        its meaning, with the sign of the frame: slot 1 is -e_y on y = 0 under the punch and
+        the holder, whose normals point down): the slot's correction is F_kk (g_k - q_k).
+        Without F_kk a slot along -e_k doubled q_k at every iteration instead of zeroing it."""
         delta = self._known_fn.x.array.copy()
         d = self.support_dofs
         delta[d] = self.g[d] - self.q.x.array[d]
+        block, slot = d // BS, d % BS
+        turned = (slot < 3) & self.rotated[block]
+        delta[d[turned]] *= self.frames[block[turned], slot[turned], slot[turned]]
         return delta
 
     def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
