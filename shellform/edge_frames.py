@@ -131,16 +131,17 @@ class EdgeConstraints:
         self.rotation = None
 
     def _rotation(self, A):
-        """R: identity but for the 2 x 2 frame blocks, in A's parallel layout."""
+        """R: identity but for the 2 x 2 frame blocks, in A's parallel layout (CSR of the owned rows)."""
         imap = self.V.dofmap.index_map
-        start = imap.local_range[0] * self.bs
-        R = PETSc.Mat().createAIJ(A.getSizes(), nnz=2, comm=A.getComm())
-        R.setUp()
-        for i in range(imap.size_local * self.bs):
-            R.setValue(start + i, start + i, 1.0)
+        start, n = imap.local_range[0] * self.bs, imap.size_local * self.bs
+        cols = [[i] for i in range(n)]
+        vals = [[1.0] for _ in range(n)]
         for (ix, iy), d in self.frames.items():
-            gx, gy = start + ix, start + iy
-            R.setValues([gx, gy], [gx, gy], [[d[0], -d[1]], [d[1], d[0]]])
+            cols[ix], vals[ix] = [ix, iy], [d[0], -d[1]]
+            cols[iy], vals[iy] = [ix, iy], [d[1], d[0]]
+        indptr = np.concatenate([[0], np.cumsum([len(c) for c in cols])]).astype(PETSc.IntType)
+        indices = (start + np.concatenate(cols)).astype(PETSc.IntType)
+        R = PETSc.Mat().createAIJ(A.getSizes(), csr=(indptr, indices, np.concatenate(vals)), comm=A.getComm())
         R.assemble()
         return R
 
@@ -174,9 +175,11 @@ class EdgeConstraints:
 
 
 def check_symmetry_lines(blank, supports: dict[str, str], tol: float = 1e-9) -> None:
-    """A symmetry support needs a straight edge with the whole blank on one side of it."""
+    """A symmetry support needs a straight edge with the whole blank on one side of it. A line
+    along an axis gets its nodes exactly on it (gmsh leaves y = -8e-17 on y = 0; the symmetric
+    tools' normals then have components of 1e-18 across the plane)."""
     comm = blank.mesh.comm
-    x = blank.mesh.geometry.x[:, :2]
+    x = blank.mesh.geometry.x
     for group, support in supports.items():
         if support != "symmetry":
             continue
@@ -188,11 +191,16 @@ def check_symmetry_lines(blank, supports: dict[str, str], tol: float = 1e-9) -> 
         n0, p0 = ref
         bent = len(n) and np.abs(n[:, 0] * n0[1] - n[:, 1] * n0[0]).max() > tol
         off = len(n) and np.abs((ends.reshape(-1, 2) - p0) @ n0).max() > tol * blank.size
-        beyond = np.max((x - p0) @ n0, initial=-np.inf) > tol * blank.size
+        beyond = np.max((x[:, :2] - p0) @ n0, initial=-np.inf) > tol * blank.size
         bad = comm.allreduce(int(bool(bent) or bool(off)) | 2 * int(beyond), op=MPI.BOR)
         if bad & 1:
             raise InputError(f"supports.{group}", "a symmetry line must be straight: this edge is curved or bent")
         if bad & 2:
             raise InputError(f"supports.{group}", "the blank crosses this symmetry line: a symmetric part must "
                              "lie on one side of it")
+        axis = int(np.argmax(np.abs(n0)))
+        if abs(n0[1 - axis]) <= tol:  # the line x = c or y = c
+            c = 0.0 if abs(p0[axis]) <= tol * blank.size else p0[axis]
+            nodes = dolfinx.mesh.entities_to_geometry(blank.mesh, 1, blank.facets(group))
+            x[nodes.ravel(), axis] = c
 

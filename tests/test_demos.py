@@ -111,26 +111,23 @@ def test_outline_scenes(tmp_path, name, reference, rel):
 
 
 def test_round_cup_scene_is_axisymmetric(tmp_path):
-    """The round cup (demos/round_cup.toml, its 279 cells) to 3 mm of stroke: on a planar
-    isotropic sheet the draw-in along x, along y and along the diagonal agree, and so do the
-    thickness strains along 0 and 90 degrees, though the gmsh mesh has no such symmetry.
-    (The scene stops at 5.5 mm today, issue 14: this checks the round tools, not the draw.)"""
+    """The round cup (demos/round_cup.toml, its 279 cells) to 15 mm: on a planar isotropic sheet
+    the draw-in along x, along y and along the diagonal agree, and so do the thickness strains
+    along 0 and 90 degrees, though the gmsh mesh has no such symmetry. (Before the symmetry rows
+    of nodes in contact frames took their frame's sign, it stopped at 5.5 mm: v on y = 0
+    doubled every Newton iteration; tests/test_contact.py.)"""
     s = scene.load(DEMOS / "round_cup.toml")
     assert (s.tools.punch_half_width, s.tools.punch_corner_radius) == (30.0, 30.0)  # a round punch
-    text = (DEMOS / "round_cup.toml").read_text().replace("stroke = 15.0", "stroke = 3.0")
+    text = (DEMOS / "round_cup.toml").read_text().replace("stroke = 30.0", "stroke = 15.0")
     (tmp_path / "round.toml").write_text(text)
     assert cli.main(["run", str(tmp_path / "round.toml"), "--out", str(tmp_path / "out")]) == 0
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    assert summary["stopped"] is None and summary["stroke_mm"] == pytest.approx(3.0)
+    assert summary["stopped"] is None and summary["stroke_mm"] == pytest.approx(15.0)
+    assert summary["cutbacks"] == 0
     d = summary["draw_in_mm"][-1]
-    assert d["DX"] > 0.05, d
-    # measured: DX 0.155, DY 0.149, DD 0.147 mm; the 5 % spread is the gmsh mesh's asymmetry at
-    # h = 4.5 mm (at 5.5 mm of stroke it is 1.5 %)
-    assert d["DY"] == pytest.approx(d["DX"], rel=0.08) and d["DD"] == pytest.approx(d["DX"], rel=0.08), d
+    assert d["DX"] > 3.0, d
+    assert d["DY"] == pytest.approx(d["DX"], rel=0.01) and d["DD"] == pytest.approx(d["DX"], rel=0.01), d
     lines = {a: np.loadtxt(tmp_path / "out" / f"thickness_{a}.csv", delimiter=",", skiprows=1) for a in ("0deg", "90deg")}
-    r = np.linspace(0.0, 50.0, 11)
+    r = np.linspace(0.0, 50.0, 26)
     e0, e90 = (np.interp(r, lines[a][:, 0], lines[a][:, 1]) for a in lines)
-    # measured: the lines agree to 5e-5 away from the punch nose; at the nose, where 1-2 nodes
-    # sample a steep peak, -0.0063 against -0.0075
-    assert np.abs(e0 - e90).mean() < 0.1 * np.abs(e0).max(), (e0, e90)
-    assert e90.min() == pytest.approx(e0.min(), rel=0.25), (e0, e90)
+    assert np.abs(e0 - e90).max() < 0.1 * np.abs(e0).max(), (e0, e90)
