@@ -206,11 +206,19 @@ def test_z0_of_a_paraboloid_equals_its_radii():
     import tomllib
 
     data = tomllib.loads((Path(__file__).resolve().parents[1] / "demos" / "shallow_shell.toml").read_text())
+    from shellform.nonlinear.run import problem
+
     data["mesh"]["n"] = 6
-    w = []
+    w, sheet = [], []
     for surface in ({"R1": 5.0, "R2": 5.0}, {"z0": "-(x**2 + y**2)/(2*5.0)"}):
         w.append(linear.solve(scene.from_dict({**data, "surface": surface})).value("w"))
+        nonlinear = {**data, "surface": surface, "effects": data["effects"] + ["geometric_nonlinearity"],
+                     "loads": {"pressure": 1e-3}}
+        p = problem(scene.from_dict(nonlinear))
+        p.driver.run(1.0)
+        sheet.append(p.value("w", 0.0, 0.0))
     assert w[1] == pytest.approx(w[0], rel=1e-12)
+    assert sheet[1] == pytest.approx(sheet[0], rel=1e-12) and sheet[0] > 0.1
 
 
 def test_hypar_carries_its_load_in_shear():
