@@ -37,7 +37,8 @@ class ReferenceSurface:
             return f"not an expression: {err.msg}"
         for node in ast.walk(tree):
             if not isinstance(node, _NODES):
-                return f"{type(node).__name__} is not allowed; use numbers, x, y, + - * / **, pi and {', '.join(FUNCTIONS)}"
+                return (f"{type(node).__name__} is not allowed; use numbers, x, y, + - * / **, pi and "
+                        f"{', '.join(FUNCTIONS)}")
             if isinstance(node, ast.Name) and node.id not in ("x", "y", *_MATH):
                 return f"unknown name {node.id!r}; known: x, y, pi, {', '.join(FUNCTIONS)}"
             if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS):

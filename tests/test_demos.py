@@ -127,7 +127,8 @@ def test_round_cup_scene_is_axisymmetric(tmp_path):
     d = summary["draw_in_mm"][-1]
     assert d["DX"] > 3.0, d
     assert d["DY"] == pytest.approx(d["DX"], rel=0.01) and d["DD"] == pytest.approx(d["DX"], rel=0.01), d
-    lines = {a: np.loadtxt(tmp_path / "out" / f"thickness_{a}.csv", delimiter=",", skiprows=1) for a in ("0deg", "90deg")}
+    lines = {a: np.loadtxt(tmp_path / "out" / f"thickness_{a}.csv", delimiter=",", skiprows=1)
+             for a in ("0deg", "90deg")}
     r = np.linspace(0.0, 50.0, 26)
     e0, e90 = (np.interp(r, lines[a][:, 0], lines[a][:, 1]) for a in lines)
     assert np.abs(e0 - e90).max() < 0.1 * np.abs(e0).max(), (e0, e90)

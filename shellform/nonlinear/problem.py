@@ -1,7 +1,8 @@
-"""A nonlinear sheet problem on a blank (a rectangle, or any BlankMesh): mesh -> model -> supports -> loads -> driver.
+"""A nonlinear sheet problem on a blank: mesh -> model -> supports -> loads -> driver.
 
     p = SheetProblem.on_rectangle(comm, lx, ly, region, n, material, thickness, effects,
                                   supports, loads, prescribed, controls)
+    p = SheetProblem.on_blank(blank_mesh, material, thickness, effects, supports, ...)  # any outline
     p.driver.run(1.0)
     p.value("w", x, y), p.reaction(side, "w")
 
