@@ -172,6 +172,13 @@ def test_outline_errors_name_the_field(data, field):
     _names_field({"effects": ["bending"], **data}, field)
 
 
+def test_a_file_gmsh_cannot_read_is_an_error(tmp_path):
+    bad = tmp_path / "bad.geo"
+    bad.write_text("Point(1) = {0, 0, 0;\n")
+    _names_field({"effects": ["bending"], "geometry": {"shape": "file", "file": str(bad)}, "mesh": UNSTRUCTURED},
+                 "geometry.file")
+
+
 def test_a_symmetry_line_the_blank_crosses_is_an_error():
     """An L-shaped polygon: the line of its inner edge 'notch' cuts through the blank."""
     v = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]

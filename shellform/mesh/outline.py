@@ -45,7 +45,10 @@ def group_names(g) -> tuple[str, ...]:
 
 def _file_groups(path) -> list[str]:
     with gmsh_session() as gmsh:
-        gmsh.open(str(path))
+        try:
+            gmsh.open(str(path))
+        except Exception as exc:  # noqa: BLE001  (gmsh raises plain Exceptions)
+            raise InputError("geometry.file", f"gmsh cannot read {path}: {exc}") from None
         return [n for _, n in _named_curves(gmsh)] or ["boundary"]
 
 
