@@ -30,6 +30,7 @@ from dolfinx import la
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from shellform import _jit as jit
 from shellform.errors import InputError
 
 _ROLES = {  # support -> roles fixed (linear plate and shell)
@@ -70,8 +71,9 @@ def _vertex_blocks(V) -> np.ndarray:
     return out
 
 
-def group_vertex_normals(V, blank, group) -> dict[int, np.ndarray]:
-    """Owned dof block -> unit outward normal, for the vertices of a boundary group."""
+def group_vertex_normals(V, blank, group, ghosts: bool = False) -> dict[int, np.ndarray]:
+    """Dof block -> unit outward normal, for the owned (and with `ghosts` the ghost) vertices of
+    a boundary group."""
     facets = blank.facets(group)
     facets = facets[facets < blank.mesh.topology.index_map(1).size_local]  # owned: counted once
     verts, _, n = facet_normals(blank, facets)
@@ -82,6 +84,9 @@ def group_vertex_normals(V, blank, group) -> dict[int, np.ndarray]:
         np.add.at(a, blocks[verts[:, k]], np.column_stack([n, np.ones(len(n))]))
     acc.scatter_reverse(la.InsertMode.add)
     owned = V.dofmap.index_map.size_local
+    if ghosts:
+        acc.scatter_forward()
+        owned += V.dofmap.index_map.num_ghosts
     hit = np.flatnonzero(a[:owned, 2] > 0)
     normal = a[hit, :2] / np.hypot(a[hit, 0], a[hit, 1])[:, None]
     exact = blank.normals.get(group)
@@ -204,3 +209,103 @@ def check_symmetry_lines(blank, supports: dict[str, str], tol: float = 1e-9) -> 
             nodes = dolfinx.mesh.entities_to_geometry(blank.mesh, 1, blank.facets(group))
             x[nodes.ravel(), axis] = c
 
+
+
+class SheetEdgeFrames:
+    """Clamped curved edges of the nonlinear sheet (carrier U = (u, v, w) and its gradient).
+
+    Clamped holds u = v = w = 0 along the edge, hence grad w = 0 (w,s = 0 and w,n = 0) and the
+    derivatives of u and v along the edge, (u_x, u_y) . s = 0 and (v_x, v_y) . s = 0. Only
+    these two slope pairs need the edge's frame: each turns as (a_x, a_y) = a_1 s + a_2 s_perp,
+    q = Q q', and a_1 is fixed (the pairs' x slots hold it). Vertices where two edges meet fix
+    both components; an axis direction fixes one, unturned. The element arrays are turned before
+    assembly (f' = Q^T f, K' = Q^T K Q on the two pairs), the Newton correction back after the
+    solve; the state stays in x, y components. (Simply supported or sliding curved edges would
+    couple u_n to the tangential derivatives through the edge's curvature: not built.)
+    """
+
+    PAIRS = ((3, 4), (5, 6))  # (u_x, u_y), (v_x, v_y) in shellform.assembly.sheet_element.COMPONENTS
+    HELD = (0, 1, 2, 7, 8)  # u, v, w, w_x, w_y
+
+    def __init__(self, V, blank, groups, tol: float = 1e-10):
+        bs = V.dofmap.index_map_bs
+        nblocks = V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts
+        self.Q = np.tile(np.eye(2), (nblocks, 1, 1))
+        self.rotated = np.zeros(nblocks, dtype=np.bool_)
+        fixed: set[int] = set()
+        directions: dict[int, list[np.ndarray]] = {}
+        for group in groups:
+            for block, n in group_vertex_normals(V, blank, group, ghosts=True).items():
+                fixed.update(block * bs + k for k in self.HELD)
+                directions.setdefault(block, []).append(np.array([-n[1], n[0]]))
+        for block, ds in directions.items():
+            d = ds[0] / np.hypot(*ds[0])
+            if any(abs(d[0] * e[1] - d[1] * e[0]) > tol for e in ds[1:]):
+                slots = (3, 4, 5, 6)  # two directions: the whole pairs
+            elif abs(d[1]) <= tol:
+                slots = (3, 5)  # along x: u_x, v_x
+            elif abs(d[0]) <= tol:
+                slots = (4, 6)  # along y: u_y, v_y
+            else:
+                self.rotated[block] = True
+                self.Q[block] = [[d[0], -d[1]], [d[1], d[0]]]
+                slots = (3, 5)  # a_1 of each pair
+            fixed.update(block * bs + k for k in slots)
+        self.dofs = np.array(sorted(fixed), dtype=np.int32)  # local, ghosts included, frame basis
+        self.bs = bs
+
+    def dirichlet(self, V):
+        """Homogeneous conditions on the held slots (frame basis), one per component."""
+        from dolfinx import fem
+
+        slot = self.dofs % self.bs
+        return [fem.dirichletbc(np.float64(0), self.dofs[slot == k], V.sub(k)) for k in range(self.bs)
+                if np.any(slot == k)]
+
+    def to_frames(self, array: np.ndarray) -> np.ndarray:
+        """q' = Q^T q on the turned blocks (a copy)."""
+        out = array.copy()
+        d = out.reshape(-1, self.bs)
+        idx = np.flatnonzero(self.rotated[: d.shape[0]])
+        for i, j in self.PAIRS:
+            d[idx, i], d[idx, j] = (np.einsum("nk,nk->n", self.Q[idx, :, 0], d[idx][:, [i, j]]),
+                                    np.einsum("nk,nk->n", self.Q[idx, :, 1], d[idx][:, [i, j]]))
+        return out
+
+    def from_frames(self, array: np.ndarray) -> np.ndarray:
+        """q = Q q' on the turned blocks (a copy)."""
+        out = array.copy()
+        d = out.reshape(-1, self.bs)
+        idx = np.flatnonzero(self.rotated[: d.shape[0]])
+        for i, j in self.PAIRS:
+            d[idx, i], d[idx, j] = (np.einsum("nk,nk->n", self.Q[idx, 0, :], d[idx][:, [i, j]]),
+                                    np.einsum("nk,nk->n", self.Q[idx, 1, :], d[idx][:, [i, j]]))
+        return out
+
+    def turn_cell_arrays(self, dofs, vectors, matrices, tangent: bool) -> None:
+        """In place: f' = Q^T f, K' = Q^T K Q on the turned blocks' pairs."""
+        _turn_pairs(dofs, self.rotated, self.Q, vectors, matrices, tangent, self.bs)
+
+
+@jit.njit
+def _turn_pairs(dofs, rotated, Q, vectors, matrices, tangent, bs):
+    ncells, nv = dofs.shape
+    n = vectors.shape[1]
+    for c in range(ncells):
+        for a in range(nv):
+            b = dofs[c, a]
+            if not rotated[b]:
+                continue
+            q00, q01, q10, q11 = Q[b, 0, 0], Q[b, 0, 1], Q[b, 1, 0], Q[b, 1, 1]
+            for i0 in (3, 5):
+                i, j = bs * a + i0, bs * a + i0 + 1
+                fi, fj = vectors[c, i], vectors[c, j]
+                vectors[c, i], vectors[c, j] = q00 * fi + q10 * fj, q01 * fi + q11 * fj
+                if not tangent:
+                    continue
+                for k in range(n):  # rows: Q^T K
+                    ki, kj = matrices[c, i, k], matrices[c, j, k]
+                    matrices[c, i, k], matrices[c, j, k] = q00 * ki + q10 * kj, q01 * ki + q11 * kj
+                for k in range(n):  # columns: K Q
+                    ki, kj = matrices[c, k, i], matrices[c, k, j]
+                    matrices[c, k, i], matrices[c, k, j] = ki * q00 + kj * q10, ki * q01 + kj * q11

@@ -82,6 +82,25 @@ def normal_axis(blank, group: str, tol: float = 1e-9) -> str:
                      "support such edges (in the edge's frame); the nonlinear sheet needs edges along x or y")
 
 
+def split_by_direction(blank, supports) -> tuple[dict[str, str], list[str]]:
+    """The nonlinear sheet's supports: ({group: support} on edges along x or y, [curved or
+    oblique clamped groups]); any other support on a curved or oblique edge is an InputError."""
+    straight, curved = {}, []
+    for group, support in supports.items():
+        if support == "free":
+            continue
+        try:
+            normal_axis(blank, group)
+        except InputError:
+            if support != "clamped":
+                raise InputError(f"supports.{group}", f"this edge is curved or oblique: the nonlinear sheet holds "
+                                 f"such an edge 'clamped' only (in its frame), got {support!r}") from None
+            curved.append(group)
+        else:
+            straight[group] = support
+    return straight, curved
+
+
 def boundary_conditions(V, components, blank, supports, fixed=fixed_components) -> list[fem.DirichletBC]:
     """Homogeneous Dirichlet conditions for the supports {group: name} of a BlankMesh on the carrier V."""
     fdim = blank.facet_tags.dim

@@ -97,11 +97,12 @@ class Driver:
     """Newton on the sheet model with DOLFINx assembly and a MUMPS LU solve."""
 
     def __init__(self, model, bcs, prescribed=None, pressure=0.0, nodal=None, controls=None,
-                 checkpoint_dir=None, verbose=True):
+                 checkpoint_dir=None, verbose=True, frames=None):
         """bcs: Dirichlet conditions of the carrier (values = the prescribed values at lambda = 1,
         held in the `prescribed` Function, or homogeneous); pressure: dead pressure at lambda = 1;
-        nodal: shellform.nonlinear.loads.NodalLoads."""
-        self.model, self.bcs, self.nodal = model, bcs, nodal
+        nodal: shellform.nonlinear.loads.NodalLoads; frames: shellform.edge_frames.SheetEdgeFrames
+        of clamped curved edges (the system is solved in their frames, the state kept in x, y)."""
+        self.model, self.bcs, self.nodal, self.frames = model, bcs, nodal, frames
         self.controls = controls or Controls()
         self.controls.check()
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
@@ -138,11 +139,15 @@ class Driver:
         self._cause = ""  # why the last Newton attempt failed, in words
 
     # -- residual and tangent ----------------------------------------------------------------
+    def _in_frames(self) -> np.ndarray:
+        """The carrier in the basis the system is solved in (edge frames turned; else q itself)."""
+        return self.frames.to_frames(self.q.x.array) if self.frames is not None else self.q.x.array
+
     def _set_dirichlet(self, lam, dofs=None):
         """g = lam qbar on the Dirichlet dofs (or on `dofs`); returns the largest jump |g - q| there."""
         g, d = self.g, self.bc_dofs if dofs is None else dofs
         g[d] = lam * self.prescribed.x.array[d] if self.prescribed else 0.0
-        jump = np.abs(g[d] - self.q.x.array[d]).max() if d.size else 0.0
+        jump = np.abs(g[d] - self._in_frames()[d]).max() if d.size else 0.0
         return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
 
     def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
@@ -184,12 +189,16 @@ class Driver:
         return self.b.norm(), max(f_int, ext, self._floor / self.controls.rtol), ev
 
     def _element_arrays(self, tangent: bool) -> None:
-        """Hook between the element loop and assembly (the contact driver rotates here)."""
+        """Hook between the element loop and assembly: the edge frames turn the arrays here (the
+        contact driver rotates its nodal frames instead)."""
+        if self.frames is not None:
+            m = self.model
+            self.frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, tangent)
 
     def _correction(self) -> np.ndarray:
         """The known correction dq_D on the Dirichlet dofs (zero elsewhere)."""
         delta = np.zeros_like(self.q.x.array)
-        delta[self.bc_dofs] = self.g[self.bc_dofs] - self.q.x.array[self.bc_dofs]
+        delta[self.bc_dofs] = self.g[self.bc_dofs] - self._in_frames()[self.bc_dofs]
         return delta
 
     def _increment_info(self) -> dict:
@@ -279,8 +288,9 @@ class Driver:
             x0 = self.q.x.array.copy()
             s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) = -dq . K dq < 0: the energy slope
             alpha, accepted = 1.0, False
+            step_xy = self.frames.from_frames(self.dq.x.array) if self.frames is not None else self.dq.x.array
             for _ in range(c.line_search + 1):
-                self.q.x.array[:] = x0 + alpha * self.dq.x.array
+                self.q.x.array[:] = x0 + alpha * step_xy
                 trial, scale, ev = self.residual(lam, tangent=True)
                 if not np.isfinite(trial) or ev.failed:
                     alpha *= 0.5  # outside the material's reach: shorten
@@ -297,7 +307,9 @@ class Driver:
                 self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
                 return False, it, residuals, ev
             if alpha < 1.0 and jump > 0:
-                self.q.x.array[self.bc_dofs] = self.g[self.bc_dofs]  # the prescribed values
+                held = self._in_frames()
+                held[self.bc_dofs] = self.g[self.bc_dofs]  # the prescribed values
+                self.q.x.array[:] = self.frames.from_frames(held) if self.frames is not None else held
                 trial, scale, ev = self.residual(lam, tangent=True)
             jump = 0.0
             norm = trial

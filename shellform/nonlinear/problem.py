@@ -20,6 +20,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from shellform import supports as named_supports
+from shellform.edge_frames import SheetEdgeFrames
 from shellform.loads import value_at
 from shellform.mesh import rectangle
 from shellform.nonlinear.driver import Controls, Driver
@@ -46,14 +47,20 @@ class SheetProblem:
     @classmethod
     def on_blank(cls, rect, material, thickness, effects, supports, loads=None, prescribed=None, controls=None,
                  thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
-        """The problem on a meshed blank (shellform.mesh.BlankMesh) whose supported edges lie
-        along x or y."""
+        """The problem on a meshed blank (shellform.mesh.BlankMesh): supports on edges along x or
+        y fix components; a clamped curved or oblique edge is held in its own frame
+        (shellform.edge_frames.SheetEdgeFrames)."""
         loads = loads or SheetLoads()
         mat = material.pack() if hasattr(material, "pack") else np.asarray(material, dtype=np.float64)
         model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0)
         V, comps = model.V, model.components
-        bcs = named_supports.boundary_conditions(V, comps, rect, supports,
+        straight, curved = named_supports.split_by_direction(rect, supports)
+        bcs = named_supports.boundary_conditions(V, comps, rect, straight,
                                                  fixed=named_supports.sheet_fixed_components)
+        frames = None
+        if curved:
+            frames = SheetEdgeFrames(V, rect, curved)
+            bcs += frames.dirichlet(V)
         qbar = fem.Function(V)
         pdofs = {}
         xy = V.tabulate_dof_coordinates()
@@ -71,7 +78,7 @@ class SheetProblem:
         nodal = NodalLoads(V, rect.facet_tags, loads, tol) if (loads.points or loads.moments) else None
         driver = Driver(model, bcs, prescribed=qbar if prescribed else None, pressure=loads.pressure,
                         nodal=nodal, controls=controls or Controls(), checkpoint_dir=checkpoint_dir,
-                        verbose=verbose)
+                        verbose=verbose, frames=frames)
         return cls(rect, model, driver, pdofs)
 
     def value(self, name: str, x: float, y: float) -> float:
