@@ -155,7 +155,7 @@ def test_nonlinear_sheet_clamped_on_a_curved_rim_is_the_plate_at_small_load():
     plate = linear.solve(circle_scene("clamped", 8)).value("w") * 64
     assert w / 1e-3 == pytest.approx(plate, rel=1e-5)
     assert abs(plate - 1) < 6e-3
-    assert p.driver.frames is not None and p.driver.frames.rotated.any()
+    assert p.driver.edge_frames is not None and p.driver.edge_frames.rotated.any()
 
 
 def test_nonlinear_clamped_disc_is_rotation_invariant_at_large_deflection():

@@ -102,7 +102,7 @@ class Driver:
         held in the `prescribed` Function, or homogeneous); pressure: dead pressure at lambda = 1;
         nodal: shellform.nonlinear.loads.NodalLoads; frames: shellform.edge_frames.SheetEdgeFrames
         of clamped curved edges (the system is solved in their frames, the state kept in x, y)."""
-        self.model, self.bcs, self.nodal, self.frames = model, bcs, nodal, frames
+        self.model, self.bcs, self.nodal, self.edge_frames = model, bcs, nodal, frames
         self.controls = controls or Controls()
         self.controls.check()
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
@@ -133,6 +133,7 @@ class Driver:
         self.ksp.setType("preonly")
         self.ksp.getPC().setType("lu")
         self.ksp.getPC().setFactorSolverType("mumps")
+        self.ksp.setFromOptions()  # PETSc options (PETSC_OPTIONS, e.g. -mat_mumps_icntl_7 5) may refine these
         self._dlam_prev = None
         self._direction = None
         self._floor = 0.0
@@ -141,7 +142,7 @@ class Driver:
     # -- residual and tangent ----------------------------------------------------------------
     def _in_frames(self) -> np.ndarray:
         """The carrier in the basis the system is solved in (edge frames turned; else q itself)."""
-        return self.frames.to_frames(self.q.x.array) if self.frames is not None else self.q.x.array
+        return self.edge_frames.to_frames(self.q.x.array) if self.edge_frames is not None else self.q.x.array
 
     def _set_dirichlet(self, lam, dofs=None):
         """g = lam qbar on the Dirichlet dofs (or on `dofs`); returns the largest jump |g - q| there."""
@@ -191,9 +192,9 @@ class Driver:
     def _element_arrays(self, tangent: bool) -> None:
         """Hook between the element loop and assembly: the edge frames turn the arrays here (the
         contact driver rotates its nodal frames instead)."""
-        if self.frames is not None:
+        if self.edge_frames is not None:
             m = self.model
-            self.frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, tangent)
+            self.edge_frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, tangent)
 
     def _correction(self) -> np.ndarray:
         """The known correction dq_D on the Dirichlet dofs (zero elsewhere)."""
@@ -288,7 +289,8 @@ class Driver:
             x0 = self.q.x.array.copy()
             s0 = self.dq.x.petsc_vec.dot(R0)  # dq . R(q) = -dq . K dq < 0: the energy slope
             alpha, accepted = 1.0, False
-            step_xy = self.frames.from_frames(self.dq.x.array) if self.frames is not None else self.dq.x.array
+            step_xy = (self.edge_frames.from_frames(self.dq.x.array) if self.edge_frames is not None
+                       else self.dq.x.array)
             for _ in range(c.line_search + 1):
                 self.q.x.array[:] = x0 + alpha * step_xy
                 trial, scale, ev = self.residual(lam, tangent=True)
@@ -309,7 +311,7 @@ class Driver:
             if alpha < 1.0 and jump > 0:
                 held = self._in_frames()
                 held[self.bc_dofs] = self.g[self.bc_dofs]  # the prescribed values
-                self.q.x.array[:] = self.frames.from_frames(held) if self.frames is not None else held
+                self.q.x.array[:] = self.edge_frames.from_frames(held) if self.edge_frames is not None else held
                 trial, scale, ev = self.residual(lam, tangent=True)
             jump = 0.0
             norm = trial
