@@ -511,19 +511,24 @@ def test_drawn_cup_springback_outputs(tmp_path):
     assert (tmp_path / "springback.csv").exists() and (tmp_path / "springback.png").exists()
 
 
-@pytest.mark.parametrize("name", ["numisheet93_aluminium.toml", "numisheet93_steel.toml"])
+@pytest.mark.parametrize("name", ["numisheet93_aluminium.toml", "numisheet93_steel.toml",
+                                  "numisheet93_aluminium_graded.toml"])
 def test_numisheet_scenes_draw_their_first_millimetres(name):
-    """The NUMISHEET'93 scenes (the numisheet study's, on 6 x 6) draw 2 mm: the holder's forces
-    sum to F, the tools balance, no free node under the closed holder, penetration within 1 % of
-    t, and the punch force grows."""
+    """The NUMISHEET'93 scenes (the numisheet study's, on 6 x 6; the graded one on its gmsh mesh
+    from demos/meshes/square_cup_graded.geo) draw 2 mm: the holder's forces sum to F, the tools
+    balance, no free node under the closed holder, penetration within 1 % of t, and the punch
+    force grows."""
     s = scene.load(ROOT / "demos" / name)
-    s.mesh.n = 6
+    if s.geometry.shape == "rectangle":
+        s.mesh.n = 6
     p = DrawingProblem.from_scene(s, verbose=False)
     forces = []
 
     def check(d):
         assert abs(p.holder_force() - s.tools.blank_holder_force) <= 1e-9 * s.tools.blank_holder_force
-        assert p.force_balance() <= 1e-6 and p.free_under_holder() == 0
+        # the z-balance closes to Newton's tolerance, which scales with the element forces, not
+        # the punch force: early in the stroke 2.4 rtol of it on the graded mesh, under 1 rtol on 6 x 6
+        assert p.force_balance() <= 5 * s.process.rtol and p.free_under_holder() == 0
         assert p.max_penetration() <= 0.01 * s.material.thickness
         forces.append(p.punch_force())
 
