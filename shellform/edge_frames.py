@@ -96,6 +96,20 @@ def group_vertex_normals(V, blank, group, ghosts: bool = False) -> dict[int, np.
     return dict(zip(hit.tolist(), normal))
 
 
+def pair_constraint(directions: list[np.ndarray], tol: float) -> tuple[str, np.ndarray]:
+    """What the directions d (a_d = grad . d = 0) fixed at one vertex do to a component pair
+    (a_x, a_y): ("both", d) for two non-parallel ones, ("x", d) or ("y", d) for one along an
+    axis, ("turn", d) for any other one (fix a_1 of a_x, a_y = a_1 d + a_2 d_perp)."""
+    d = directions[0] / np.hypot(*directions[0])
+    if any(abs(d[0] * e[1] - d[1] * e[0]) > tol for e in directions[1:]):
+        return "both", d
+    if abs(d[1]) <= tol:
+        return "x", d
+    if abs(d[0]) <= tol:
+        return "y", d
+    return "turn", d
+
+
 class EdgeConstraints:
     """The supports {group: support} of a BlankMesh on the linear carrier V, in edge frames."""
 
@@ -121,16 +135,10 @@ class EdgeConstraints:
         frames = {}
         for (block, pair), ds in directions.items():
             ix, iy = (block * self.bs + col[c] for c in _PAIRS[pair])
-            d = ds[0]
-            if any(abs(d[0] * e[1] - d[1] * e[0]) > tol for e in ds[1:]):
-                fixed.update((ix, iy))  # two directions: the whole pair
-            elif abs(d[1]) <= tol:
-                fixed.add(ix)
-            elif abs(d[0]) <= tol:
-                fixed.add(iy)
-            else:
-                frames[(ix, iy)] = d / np.hypot(*d)
-                fixed.add(ix)  # a_1, the component along d, sits in the x slot
+            kind, d = pair_constraint(ds, tol)
+            fixed.update({"both": (ix, iy), "x": (ix,), "y": (iy,), "turn": (ix,)}[kind])
+            if kind == "turn":  # a_1, the component along d, sits in the x slot
+                frames[(ix, iy)] = d
         self.fixed = np.array(sorted(fixed), dtype=np.int32)  # owned local dofs, frame basis
         self.frames = frames
         self.rotation = None
@@ -239,17 +247,11 @@ class SheetEdgeFrames:
                 fixed.update(block * bs + k for k in self.HELD)
                 directions.setdefault(block, []).append(np.array([-n[1], n[0]]))
         for block, ds in directions.items():
-            d = ds[0] / np.hypot(*ds[0])
-            if any(abs(d[0] * e[1] - d[1] * e[0]) > tol for e in ds[1:]):
-                slots = (3, 4, 5, 6)  # two directions: the whole pairs
-            elif abs(d[1]) <= tol:
-                slots = (3, 5)  # along x: u_x, v_x
-            elif abs(d[0]) <= tol:
-                slots = (4, 6)  # along y: u_y, v_y
-            else:
+            kind, d = pair_constraint(ds, tol)
+            if kind == "turn":
                 self.rotated[block] = True
                 self.Q[block] = [[d[0], -d[1]], [d[1], d[0]]]
-                slots = (3, 5)  # a_1 of each pair
+            slots = {"both": (3, 4, 5, 6), "x": (3, 5), "y": (4, 6), "turn": (3, 5)}[kind]  # "turn": a_1 of each
             fixed.update(block * bs + k for k in slots)
         self.dofs = np.array(sorted(fixed), dtype=np.int32)  # local, ghosts included, frame basis
         self.bs = bs
@@ -264,22 +266,18 @@ class SheetEdgeFrames:
 
     def to_frames(self, array: np.ndarray) -> np.ndarray:
         """q' = Q^T q on the turned blocks (a copy)."""
-        out = array.copy()
-        d = out.reshape(-1, self.bs)
-        idx = np.flatnonzero(self.rotated[: d.shape[0]])
-        for i, j in self.PAIRS:
-            d[idx, i], d[idx, j] = (np.einsum("nk,nk->n", self.Q[idx, :, 0], d[idx][:, [i, j]]),
-                                    np.einsum("nk,nk->n", self.Q[idx, :, 1], d[idx][:, [i, j]]))
-        return out
+        return self._turned(array, np.swapaxes(self.Q, 1, 2))
 
     def from_frames(self, array: np.ndarray) -> np.ndarray:
         """q = Q q' on the turned blocks (a copy)."""
+        return self._turned(array, self.Q)
+
+    def _turned(self, array: np.ndarray, M: np.ndarray) -> np.ndarray:
         out = array.copy()
         d = out.reshape(-1, self.bs)
         idx = np.flatnonzero(self.rotated[: d.shape[0]])
         for i, j in self.PAIRS:
-            d[idx, i], d[idx, j] = (np.einsum("nk,nk->n", self.Q[idx, 0, :], d[idx][:, [i, j]]),
-                                    np.einsum("nk,nk->n", self.Q[idx, 1, :], d[idx][:, [i, j]]))
+            d[np.ix_(idx, [i, j])] = np.einsum("nab,nb->na", M[idx], d[np.ix_(idx, [i, j])])
         return out
 
     def turn_cell_arrays(self, dofs, vectors, matrices, tangent: bool) -> None:
