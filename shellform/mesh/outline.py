@@ -21,6 +21,7 @@ import dolfinx.mesh
 from shellform.errors import InputError
 from shellform.mesh.blank_mesh import BlankMesh
 from shellform.mesh.gmsh_model import gmsh_session, mesh_on_root
+from shellform.mesh.rectangle import rectangle
 
 SHAPES = ("rectangle", "circle", "polygon", "file")
 CIRCLE_GROUPS = {"full": ("rim",), "half": ("rim", "bottom"), "quarter": ("rim", "left", "bottom")}
@@ -247,8 +248,7 @@ def _whole_boundary(msh) -> BlankMesh:
 def blank(comm, scene, points=()) -> BlankMesh:
     """The mesh of a scene's blank (its [geometry] and [mesh]), with `points` as vertices where
     the outline allows; symmetry lines are checked to be straight, with the blank on one side."""
-    from shellform.edge_frames import check_symmetry_lines
-    from shellform.mesh.rectangle import rectangle
+    from shellform.edge_frames import check_symmetry_lines  # PETSc: not at the scene's import
 
     g, m = scene.geometry, scene.mesh
     if g.shape == "rectangle":

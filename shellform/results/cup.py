@@ -38,11 +38,6 @@ def draw_in(p) -> dict:
             "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
 
 
-def _on_line(X, diagonal: bool, tol: float) -> np.ndarray:
-    """The nodes (initial positions X) on the diagonal x = y or on the transverse line y = 0."""
-    return np.abs(X[:, 0] - X[:, 1]) < tol if diagonal else np.abs(X[:, 1]) < tol
-
-
 LINES = {  # the thickness lines of a cup by its tools' shape: name -> nodes on it
     "square": {"diagonal": lambda X, tol: np.abs(X[:, 0] - X[:, 1]) < tol,
                "transverse": lambda X, tol: np.abs(X[:, 1]) < tol},
@@ -193,7 +188,7 @@ def profile(driver, X, diagonal=False):
     distance from the centre, gathered on every rank."""
     n = driver.model.V.dofmap.index_map.size_local
     x = X[:n] + driver.q.x.array.reshape(-1, BS)[:n, :3]
-    on = _on_line(X[:n], diagonal, 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
+    on = LINES["square"]["diagonal" if diagonal else "transverse"](X[:n], 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
     r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
     rows, = _gather(driver.model.mesh.comm, np.column_stack([np.hypot(X[:n, 0], X[:n, 1])[on], r, x[on, 2]]))
     return rows[np.argsort(rows[:, 0])]
