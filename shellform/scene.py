@@ -427,8 +427,8 @@ def _validate_size(s: Scene) -> None:
 
     g, m = s.geometry, s.mesh
     if g.shape == "file":
-        return  # a .msh file is the size its author made it
-    if g.shape == "rectangle":
+        cells = outline.file_cells(g, m.n, m.refine)
+    elif g.shape == "rectangle":
         cells = budget.estimated_cells(g.lx, g.ly, g.region, m.kind, m.n, m.refine)
     else:
         x0, x1, _, _ = outline.region_bounds(g)

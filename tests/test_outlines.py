@@ -3,6 +3,7 @@
 against the built-in rectangle, rotation invariance, and the errors that name the field."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -180,6 +181,7 @@ def _names_field(data, field):
 
 
 CIRCLE = {"shape": "circle", "radius": 1.0}
+GEO = Path(__file__).resolve().parents[1] / "demos" / "meshes" / "quarter_disc.geo"
 UNSTRUCTURED = {"kind": "unstructured"}
 
 
@@ -199,6 +201,7 @@ UNSTRUCTURED = {"kind": "unstructured"}
     ({"geometry": {"shape": "file", "file": "/no/such/blank.msh"}, "mesh": UNSTRUCTURED}, "geometry.file"),
     ({"geometry": {"shape": "file", "file": "blank.stl"}, "mesh": UNSTRUCTURED}, "geometry.file"),
     ({"geometry": CIRCLE, "mesh": {"kind": "unstructured", "n": 10**6}}, "mesh.n"),  # too large for the machine
+    ({"geometry": {"shape": "file", "file": str(GEO)}, "mesh": {"kind": "unstructured", "refine": 12}}, "mesh.n"),
     ({"supports": {"left": 3}}, "supports.left"),
 ])
 def test_outline_errors_name_the_field(data, field):

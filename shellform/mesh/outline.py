@@ -11,6 +11,7 @@ Mesh size: h = (width of the region along x) / mesh.n, as for the unstructured r
 file is read as it is, a .geo or CAD file is meshed with its own sizes capped at h.
 """
 
+import functools
 import math
 from pathlib import Path
 
@@ -41,16 +42,33 @@ def group_names(g) -> tuple[str, ...]:
         return CIRCLE_GROUPS[g.region]
     if g.shape == "polygon":
         return tuple(dict.fromkeys(polygon_edge_names(g.vertices, g.edges)))
-    return tuple(_file_groups(g.file))
+    return _read_file(g.file, Path(g.file).stat().st_mtime)[0]
 
 
-def _file_groups(path) -> list[str]:
+def file_cells(g, n: int, refine: int) -> int:
+    """Triangles a file blank makes: those of its mesh (a .msh), or a gmsh estimate from its
+    bounding box at h = width / n (a .geo or CAD file), times 4^refine."""
+    from shellform.mesh.budget import gmsh_cells
+
+    _, triangles, (width, height) = _read_file(g.file, Path(g.file).stat().st_mtime)
+    if triangles:
+        return triangles * 4**refine
+    return gmsh_cells(width * height, width / n, refine)
+
+
+@functools.lru_cache(maxsize=8)
+def _read_file(path, mtime) -> tuple[tuple[str, ...], int, tuple[float, float]]:
+    """(boundary groups, triangles in its mesh (0: none yet), bounding box width and height)
+    of a gmsh file, read once per version of it."""
     with gmsh_session() as gmsh:
         try:
             gmsh.open(str(path))
         except Exception as exc:  # noqa: BLE001  (gmsh raises plain Exceptions)
             raise InputError("geometry.file", f"gmsh cannot read {path}: {exc}") from None
-        return [n for _, n in _named_curves(gmsh)] or ["boundary"]
+        groups = tuple(n for _, n in _named_curves(gmsh)) or ("boundary",)
+        triangles = sum(len(tags) for t, tags in zip(*gmsh.model.mesh.getElements(2)[:2]) if t == TRIANGLE)
+        x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(-1, -1)
+        return groups, triangles, (x1 - x0, y1 - y0)
 
 
 def _named_curves(gmsh) -> list[tuple[int, str]]:
