@@ -245,7 +245,6 @@ def test_a_mesh_of_quadrilaterals_is_an_error(tmp_path):
 def test_z0_of_a_paraboloid_equals_its_radii():
     """surface.z0 = -(x^2 + y^2)/(2 R) and R1 = R2 = R: the same kernels' answer (UFL
     differentiates z0; the linear and the nonlinear route alike)."""
-    from pathlib import Path
     import tomllib
 
     data = tomllib.loads((Path(__file__).resolve().parents[1] / "demos" / "shallow_shell.toml").read_text())
@@ -266,8 +265,6 @@ def test_z0_of_a_paraboloid_equals_its_radii():
 
 def test_hypar_carries_its_load_in_shear():
     """demos/hypar_shell.toml: membrane theory's N_xy = -q/(2c), N_x = N_y = 0 at the centre."""
-    from pathlib import Path
-
     s = scene.load(Path(__file__).resolve().parents[1] / "demos" / "hypar_shell.toml")
     r = linear.solve(s)
     f = r.cell_fields()["membrane_force"]
