@@ -69,17 +69,13 @@ def sheet_fixed_components(support: str, normal: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def normal_axis(blank, group: str, tol: float = 1e-9) -> str:
-    """'x' or 'y': the axis every facet normal of a boundary group lies along (on all ranks)."""
+def edge_axis(blank, group: str, tol: float = 1e-9) -> str | None:
+    """'x' or 'y': the axis every facet normal of a boundary group lies along (on all ranks);
+    None for a curved or oblique edge."""
     _, _, n = facet_normals(blank, blank.facets(group))
     along = (bool(np.all(np.abs(n[:, 1]) <= tol)), bool(np.all(np.abs(n[:, 0]) <= tol)))
     along = tuple(blank.mesh.comm.allreduce(int(a), op=MPI.MIN) > 0 for a in along)
-    if along[0]:
-        return "x"
-    if along[1]:
-        return "y"
-    raise InputError(f"supports.{group}", "this edge is curved or oblique: only the linear plate and shell "
-                     "support such edges (in the edge's frame); the nonlinear sheet needs edges along x or y")
+    return "x" if along[0] else "y" if along[1] else None
 
 
 def split_by_direction(blank, supports) -> tuple[dict[str, str], list[str]]:
@@ -89,15 +85,13 @@ def split_by_direction(blank, supports) -> tuple[dict[str, str], list[str]]:
     for group, support in supports.items():
         if support == "free":
             continue
-        try:
-            normal_axis(blank, group)
-        except InputError:
-            if support != "clamped":
-                raise InputError(f"supports.{group}", f"this edge is curved or oblique: the nonlinear sheet holds "
-                                 f"such an edge 'clamped' only (in its frame), got {support!r}") from None
+        if edge_axis(blank, group) is not None:
+            straight[group] = support
+        elif support == "clamped":
             curved.append(group)
         else:
-            straight[group] = support
+            raise InputError(f"supports.{group}", f"this edge is curved or oblique: the nonlinear sheet holds "
+                             f"such an edge 'clamped' only (in its frame), got {support!r}")
     return straight, curved
 
 
@@ -109,7 +103,11 @@ def boundary_conditions(V, components, blank, supports, fixed=fixed_components) 
         if support == "free":
             continue
         facets = blank.facets(group)
-        for comp in fixed(support, normal_axis(blank, group)):
+        axis = edge_axis(blank, group)
+        if axis is None:
+            raise InputError(f"supports.{group}", "this edge is curved or oblique: its support needs the edge's "
+                             "frame (shellform.edge_frames), which the contact driver does not take")
+        for comp in fixed(support, axis):
             if comp in components:
                 sub = V.sub(components.index(comp))
                 dofs.setdefault(comp, []).append(fem.locate_dofs_topological(sub, fdim, facets))
