@@ -154,9 +154,7 @@ from mpi4py import MPI
 from shellform import linear, scene
 w = {name: linear.solve(scene.load("demos/" + name + ".toml")).value("w")
      for name in ("circular_plate", "triangle_plate")}
-import sys
-sys.path.insert(0, "tests")
-from test_outlines import clamped_disc
+from shellform.studies.outlines import clamped_disc
 w["clamped_disc"] = clamped_disc("quarter", 8, 1.488)[0]
 if MPI.COMM_WORLD.rank == 0:
     print("RESULT " + json.dumps(w))
@@ -174,7 +172,7 @@ def test_curved_and_oblique_supports_on_two_ranks_match_serial(tmp_path, monkeyp
     root = Path(__file__).resolve().parents[1]
     monkeypatch.chdir(root)
     parallel = on_two_ranks(tmp_path, OUTLINES)
-    from test_outlines import clamped_disc
+    from shellform.studies.outlines import clamped_disc
 
     assert parallel.pop("clamped_disc") == pytest.approx(clamped_disc("quarter", 8, 1.488)[0], rel=1e-10)
     for name, w in parallel.items():
