@@ -11,8 +11,14 @@ Reference element (one triangle, fields of forms.fields.HybridFields), a basix m
     nodal (q):   u  P1 vector       [membrane]
                  w  reduced cubic   [bending]
                  g  P1 vector       [bending]  the string-net normal slope carrier
-    local:       eps_p, eps_b       assumed strains (DG1 symmetric tensors)
+    local:       eps_p              assumed membrane strain (DG0 symmetric tensor)
+                 eps_b              assumed curvature (DG1 symmetric tensor)
                  N, M               their multipliers (same spaces, same order)
+
+The assumed membrane strain is constant, the space of sym grad u for the P1 in-plane
+displacement: the curvature-coupled part w kappa0 of f^p enters through its cell mean only, so
+that the in-plane displacement can balance it and the element does not lock in membrane when
+membrane and bending couple (docs/locking.md). On a flat shell the two choices are the same.
 
 The same fields also come as three mixed elements of their own, ``nodal`` (u, w, g), ``strains``
 (eps_p, eps_b) and ``multipliers`` (N, M), in which the condensation's blocks are separate
@@ -50,7 +56,8 @@ class HybridElement:
             raise ValueError("a hybrid element needs the membrane or the bending effect")
         cell = "triangle"
         p1v = basix.ufl.element("Lagrange", cell, 1, shape=(2,))
-        sym = basix.ufl.element("DG", cell, 1, shape=(2, 2), symmetry=True)
+        space = {"membrane": basix.ufl.element("DG", cell, 0, shape=(2, 2), symmetry=True),
+                 "bending": basix.ufl.element("DG", cell, 1, shape=(2, 2), symmetry=True)}
         subs: list[tuple[str, basix.ufl._ElementBase]] = []
         comps: list[str] = []
         if has_m:
@@ -62,14 +69,14 @@ class HybridElement:
         self.groups = tuple(gr for gr in GROUPS if gr in self.effects)
         strain_name = {"membrane": "eps_p", "bending": "eps_b"}
         mult_name = {"membrane": "N", "bending": "M"}
-        subs += [(strain_name[gr], sym) for gr in self.groups]
-        subs += [(mult_name[gr], sym) for gr in self.groups]
+        subs += [(strain_name[gr], space[gr]) for gr in self.groups]
+        subs += [(mult_name[gr], space[gr]) for gr in self.groups]
         self.carrier_components = tuple(comps)
         self.sub_names = tuple(n for n, _ in subs)
         self.mixed = basix.ufl.mixed_element([e for _, e in subs])
         nodal = [(n, e) for n, e in subs if n in ("u", "w", "g")]
-        self.parts = {"nodal": nodal, "strains": [(strain_name[gr], sym) for gr in self.groups],
-                      "multipliers": [(mult_name[gr], sym) for gr in self.groups]}
+        self.parts = {"nodal": nodal, "strains": [(strain_name[gr], space[gr]) for gr in self.groups],
+                      "multipliers": [(mult_name[gr], space[gr]) for gr in self.groups]}
         self.offsets, start = {}, 0
         for name, e in subs:
             self.offsets[name] = slice(start, start + e.dim)
@@ -78,7 +85,7 @@ class HybridElement:
         self.q = np.concatenate([np.arange(self.offsets[n].start, self.offsets[n].stop) for n in nodal])
         self.eps = np.concatenate([self._range(strain_name[gr]) for gr in self.groups])
         self.lam = np.concatenate([self._range(mult_name[gr]) for gr in self.groups])
-        self.sym_dim = sym.dim
+        self.strain_dims = tuple(space[gr].dim for gr in self.groups)  # eps dofs per group
 
     def part(self, kind: str):
         """(names, element) of the nodal, strain or multiplier fields alone."""
@@ -131,12 +138,16 @@ class HybridElement:
         return cols, codes
 
     def centroid_average(self) -> np.ndarray:
-        """(3, sym_dim): centroid value (xx, yy, xy) of a DG1 symmetric tensor from its dofs.
+        """(3 groups, eps dofs): centroid value (xx, yy, xy) of each group's assumed strain.
 
-        basix.ufl blocks a symmetric 2x2 tensor as (xx, xy, yy), node-major; the Lagrange DG1
-        value at the centroid is the mean of the three nodal values.
+        basix.ufl blocks a symmetric 2x2 tensor as (xx, xy, yy), node-major; a DG0 tensor has one
+        node, and the Lagrange DG1 value at the centroid is the mean of the three nodal values.
         """
-        avg = np.zeros((3, self.sym_dim))
-        for out, comp in enumerate((0, 2, 1)):  # xx, yy, xy
-            avg[out, comp::3] = 1.0 / 3.0
+        avg = np.zeros((3 * len(self.groups), sum(self.strain_dims)))
+        start = 0
+        for g, dim in enumerate(self.strain_dims):
+            nodes = dim // 3
+            for out, comp in enumerate((0, 2, 1)):  # xx, yy, xy
+                avg[3 * g + out, start + comp:start + dim:3] = 1.0 / nodes
+            start += dim
         return avg

@@ -320,13 +320,12 @@ def recovered(cell, facet, gather, cols, codes, mapped, npar, ne, nq, avg, c, co
     for i in range(ne):
         for j in range(ne):
             lam[i] += R[i, j] * eps[j]
-    ns = avg.shape[1]
-    for g in range(ne // ns):
+    for g in range(avg.shape[0] // 3):
         for k in range(3):
             a, r = 0.0, 0.0
-            for j in range(ns):
-                a += avg[k, j] * eps[g * ns + j]
-                r += avg[k, j] * lam[g * ns + j]
+            for j in range(ne):
+                a += avg[3 * g + k, j] * eps[j]
+                r += avg[3 * g + k, j] * lam[j]
             out[6 * g + k] = a
             out[6 * g + 3 + k] = r
 

@@ -7,11 +7,13 @@ Compiled once per (effects, quadrature degree) on a mesh-free domain, like Eleme
     force      d/dz int S . e              (coefficients z, S)
     tangent    int de . D . te + S . d2e   (coefficients z, S, D)
     pressure   d/dz int p U_3              (dead pressure per unit p)
+    strain_gradient, geometric   B = de/dz at the points, int S . d2e (the assumed membrane strain)
 
 Two numba loops over the owned cells do the element around the constitutive update (which is
 shellform.material.section.update, a loop of its own so that its time is measured apart):
 
     strain_loop   gather the carrier values q, map them (z = Q q), strains e at the points
+                  (the membrane rows projected: shellform.assembly.assumed_membrane)
     tensor_loop   r = Q^T r_z and K = Q^T K_z Q from the resultants S and section tangents D
 
 Assembly is DOLFINx's (shellform.nonlinear.assemble).
@@ -26,7 +28,7 @@ import ufl
 from dolfinx.jit import ffcx_jit
 
 from shellform.forms import kirchhoff_love as kl
-from shellform.assembly import condensation, slope_map
+from shellform.assembly import assumed_membrane, condensation, slope_map
 from shellform.assembly.kernels import JIT_OPTIONS, reference_fields
 from shellform.assembly.sheet_element import NDOF, SheetElement, build_q, congruence
 from shellform import _jit as jit
@@ -120,7 +122,19 @@ class SheetKernels:
         ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS,
                                 jit_options=JIT_OPTIONS)
         self.strain = ufcx_e.tabulate_tensor_float64
+        # The assumed membrane strain (assumed_membrane) needs e and B = de/dz at the area and
+        # edge points, and the initial-stress part of the tangent on its own.
+        both = np.vstack([el.points, assumed_membrane.edge_points()])
+        ufcx_a, _, _ = ffcx_jit(comm, (e, both), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
+        ufcx_b, _, _ = ffcx_jit(comm, (de, both), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
+        self.strain_all, self.gradient_all = ufcx_a.tabulate_tensor_float64, ufcx_b.tabulate_tensor_float64
+        self.geometric = None
+        if nonlinear:
+            fgeo = ufl.derivative(ufl.derivative(kl.internal_work(e, Sq, dx), z, dz), z, tz)
+            self.geometric, ufcx_g = _cell_kernel(comm, fgeo)
+            self.geometric_offsets = packed_offsets(ufcx_g, fgeo, [z, Sq, Dq])
         self.nconst = 4 if shallow is True else 0  # a constant kappa0 in every kernel that sees it
+        self.tables = (assumed_membrane.edge_directions(), assumed_membrane.cubic_gradients())
 
         self.setup = self._setup_loop()
         self.strain_loop = self._strain_loop()
@@ -136,15 +150,18 @@ class SheetKernels:
 
     def _strain_loop(self):
         el = self.element
-        bound = functools.partial(strain_loop, kernel_address(self.strain), *el.q_map(), el.component_columns(),
-                                  el.nz, self.nconst)
+        bound = functools.partial(strain_loop, kernel_address(self.strain), kernel_address(self.strain_all),
+                                  *el.q_map(), el.component_columns(), el.nz, self.nconst, self.tables[0])
         return lambda *args: bound(numba.get_num_threads(), *args)
 
     def _tensor_loop(self):
         el = self.element
-        bound = functools.partial(tensor_loop, kernel_address(self.force), kernel_address(self.tangent),
-                                  self.force_offsets, self.tangent_offsets, *el.q_map(), el.component_columns(),
-                                  el.nz, el.nqp, self.nconst)
+        geometric = kernel_address(self.geometric) if self.geometric is not None else 0
+        go = self.geometric_offsets if self.geometric is not None else self.tangent_offsets
+        bound = functools.partial(tensor_loop, kernel_address(self.force), kernel_address(self.tangent), geometric,
+                                  kernel_address(self.gradient_all), self.force_offsets, self.tangent_offsets, go,
+                                  *el.q_map(), el.component_columns(), el.nz, el.nqp, self.nconst, *self.tables,
+                                  el.weights)
         return lambda *args: bound(numba.get_num_threads(), *args)
 
 
@@ -204,12 +221,17 @@ def _scratch(consts, nconst):
 
 
 @jit.njit(parallel=True)
-def strain_loop(strain, qcols, qcodes, ccols, nz, nconst, nt, cells, cells_coords, dofs, x, P, consts, z_out, e_out):
+def strain_loop(strain, strain_all, qcols, qcodes, ccols, nz, nconst, directions, nt, cells, cells_coords, dofs, x, P,
+                consts, beta, z_out, e_out):
     """z = Q q and the section strains e at the quadrature points of every cell (the cells dealt
-    out to the nt threads, each with its own buffers)."""
+    out to the nt threads, each with its own buffers); the membrane rows are the assumed
+    membrane strain where beta < 1 (assumed_membrane)."""
     for t in numba.prange(nt):
         Q = np.zeros((nz, NDOF))
         q = np.empty(NDOF)
+        A = np.zeros((3, 27))
+        nqp = e_out.shape[1]
+        e_all = np.zeros((nqp + 9, 6))
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
             cidx = cells[k]
@@ -219,9 +241,15 @@ def strain_loop(strain, qcols, qcodes, ccols, nz, nconst, nt, cells, cells_coord
                 for b in range(9):
                     q[9 * v + b] = x[9 * dofs[cidx, v] + b]
             z_out[k, :] = Q @ q
-            e = e_out[k].ravel()
-            e[:] = 0.0
-            jit.call_kernel(strain, e, z_out[k], c, coords, local, perm)
+            if beta[cidx] < 1.0:
+                e_all[:, :] = 0.0
+                jit.call_kernel(strain_all, e_all.reshape(e_all.size), z_out[k], c, coords, local, perm)
+                assumed_membrane.tying(slope_map.jacobian(coords), directions, A)
+                assumed_membrane.assumed_strain(e_all, nqp, A, beta[cidx], e_out[k])
+            else:
+                e = e_out[k].ravel()
+                e[:] = 0.0
+                jit.call_kernel(strain, e, z_out[k], c, coords, local, perm)
 
 
 @jit.njit
@@ -235,28 +263,52 @@ def _pack(w, offsets, nz, nqp, z, S, D):
 
 
 @jit.njit(parallel=True)
-def tensor_loop(force, tangent, fo, to, qcols, qcodes, ccols, nz, nqp, nconst, nt, cells, cells_coords, P, consts, z,
-                S, D, want_tangent, R_out, K_out):
+def tensor_loop(force, tangent, geometric, gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst, directions,
+                grads, weights, nt, cells, cells_coords, P, consts, beta, z, S, D, want_tangent, R_out, K_out):
     """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
-    nt threads, each with its own buffers)."""
+    nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
+    (shellform.assembly.assumed_membrane, whose docstring has the terms)."""
     for t in numba.prange(nt):
         Q = np.zeros((nz, NDOF))
         w = np.zeros(nz + 42 * nqp)
         rz = np.zeros(nz)
         Kz = np.zeros((nz, nz))
         QtK, KQ = np.zeros((NDOF, nz)), np.zeros((nz, NDOF))
+        Sp = np.zeros((nqp, 6))
+        B = np.zeros((nqp + 9, 6, nz))
+        Bt, DB, wdet = np.zeros((6, nz)), np.zeros((6, nz)), np.zeros(nqp)
+        A, sigma = np.zeros((3, 27)), np.zeros((9, 3))
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
             cidx = cells[k]
             coords = cells_coords[cidx]
             J = slope_map.jacobian(coords)
             build_q(J, P[cidx], qcols, qcodes, ccols, Q)
-            _pack(w, fo, nz, nqp, z[k], S[k].ravel(), D[k].ravel())
+            bk = beta[cidx]
+            assumed = bk < 1.0
+            Sp[:, :] = S[k]
             rz[:] = 0.0
+            if assumed:
+                Sp[:, :3] *= bk
+                wdet[:] = weights * abs(slope_map.determinant(J))
+                assumed_membrane.tying(J, directions, A)
+                assumed_membrane.tied_stress(S[k], wdet, A, sigma)
+                B[:, :, :] = 0.0
+                jit.call_kernel(gradient, B.reshape(B.size), z[k], c, coords, local, perm)
+                assumed_membrane.tied_force(B, nqp, sigma, 1.0 - bk, rz)
+            _pack(w, fo, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
             jit.call_kernel(force, rz, w, c, coords, local, perm)
             R_out[k, :] = Q.T @ rz
-            if want_tangent:
-                _pack(w, to, nz, nqp, z[k], S[k].ravel(), D[k].ravel())
-                Kz[:, :] = 0.0
+            if not want_tangent:
+                continue
+            Kz[:, :] = 0.0
+            if assumed:
+                assumed_membrane.material_tangent(B, nqp, A, bk, D[k].reshape(nqp, 36), wdet, Kz, Bt, DB)
+                if geometric != 0:
+                    _pack(w, go, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
+                    jit.call_kernel(geometric, Kz, w, c, coords, local, perm)
+                    assumed_membrane.tied_initial_stress(J, grads, sigma, 1.0 - bk, Kz)
+            else:
+                _pack(w, to, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
                 jit.call_kernel(tangent, Kz, w, c, coords, local, perm)
-                congruence(Kz, J, P[cidx], qcols, qcodes, ccols, QtK, KQ, K_out[k])
+            congruence(Kz, J, P[cidx], qcols, qcodes, ccols, QtK, KQ, K_out[k])

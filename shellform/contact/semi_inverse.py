@@ -122,6 +122,8 @@ class SemiInverseDriver(Driver):
     (default: the last tool); friction: mu.
     """
 
+    swap_line_search = False  # its Newton (_newton) has its own line search and contact passes
+
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
                  prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None):
         super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,

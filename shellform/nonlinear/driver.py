@@ -138,6 +138,7 @@ class Driver:
         self._direction = None
         self._floor = 0.0
         self._cause = ""  # why the last Newton attempt failed, in words
+        self.searching = True  # the energy line search on; an increment that fails swaps it once
 
     # -- residual and tangent ----------------------------------------------------------------
     def _in_frames(self) -> np.ndarray:
@@ -299,7 +300,8 @@ class Driver:
                     continue
                 # The lifted iteration moves the prescribed dofs: its slope on the free rows
                 # (about zero at a converged start) says nothing of the energy: full step.
-                shorter = None if jump > 0 else shorten(alpha, s0, self.dq.x.petsc_vec.dot(self.b))
+                searching = self.searching and jump == 0
+                shorter = shorten(alpha, s0, self.dq.x.petsc_vec.dot(self.b)) if searching else None
                 if shorter is None:
                     accepted = True
                     break
@@ -328,6 +330,22 @@ class Driver:
         else:
             self.q.x.array[:] = x_n
 
+    swap_line_search = True  # the contact driver has a line search of its own
+
+    def _other_line_search(self, lam, reversal, dlam, x_n, x_prev, its):
+        """Retry a failed increment with the energy line search swapped (off if it was on), and
+        keep the swap while it converges. A thin sheet needs it off: Newton's first step bends it
+        with the membrane unbalanced, past the energy minimum along that step, and converges from
+        there in a few iterations, where a line search would creep (docs/locking.md)."""
+        cause = self._cause
+        self.searching = not self.searching
+        self._predict(dlam, x_n, x_prev)
+        ok, its2, res, ev = self._newton(lam, reversal)
+        if not ok:
+            self.searching = not self.searching
+            self._cause = f"{cause}; with the line search {'on' if self.searching else 'off'}: {self._cause}"
+        return ok, its + its2, res, ev
+
     def run(self, target: float = 1.0, on_increment=None):
         """Step lambda from its current value to `target` (up or down)."""
         c = self.controls
@@ -346,6 +364,8 @@ class Driver:
                 self._predict(dlam, x_n, x_prev)
                 t0 = time.perf_counter()
                 ok, its, res, ev = self._newton(lam, reversal)
+                if not ok and self.swap_line_search:
+                    ok, its, res, ev = self._other_line_search(lam, reversal, dlam, x_n, x_prev, its)
                 if ok:
                     break
                 self.q.x.array[:] = x_n

@@ -18,6 +18,7 @@ from mpi4py import MPI
 from shellform.assembly.kernels import check_mesh
 from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
+from shellform.assembly import assumed_membrane as membrane_projection
 from shellform.assembly.sheet_kernels import SheetKernels
 from shellform.material import hencky, hill79, section
 from shellform.material.update import section_update
@@ -71,7 +72,8 @@ class SheetModel:
     components = COMPONENTS
 
     def __init__(self, mesh, material, thickness: float, effects=("geometric_nonlinearity",),
-                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4):
+                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4,
+                 assumed_membrane: bool = True):
         check_mesh(mesh)
         if not (np.isfinite(thickness) and thickness > 0):
             raise InputError("material.thickness", f"must be > 0, got {thickness}")
@@ -100,6 +102,9 @@ class SheetModel:
         a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
         area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
         self.cell_area = area
+        # beta = 1: the compatible membrane strain; below 1 the assumed one (docs/locking.md)
+        beta = membrane_projection.stabilisation(self.thickness, self.cell_coords, mesh.comm) if assumed_membrane else 1.0
+        self.beta = np.full(self.num_cells, beta)
         self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element
         self.nqp = el.nqp
@@ -131,7 +136,7 @@ class SheetModel:
         k = self.kernels
         numba.set_num_threads(self.threads)
         t0 = time.perf_counter()
-        k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.z,
+        k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta, self.z,
                       self.strain)
         t1 = time.perf_counter()
         nplastic, nfail, nguard = section_update(
@@ -139,7 +144,7 @@ class SheetModel:
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
             elastic_tangent)
         t2 = time.perf_counter()
-        k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.z, self.resultants,
+        k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.z, self.resultants,
                       self.tangents, tangent, self.forms.vectors, self.forms.matrices)
         t3 = time.perf_counter()
         return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard))
