@@ -12,6 +12,9 @@ Effects of the nonlinear sheet (forms.nonlinear, shellform.nonlinear):
 - ``anisotropy``              r != 1 or m != 2 in the Hill 1979 yield function (needs plasticity)
 - ``finite_strain``           the layers in logarithmic strains, a thinning lever arm (needs
                               plasticity and geometric_nonlinearity)
+- ``assumed_membrane``        the membrane strain tied to the element edges (the string net),
+                              for thin and curved sheets without membrane locking
+                              (shellform.assembly.assumed_membrane, docs/locking.md)
 """
 
 import ufl
@@ -20,8 +23,8 @@ from shellform.forms import assumed_strain, bending, loads, membrane, string_net
 from shellform.forms.fields import HybridFields, ShellParameters
 
 EFFECTS = ("bending", "membrane", "shallow_curvature", "geometric_nonlinearity", "plasticity", "anisotropy",
-           "finite_strain")
-NONLINEAR_EFFECTS = ("geometric_nonlinearity", "plasticity", "anisotropy", "finite_strain")
+           "finite_strain", "assumed_membrane")
+NONLINEAR_EFFECTS = ("geometric_nonlinearity", "plasticity", "anisotropy", "finite_strain", "assumed_membrane")
 
 
 def strain_energy(f: HybridFields, p: ShellParameters, effects) -> ufl.Form | None:

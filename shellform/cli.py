@@ -12,7 +12,9 @@
                                             cup-paper (the paper's Figs. 5 to 8), numisheet
                                             (the NUMISHEET'93 cups to 40 mm), numisheet-cost
                                             (the aluminium cup's accuracy against time),
-                                            cup-benchmark (its speed at 900 to 10,000 cells)
+                                            cup-benchmark (its speed at 900 to 10,000 cells),
+                                            outlines (blanks of any outline), locking (thin
+                                            roll-ups and a curved roof, membrane locking)
 """
 
 import argparse
@@ -59,7 +61,7 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
 
 
 STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark", "outlines"]
+           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark", "outlines", "locking"]
 
 
 def main(argv=None) -> int:

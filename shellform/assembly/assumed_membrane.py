@@ -40,7 +40,7 @@ import numpy as np
 from shellform import _jit as jit
 from shellform.elements import reduced_cubic
 
-ALPHA = 1.0  # beta^2 = t^2 / (t^2 + ALPHA h^2)
+ALPHA = 0.3  # beta^2 = t^2 / (t^2 + ALPHA h^2)
 MEMBRANE_ROWS = 3  # e = (E11, E22, 2 E12, K11, K22, 2 K12)
 EDGES = ((0, 1), (1, 2), (2, 0))  # reference vertices (0, 0), (1, 0), (0, 1)
 _VERTICES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])

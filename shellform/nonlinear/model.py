@@ -72,8 +72,7 @@ class SheetModel:
     components = COMPONENTS
 
     def __init__(self, mesh, material, thickness: float, effects=("geometric_nonlinearity",),
-                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4,
-                 assumed_membrane: bool = True):
+                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4):
         check_mesh(mesh)
         if not (np.isfinite(thickness) and thickness > 0):
             raise InputError("material.thickness", f"must be > 0, got {thickness}")
@@ -103,7 +102,8 @@ class SheetModel:
         area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
         self.cell_area = area
         # beta = 1: the compatible membrane strain; below 1 the assumed one (docs/locking.md)
-        beta = membrane_projection.stabilisation(self.thickness, self.cell_coords, mesh.comm) if assumed_membrane else 1.0
+        assumed = "assumed_membrane" in self.effects
+        beta = membrane_projection.stabilisation(self.thickness, self.cell_coords, mesh.comm) if assumed else 1.0
         self.beta = np.full(self.num_cells, beta)
         self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element

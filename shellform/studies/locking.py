@@ -1,0 +1,138 @@
+"""Membrane locking: thin roll-ups and a curved roof, with and without the assumed membrane strain.
+
+Two cases in which bending and membrane couple (docs/locking.md):
+
+- **roll-up** (docs/rollup.md): the strip rolled into a full circle at t/L = 1e-2, 1e-3 and
+  1e-4, 16 to 64 elements along it, with the sheet's compatible membrane strain ("compatible",
+  the element before issue 13) and with the edge-tied assumed one ("assumed",
+  shellform.assembly.assumed_membrane). Error: the largest tip distance from the exact arc over
+  the load path, in units of L.
+- **roof**: the Scordelis-Lo cylindrical roof as a shallow panel (R = 25, 50 long, t = 0.25,
+  80 degrees of arc, z0 = -y^2/(2R) over the plane, nu = 0, diaphragm ends, free straight
+  edges, uniform load 90 per unit plan area, a quarter model), deflection at the middle of the
+  free edge relative to each model's own overkill value:
+  the linear shallow-shell element (its assumed membrane strain constant since issue 13), and
+  the sheet in linearised Kirchhoff-Love strains, compatible and assumed.
+
+Wall time is the whole solve of each run, compilation included where a configuration is first
+met (the first row of each family).
+"""
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from shellform import linear
+from shellform.material import Hill79Material
+from shellform.nonlinear.driver import Controls, ConvergenceFailure
+from shellform.nonlinear.loads import SheetLoads
+from shellform.nonlinear.problem import SheetProblem
+from shellform.results.log import say
+from shellform.results.tables import write_csv
+from shellform.scene import Scene, from_dict
+from shellform.studies import rollup
+from shellform.studies.common import observed_rates, plot_error_time
+
+THICKNESSES = (1e-2, 1e-3, 1e-4)
+ROLLUP_LEVELS = (16, 32, 64)
+MEMBRANE = ("compatible", "assumed")
+
+R, LENGTH, T_ROOF, E_ROOF, LOAD = 25.0, 50.0, 0.25, 4.32e8, 90.0
+HALF_WIDTH = R * math.sin(math.radians(40.0))  # the planform of the 80 degree arc
+ROOF_LEVELS = (8, 16, 32, 64)
+ROOF_OVERKILL = {"linear": 256, "sheet": 128}
+LEVELS = (ROLLUP_LEVELS, ROOF_LEVELS)
+QUICK_LEVELS = ((16,), (8, 16))
+COLUMNS = ["case", "element", "membrane", "thickness", "n", "cells", "value", "reference", "error", "rate",
+           "increments", "iterations", "total_s", "note"]
+
+
+def rollup_row(n: int, thickness: float, membrane: str) -> dict:
+    row = {"case": "roll-up", "element": "sheet", "membrane": membrane, "thickness": thickness, "n": n,
+           "cells": 4 * n}
+    t0 = time.perf_counter()
+    try:
+        r = rollup.solve(n, thickness=thickness, assumed_membrane=membrane == "assumed")
+    except ConvergenceFailure as err:
+        return {**row, "error": math.nan, "total_s": time.perf_counter() - t0, "note": f"stopped: {err}"}
+    return {**row, "value": r["full_circle_error"], "error": r["max_tip_error"], "increments": r["increments"],
+            "iterations": r["iterations"], "total_s": r["total_s"], "note": ""}
+
+
+def roof_scene(n: int) -> Scene:
+    """The linear shallow-shell roof on an n x round(0.64 n) quarter mesh."""
+    return from_dict({
+        "title": f"Scordelis-Lo roof (shallow), n={n}", "effects": ["bending", "membrane", "shallow_curvature"],
+        "geometry": {"lx": LENGTH, "ly": 2 * HALF_WIDTH, "region": "quarter"}, "surface": {"R2": R},
+        "mesh": {"kind": "structured", "n": n},
+        "material": {"E": E_ROOF, "nu": 0.0, "thickness": T_ROOF},
+        "supports": {"left": "symmetry", "bottom": "symmetry", "right": "simply_supported", "top": "free"},
+        "loads": {"pressure": -LOAD}})
+
+
+def roof_linear(n: int) -> dict:
+    t0 = time.perf_counter()
+    res = linear.solve(roof_scene(n))
+    return {"case": "roof", "element": "linear shallow shell", "membrane": "constant", "thickness": T_ROOF, "n": n,
+            "cells": res.num_cells, "value": -res.value("w", 0.0, HALF_WIDTH), "total_s": time.perf_counter() - t0}
+
+
+def roof_sheet(n: int, membrane: str) -> dict:
+    """The roof in the sheet's linearised Kirchhoff-Love strains over the exact z0 (one increment)."""
+    t0 = time.perf_counter()
+    p = SheetProblem.on_rectangle(
+        MPI.COMM_WORLD, LENGTH, 2 * HALF_WIDTH, n, Hill79Material(E=E_ROOF, nu=0.0), T_ROOF,
+        ("bending", "membrane") + (("assumed_membrane",) if membrane == "assumed" else ()),
+        supports={"left": "symmetry", "bottom": "symmetry", "right": "simply_supported", "top": "free"},
+        loads=SheetLoads(pressure=-LOAD), controls=Controls(initial_step=1.0, max_step=1.0), region="quarter",
+        kappa0=np.array([[0.0, 0.0], [0.0, 1.0 / R]]))
+    p.driver.run(1.0)
+    return {"case": "roof", "element": "sheet (linearised)", "membrane": membrane, "thickness": T_ROOF, "n": n,
+            "cells": p.model.num_cells, "value": -p.value("w", 0.0, HALF_WIDTH),
+            "iterations": sum(h.iterations for h in p.driver.history), "total_s": time.perf_counter() - t0}
+
+
+def _against(rows: list[dict], reference: float) -> list[dict]:
+    for r in rows:
+        r["reference"] = reference
+        r["error"] = (r["value"] - reference) / reference
+    for r, rate in zip(rows, observed_rates(rows, error="error")):
+        r["rate"] = rate
+    return rows
+
+
+def run(outdir: Path, levels=LEVELS, thicknesses=THICKNESSES) -> list[dict]:
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    roll_levels, roof_levels = levels
+    rows, series = [], {}
+    for t in thicknesses:
+        for membrane in MEMBRANE:
+            part = [rollup_row(n, t, membrane) for n in roll_levels]
+            for r in part:
+                say(f"roll-up t/L={t:g} {membrane:10s} n={r['n']:3d}: max tip error/L {r['error']:.2e} "
+                    f"({r.get('increments', '-')} increments, {r['total_s']:.1f} s) {r['note']}")
+            rows += part
+            series[f"roll-up t/L={t:g}, {membrane}"] = [r for r in part if np.isfinite(r["error"])]
+    linear_rows = [roof_linear(n) for n in roof_levels]
+    ref = roof_linear(ROOF_OVERKILL["linear"])["value"]
+    rows += _against(linear_rows, ref)
+    series["roof, linear element"] = linear_rows
+    for r in linear_rows:
+        say(f"roof linear n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, {r['value'] / ref:.3f} of {ref:.5f}")
+    ref = roof_sheet(ROOF_OVERKILL["sheet"], "assumed")["value"]
+    for membrane in MEMBRANE:
+        part = _against([roof_sheet(n, membrane) for n in roof_levels], ref)
+        for r in part:
+            say(f"roof sheet {membrane:10s} n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, "
+                f"{r['value'] / ref:.4f} of {ref:.5f}")
+        rows += part
+        series[f"roof, sheet {membrane}"] = part
+    write_csv(outdir / "locking.csv", rows, COLUMNS)
+    plot_error_time(outdir / "locking_error_time.png", series,
+                    "Membrane locking: roll-up tip error/L and roof deflection error against wall time",
+                    error="error", ylabel="|error| (roll-up: tip / L; roof: relative)")
+    return rows
