@@ -93,3 +93,23 @@ def test_rigid_modes_are_the_null_space(one_cell, effects, nzero):
     for r in modes:
         res = np.linalg.norm(K @ r) / (normK * np.linalg.norm(r))
         assert res < 1e-12, f"rigid mode not in the null space: {res:.3e}"
+
+
+@pytest.mark.parametrize("R", [10.0, 2.0])
+def test_curved_element_has_six_zero_modes(one_cell, R):
+    """A shallow-shell triangle on a doubly curved surface (kappa0 = diag(1/R, 1/(2R))): exactly
+    6 zero eigenvalues, the next above 1e-6 of the largest. The assumed membrane strain is
+    constant (3 conditions) and the curvature linear (6): 15 - 9 = 6 modes. With a linear
+    membrane strain (the element before issue 13) the curvature-coupled term w kappa0 gave the
+    membrane 9 conditions that the P1 in-plane field could not meet: membrane locking."""
+    c = lambda v: fem.Constant(one_cell, np.float64(v))  # noqa: E731
+    kappa0 = fem.Constant(one_cell, np.array([[1 / R, 0.0], [0.0, 0.5 / R]]))
+    params = ShellParameters(E=c(1.0e3), nu=c(0.3), thickness=c(0.1), kappa0=kappa0, pressure=c(0.0))
+    forms = HybridShellForms(one_cell, HybridElement(("bending", "membrane", "shallow_curvature")), params)
+    A = fem_petsc.assemble_matrix(forms.stiffness)
+    A.assemble()
+    K = A.getValues(range(15), range(15))
+    A.destroy()
+    lam = np.linalg.eigvalsh(0.5 * (K + K.T))
+    ratio = np.abs(lam) / lam.max()
+    assert np.all(ratio[:6] < 1e-12) and ratio[6] > 1e-6, ratio[:8]
