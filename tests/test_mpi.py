@@ -49,23 +49,27 @@ def test_two_ranks_match_serial(tmp_path):
 NONLINEAR = """
 import json, shellform
 from mpi4py import MPI
-from shellform.studies import levy, plastic
+from shellform.studies import levy, plastic, rollup
 w = levy.solve(8, loads=[95.0])[-1]["w_over_h"]
 row = plastic.solve(8, 5)
+roll = rollup.solve(16, thickness=1e-3, assumed_membrane=True)["errors"]
 if MPI.COMM_WORLD.rank == 0:
-    print("RESULT " + json.dumps({"levy": w, "plastic": row["P_max_over_PL"]}))
+    print("RESULT " + json.dumps({"levy": w, "plastic": row["P_max_over_PL"], "rollup": roll}))
 """
 
 
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 def test_nonlinear_two_ranks_match_serial(tmp_path):
-    """Newton with plasticity on two ranks: the same answer to the solver tolerance."""
-    from shellform.studies import levy, plastic
+    """Newton with plasticity, and the thin roll-up with the assumed membrane strain (one beta
+    from the whole mesh), on two ranks: the same answers to the solver tolerance."""
+    from shellform.studies import levy, plastic, rollup
 
     parallel = on_two_ranks(tmp_path, NONLINEAR)
     assert parallel["levy"] == pytest.approx(levy.solve(8, loads=[95.0])[-1]["w_over_h"], rel=1e-8)
     assert parallel["plastic"] == pytest.approx(plastic.solve(8, 5)["P_max_over_PL"], rel=1e-8)
+    serial = rollup.solve(16, thickness=1e-3, assumed_membrane=True)["errors"]
+    assert parallel["rollup"] == pytest.approx(serial, rel=1e-6)
 
 
 CUP = """
