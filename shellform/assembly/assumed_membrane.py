@@ -100,19 +100,16 @@ def tying(J, directions, A):
 
 
 @jit.njit
-def assumed_strain(e_all, nqp, A, beta, e_out):
-    """e_out (nqp x 6): the area points' strains of e_all (area points, then the 9 edge points)
-    with the membrane rows (1 - beta) eps^p + beta E."""
+def assumed_strain(E_edge, A, beta, e):
+    """e (points x 6): membrane rows (1 - beta) eps^p + beta E, eps^p = sum_k A_k E_edge[k]."""
     eps = np.zeros(MEMBRANE_ROWS)
     for k in range(9):
         for a in range(MEMBRANE_ROWS):
             for b in range(MEMBRANE_ROWS):
-                eps[a] += A[a, 3 * k + b] * e_all[nqp + k, b]
-    for i in range(nqp):
+                eps[a] += A[a, 3 * k + b] * E_edge[k, b]
+    for i in range(e.shape[0]):
         for r in range(MEMBRANE_ROWS):
-            e_out[i, r] = (1.0 - beta) * eps[r] + beta * e_all[i, r]
-        for r in range(MEMBRANE_ROWS, 6):
-            e_out[i, r] = e_all[i, r]
+            e[i, r] = (1.0 - beta) * eps[r] + beta * e[i, r]
 
 
 @jit.njit
@@ -132,21 +129,23 @@ def tied_stress(S, wdet, A, sigma):
 
 
 @jit.njit
-def tied_force(B, nqp, sigma, scale, rz):
-    """rz += scale sum_k B_k^T sigma_k (B: all points x 6 x nz, edge points after the area ones)."""
+def tied_force(Bm, sigma, scale, rz):
+    """rz += scale sum_k Bm_k^T sigma_k (Bm: the 9 edge points x 3 membrane rows x nz)."""
     nz = rz.size
     for k in range(9):
         for j in range(nz):
             s = 0.0
             for b in range(MEMBRANE_ROWS):
-                s += B[nqp + k, b, j] * sigma[k, b]
+                s += Bm[k, b, j] * sigma[k, b]
             rz[j] += scale * s
 
 
 @jit.njit
-def material_tangent(B, nqp, A, beta, D, wdet, Kz, Bt, DB):
-    """Kz += sum_i wdet_i Bt_i^T D_i Bt_i (D: points x 36; scratch Bt, DB: 6 x nz)."""
-    nz = Kz.shape[0]
+def material_tangent(B, Bm, A, beta, D, wdet, Kz, Bt, DB):
+    """Kz += sum_i wdet_i Bt_i^T D_i Bt_i (B: area points x 6 x nz, Bm: edge points x 3 x nz,
+    D: points x 36), as one product Bt^T (blockdiag(wdet_i D_i) Bt) of the stacked rows
+    (scratch Bt, DB: 6 points x nz)."""
+    nqp, nz = B.shape[0], B.shape[2]
     Beps = np.zeros((MEMBRANE_ROWS, nz))
     for k in range(9):
         for a in range(MEMBRANE_ROWS):
@@ -154,27 +153,21 @@ def material_tangent(B, nqp, A, beta, D, wdet, Kz, Bt, DB):
                 c = A[a, 3 * k + b]
                 if c != 0.0:
                     for j in range(nz):
-                        Beps[a, j] += c * B[nqp + k, b, j]
+                        Beps[a, j] += c * Bm[k, b, j]
     for i in range(nqp):
         for j in range(nz):
             for r in range(MEMBRANE_ROWS):
-                Bt[r, j] = (1.0 - beta) * Beps[r, j] + beta * B[i, r, j]
+                Bt[6 * i + r, j] = (1.0 - beta) * Beps[r, j] + beta * B[i, r, j]
             for r in range(MEMBRANE_ROWS, 6):
-                Bt[r, j] = B[i, r, j]
+                Bt[6 * i + r, j] = B[i, r, j]
         for a in range(6):
             for j in range(nz):
-                s = 0.0
-                for b in range(6):
-                    s += D[i, 6 * a + b] * Bt[b, j]
-                DB[a, j] = wdet[i] * s
-        for j in range(nz):
-            for m in range(j, nz):
-                s = 0.0
-                for a in range(6):
-                    s += Bt[a, j] * DB[a, m]
-                Kz[j, m] += s
-                if m != j:
-                    Kz[m, j] += s
+                DB[6 * i + a, j] = 0.0
+            for b in range(6):
+                d = wdet[i] * D[i, 6 * a + b]
+                for j in range(nz):
+                    DB[6 * i + a, j] += d * Bt[6 * i + b, j]
+    Kz += Bt.T @ DB
 
 
 @jit.njit

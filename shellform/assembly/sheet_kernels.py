@@ -122,12 +122,16 @@ class SheetKernels:
         ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS,
                                 jit_options=JIT_OPTIONS)
         self.strain = ufcx_e.tabulate_tensor_float64
-        # The assumed membrane strain (assumed_membrane) needs e and B = de/dz at the area and
-        # edge points, and the initial-stress part of the tangent on its own.
-        both = np.vstack([el.points, assumed_membrane.edge_points()])
-        ufcx_a, _, _ = ffcx_jit(comm, (e, both), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
-        ufcx_b, _, _ = ffcx_jit(comm, (de, both), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
-        self.strain_all, self.gradient_all = ufcx_a.tabulate_tensor_float64, ufcx_b.tabulate_tensor_float64
+        # The assumed membrane strain (assumed_membrane) needs the membrane strain E and dE/dz at
+        # the edge points, B = de/dz at the area points, and the initial-stress tangent on its own.
+        edges = assumed_membrane.edge_points()
+        E = ufl.as_vector([e[i] for i in range(3)])
+        ufcx_m, _, _ = ffcx_jit(comm, (E, edges), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
+        ufcx_dm, _, _ = ffcx_jit(comm, (ufl.derivative(E, z, dz), edges), form_compiler_options=_OPTIONS,
+                                 jit_options=JIT_OPTIONS)
+        ufcx_b, _, _ = ffcx_jit(comm, (de, el.points), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
+        self.edge_strain, self.edge_gradient = ufcx_m.tabulate_tensor_float64, ufcx_dm.tabulate_tensor_float64
+        self.gradient = ufcx_b.tabulate_tensor_float64
         self.geometric = None
         if nonlinear:
             fgeo = ufl.derivative(ufl.derivative(kl.internal_work(e, Sq, dx), z, dz), z, tz)
@@ -150,7 +154,7 @@ class SheetKernels:
 
     def _strain_loop(self):
         el = self.element
-        bound = functools.partial(strain_loop, kernel_address(self.strain), kernel_address(self.strain_all),
+        bound = functools.partial(strain_loop, kernel_address(self.strain), kernel_address(self.edge_strain),
                                   *el.q_map(), el.component_columns(), el.nz, self.nconst, self.tables[0])
         return lambda *args: bound(numba.get_num_threads(), *args)
 
@@ -159,7 +163,8 @@ class SheetKernels:
         geometric = kernel_address(self.geometric) if self.geometric is not None else 0
         go = self.geometric_offsets if self.geometric is not None else self.tangent_offsets
         bound = functools.partial(tensor_loop, kernel_address(self.force), kernel_address(self.tangent), geometric,
-                                  kernel_address(self.gradient_all), self.force_offsets, self.tangent_offsets, go,
+                                  kernel_address(self.gradient), kernel_address(self.edge_gradient), self.force_offsets,
+                                  self.tangent_offsets, go,
                                   *el.q_map(), el.component_columns(), el.nz, el.nqp, self.nconst, *self.tables,
                                   el.weights)
         return lambda *args: bound(numba.get_num_threads(), *args)
@@ -221,7 +226,7 @@ def _scratch(consts, nconst):
 
 
 @jit.njit(parallel=True)
-def strain_loop(strain, strain_all, qcols, qcodes, ccols, nz, nconst, directions, nt, cells, cells_coords, dofs, x, P,
+def strain_loop(strain, edge_strain, qcols, qcodes, ccols, nz, nconst, directions, nt, cells, cells_coords, dofs, x, P,
                 consts, beta, z_out, e_out):
     """z = Q q and the section strains e at the quadrature points of every cell (the cells dealt
     out to the nt threads, each with its own buffers); the membrane rows are the assumed
@@ -230,8 +235,7 @@ def strain_loop(strain, strain_all, qcols, qcodes, ccols, nz, nconst, directions
         Q = np.zeros((nz, NDOF))
         q = np.empty(NDOF)
         A = np.zeros((3, 27))
-        nqp = e_out.shape[1]
-        e_all = np.zeros((nqp + 9, 6))
+        E_edge = np.zeros((9, 3))
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
             cidx = cells[k]
@@ -241,15 +245,14 @@ def strain_loop(strain, strain_all, qcols, qcodes, ccols, nz, nconst, directions
                 for b in range(9):
                     q[9 * v + b] = x[9 * dofs[cidx, v] + b]
             z_out[k, :] = Q @ q
+            e = e_out[k].ravel()
+            e[:] = 0.0
+            jit.call_kernel(strain, e, z_out[k], c, coords, local, perm)
             if beta[cidx] < 1.0:
-                e_all[:, :] = 0.0
-                jit.call_kernel(strain_all, e_all.reshape(e_all.size), z_out[k], c, coords, local, perm)
+                E_edge[:, :] = 0.0
+                jit.call_kernel(edge_strain, E_edge.reshape(E_edge.size), z_out[k], c, coords, local, perm)
                 assumed_membrane.tying(slope_map.jacobian(coords), directions, A)
-                assumed_membrane.assumed_strain(e_all, nqp, A, beta[cidx], e_out[k])
-            else:
-                e = e_out[k].ravel()
-                e[:] = 0.0
-                jit.call_kernel(strain, e, z_out[k], c, coords, local, perm)
+                assumed_membrane.assumed_strain(E_edge, A, beta[cidx], e_out[k])
 
 
 @jit.njit
@@ -263,7 +266,7 @@ def _pack(w, offsets, nz, nqp, z, S, D):
 
 
 @jit.njit(parallel=True)
-def tensor_loop(force, tangent, geometric, gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst, directions,
+def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst, directions,
                 grads, weights, nt, cells, cells_coords, P, consts, beta, z, S, D, want_tangent, R_out, K_out):
     """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
     nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
@@ -275,8 +278,8 @@ def tensor_loop(force, tangent, geometric, gradient, fo, to, go, qcols, qcodes, 
         Kz = np.zeros((nz, nz))
         QtK, KQ = np.zeros((NDOF, nz)), np.zeros((nz, NDOF))
         Sp = np.zeros((nqp, 6))
-        B = np.zeros((nqp + 9, 6, nz))
-        Bt, DB, wdet = np.zeros((6, nz)), np.zeros((6, nz)), np.zeros(nqp)
+        B, Bm = np.zeros((nqp, 6, nz)), np.zeros((9, 3, nz))
+        Bt, DB, wdet = np.zeros((6 * nqp, nz)), np.zeros((6 * nqp, nz)), np.zeros(nqp)
         A, sigma = np.zeros((3, 27)), np.zeros((9, 3))
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
@@ -293,9 +296,9 @@ def tensor_loop(force, tangent, geometric, gradient, fo, to, go, qcols, qcodes, 
                 wdet[:] = weights * abs(slope_map.determinant(J))
                 assumed_membrane.tying(J, directions, A)
                 assumed_membrane.tied_stress(S[k], wdet, A, sigma)
-                B[:, :, :] = 0.0
-                jit.call_kernel(gradient, B.reshape(B.size), z[k], c, coords, local, perm)
-                assumed_membrane.tied_force(B, nqp, sigma, 1.0 - bk, rz)
+                Bm[:, :, :] = 0.0
+                jit.call_kernel(edge_gradient, Bm.reshape(Bm.size), z[k], c, coords, local, perm)
+                assumed_membrane.tied_force(Bm, sigma, 1.0 - bk, rz)
             _pack(w, fo, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
             jit.call_kernel(force, rz, w, c, coords, local, perm)
             R_out[k, :] = Q.T @ rz
@@ -303,7 +306,9 @@ def tensor_loop(force, tangent, geometric, gradient, fo, to, go, qcols, qcodes, 
                 continue
             Kz[:, :] = 0.0
             if assumed:
-                assumed_membrane.material_tangent(B, nqp, A, bk, D[k].reshape(nqp, 36), wdet, Kz, Bt, DB)
+                B[:, :, :] = 0.0
+                jit.call_kernel(gradient, B.reshape(B.size), z[k], c, coords, local, perm)
+                assumed_membrane.material_tangent(B, Bm, A, bk, D[k].reshape(nqp, 36), wdet, Kz, Bt, DB)
                 if geometric != 0:
                     _pack(w, go, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
                     jit.call_kernel(geometric, Kz, w, c, coords, local, perm)
