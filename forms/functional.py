@@ -5,6 +5,9 @@ Effects and the terms they add:
 - ``membrane``          membrane energy, membrane-strain constraint
 - ``shallow_curvature`` the 1/R terms of f^p and f^b (needs bending and membrane)
 - ``pressure``          work of a uniform pressure (needs bending)
+- ``cubic_membrane``    the in-plane displacement interpolated as w is (u, v and their gradients
+                        at the vertices), the assumed membrane strain quadratic: a membrane that
+                        bends in plane (linear element; docs/locking.md)
 
 Effects of the nonlinear sheet (forms.nonlinear, shellform.nonlinear):
 - ``geometric_nonlinearity``  exact (total-Lagrangian Kirchhoff-Love) membrane and bending strains
@@ -22,8 +25,8 @@ import ufl
 from shellform.forms import assumed_strain, bending, loads, membrane, string_net
 from shellform.forms.fields import HybridFields, ShellParameters
 
-EFFECTS = ("bending", "membrane", "shallow_curvature", "geometric_nonlinearity", "plasticity", "anisotropy",
-           "finite_strain", "assumed_membrane")
+EFFECTS = ("bending", "membrane", "shallow_curvature", "cubic_membrane", "geometric_nonlinearity", "plasticity",
+           "anisotropy", "finite_strain", "assumed_membrane")
 NONLINEAR_EFFECTS = ("geometric_nonlinearity", "plasticity", "anisotropy", "finite_strain", "assumed_membrane")
 
 

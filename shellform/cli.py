@@ -25,6 +25,20 @@ from pathlib import Path
 from shellform.errors import InputError
 
 
+def _extreme_w(res) -> dict:
+    """The vertex value of w largest in magnitude (over all ranks) and where it is."""
+    from mpi4py import MPI
+
+    V = res.q.function_space
+    owned = V.dofmap.index_map.size_local
+    w = res.q.x.array.reshape(-1, len(res.components))[:owned, res.components.index("w")]
+    xy = V.tabulate_dof_coordinates()[:owned, :2]
+    k = int(abs(w).argmax()) if owned else -1
+    mine = (abs(float(w[k])), float(w[k]), xy[k].tolist()) if owned else (-1.0, 0.0, [0.0, 0.0])
+    _, value, at = max(MPI.COMM_WORLD.allgather(mine))
+    return {"w_extreme": value, "w_extreme_at": at}
+
+
 def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = False) -> dict:
     from mpi4py import MPI
 
@@ -50,7 +64,7 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
     summary = {
         "title": s.title, "effects": list(s.effects), "cells": res.num_cells, "dofs": res.num_dofs,
         "ranks": MPI.COMM_WORLD.size, "w_center": res.value("w") if "w" in res.components else None,
-        "wall_time_s": time.perf_counter() - t0, **res.timings,
+        **(_extreme_w(res) if "w" in res.components else {}), "wall_time_s": time.perf_counter() - t0, **res.timings,
     }
     if s.output.vtx:
         fields.write_vtx(outdir, res.q, res.components, cells)

@@ -92,8 +92,11 @@ def compile_forms(scene: Scene, msh) -> HybridShellForms:
 
 
 def boundary_conditions(scene: Scene, rect, forms: HybridShellForms):
-    """The scene's named supports on the sides of the meshed rectangle."""
-    return supports.boundary_conditions(forms.V, forms.element.carrier_components, rect, scene.supports)
+    """The scene's named supports on the sides of the meshed rectangle (with cubic_membrane the
+    in-plane slopes are held as the sheet's are: a value fixed along a side fixes its derivative
+    along the side)."""
+    fixed = supports.sheet_fixed_components if forms.element.cubic_membrane else supports.fixed_components
+    return supports.boundary_conditions(forms.V, forms.element.carrier_components, rect, scene.supports, fixed=fixed)
 
 
 def assemble_system(forms: HybridShellForms, bcs, point_loads=(), tol=1e-9):

@@ -448,6 +448,12 @@ def _validate_effects(s: Scene) -> None:
     if "shallow_curvature" in s.effects:
         _require("bending" in s.effects and "membrane" in s.effects, "effects",
                  "'shallow_curvature' couples membrane and bending: switch both on")
+    if "cubic_membrane" in s.effects:
+        _require("membrane" in s.effects, "effects", "'cubic_membrane' interpolates the membrane: it needs 'membrane'")
+        _require(not s.nonlinear, "effects", "'cubic_membrane' is an option of the linear element; the nonlinear "
+                 "sheet's in-plane field is cubic already")
+        _require(s.geometry.shape == "rectangle", "effects", "'cubic_membrane' holds supports on edges along x "
+                 "and y only (a rectangle); curved and oblique edges are not built for it")
     for e in s.effects:
         if e in NONLINEAR_EFFECTS:
             _require("bending" in s.effects and "membrane" in s.effects, "effects",

@@ -110,6 +110,15 @@ def test_outline_scenes(tmp_path, name, reference, rel):
     assert (tmp_path / "deformed.png").is_file()
 
 
+def test_scordelis_lo_roof_scene(tmp_path):
+    """demos/scordelis_lo_roof.toml (cubic_membrane, 16 x 10 quarter mesh): the largest deflection
+    is at the middle of the free edge, within 0.5 % of the shallow theory's converged value
+    (tests/test_locking.py)."""
+    summary = run_scene("scordelis_lo_roof.toml", tmp_path)
+    assert summary["w_extreme"] == pytest.approx(-0.34871, rel=5e-3)
+    assert summary["w_extreme_at"] == pytest.approx([0.0, 25.0 * np.sin(np.radians(40.0))], abs=1e-9)
+
+
 def test_round_cup_scene_is_axisymmetric(tmp_path):
     """The round cup (demos/round_cup.toml, its 279 cells) to 15 mm: on a planar isotropic sheet
     the draw-in along x, along y and along the diagonal agree, and so do the thickness strains

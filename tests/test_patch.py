@@ -96,7 +96,9 @@ def _exact(x, components, field):
         k = U_COEF
         u = k["a"] * X + k["b"] * Y
         v = k["c"] * X + k["d"] * Y
-    values = {"u": u, "v": v, "w": w, "w_x": wx, "w_y": wy}
+    grad_u = {"u_x": U_COEF["a"], "u_y": U_COEF["b"], "v_x": U_COEF["c"], "v_y": U_COEF["d"]}
+    values = {"u": u, "v": v, "w": w, "w_x": wx, "w_y": wy,
+              **{k: (c if field == "membrane" else 0.0) + 0 * X for k, c in grad_u.items()}}
     for j, name in enumerate(components):
         out[:, j] = values[name]
     return out
@@ -166,7 +168,7 @@ def _check_recovery(forms, q, field):
         assert e_force < TOL, f"{field}: recovered {group} resultant off by {e_force:.3e} (relative)"
 
 
-@pytest.mark.parametrize("effects", [("bending",), ("bending", "membrane")])
+@pytest.mark.parametrize("effects", [("bending",), ("bending", "membrane"), ("bending", "membrane", "cubic_membrane")])
 def test_constant_curvature_patch(patch, effects):
     """w quadratic (u = v = 0) on the boundary => interior w, w_x, w_y exact, and in every cell
     curvature (xx, yy, xy) = (-2a, -2c, -b), moment = D ((1 - nu) kappa + nu tr(kappa) I)."""
@@ -175,7 +177,8 @@ def test_constant_curvature_patch(patch, effects):
     _check_recovery(forms, q, "curvature")
 
 
-@pytest.mark.parametrize("effects", [("membrane",), ("bending", "membrane")])
+@pytest.mark.parametrize("effects", [("membrane",), ("bending", "membrane"), ("membrane", "cubic_membrane"),
+                                     ("bending", "membrane", "cubic_membrane")])
 def test_constant_membrane_strain_patch(patch, effects):
     """u, v linear (w = 0) on the boundary => interior u, v exact, and in every cell
     membrane strain = sym grad u, force N = E t/(1 - nu^2) ((1 - nu) eps + nu tr(eps) I)."""

@@ -3,12 +3,13 @@
 Carrier: a blocked P1 space on the mesh, one block per vertex with the physical nodal values,
 
     membrane + bending: (u, v, w, w_x, w_y)      bending only: (w, w_x, w_y)
+    with cubic_membrane: (u, v, u_x, u_y, v_x, v_y, w, w_x, w_y)
 
 DOLFINx owns its dofmap, ghosts, boundary conditions and output unchanged.
 
 Reference element (one triangle, fields of forms.fields.HybridFields), a basix mixed element:
 
-    nodal (q):   u  P1 vector       [membrane]
+    nodal (q):   u  P1 vector       [membrane]  (cubic_membrane: the reduced cubic, as w)
                  w  reduced cubic   [bending]
                  g  P1 vector       [bending]  the string-net normal slope carrier
     local:       eps_p              assumed membrane strain (DG0 symmetric tensor)
@@ -19,6 +20,10 @@ The assumed membrane strain is constant, the space of sym grad u for the P1 in-p
 displacement: the curvature-coupled part w kappa0 of f^p enters through its cell mean only, so
 that the in-plane displacement can balance it and the element does not lock in membrane when
 membrane and bending couple (docs/locking.md). On a flat shell the two choices are the same.
+With the effect cubic_membrane the in-plane displacement is the reduced cubic (u, v and their
+gradients at the vertices) and the assumed membrane strain quadratic (DG2), which holds sym grad u
+of every cubic: no deformation mode is left without stiffness, and the panel bends in plane
+(docs/locking.md).
 
 The same fields also come as three mixed elements of their own, ``nodal`` (u, w, g), ``strains``
 (eps_p, eps_b) and ``multipliers`` (N, M), in which the condensation's blocks are separate
@@ -54,13 +59,20 @@ class HybridElement:
         has_m, has_b = "membrane" in self.effects, "bending" in self.effects
         if not (has_m or has_b):
             raise ValueError("a hybrid element needs the membrane or the bending effect")
+        self.cubic_membrane = "cubic_membrane" in self.effects
+        if self.cubic_membrane and not has_m:
+            raise ValueError("cubic_membrane needs the membrane effect")
         cell = "triangle"
         p1v = basix.ufl.element("Lagrange", cell, 1, shape=(2,))
-        space = {"membrane": basix.ufl.element("DG", cell, 0, shape=(2, 2), symmetry=True),
-                 "bending": basix.ufl.element("DG", cell, 1, shape=(2, 2), symmetry=True)}
+        self.strain_degrees = {"membrane": 2 if self.cubic_membrane else 0, "bending": 1}
+        space = {gr: basix.ufl.element("DG", cell, k, shape=(2, 2), symmetry=True)
+                 for gr, k in self.strain_degrees.items()}
         subs: list[tuple[str, basix.ufl._ElementBase]] = []
         comps: list[str] = []
-        if has_m:
+        if has_m and self.cubic_membrane:
+            subs.append(("u", basix.ufl.blocked_element(reduced_cubic.element(), shape=(2,))))
+            comps += ["u", "v", "u_x", "u_y", "v_x", "v_y"]
+        elif has_m:
             subs.append(("u", p1v))
             comps += ["u", "v"]
         if has_b:
@@ -122,7 +134,15 @@ class HybridElement:
         codes = np.zeros((nq, 2), dtype=np.int32)
         row = {r: k for k, r in enumerate(self.q)}
         for v in range(3):
-            if "u" in self.offsets:
+            if "u" in self.offsets and self.cubic_membrane:
+                for c, name in enumerate("uv"):  # blocked reduced cubic: dof 2 j + c, j = 3 v + k
+                    r = row[self.offsets["u"].start + 2 * (3 * v) + c]
+                    cols[r, 0], codes[r, 0] = bs * v + self.component(name), 1
+                    for i in range(2):
+                        r = row[self.offsets["u"].start + 2 * (3 * v + 1 + i) + c]
+                        for j in range(2):
+                            cols[r, j], codes[r, j] = bs * v + self.component(f"{name}_{'xy'[j]}"), 2 + 2 * j + i
+            elif "u" in self.offsets:
                 for i in range(2):  # blocked P1: node-major, component-minor
                     r = row[self.offsets["u"].start + 2 * v + i]
                     cols[r, 0], codes[r, 0] = bs * v + self.component("u") + i, 1
@@ -140,14 +160,16 @@ class HybridElement:
     def centroid_average(self) -> np.ndarray:
         """(3 groups, eps dofs): centroid value (xx, yy, xy) of each group's assumed strain.
 
-        basix.ufl blocks a symmetric 2x2 tensor as (xx, xy, yy), node-major; a DG0 tensor has one
-        node, and the Lagrange DG1 value at the centroid is the mean of the three nodal values.
+        basix.ufl blocks a symmetric 2x2 tensor as (xx, xy, yy), node-major; the weights of the
+        nodes are the scalar DG basis functions at the centroid.
         """
         avg = np.zeros((3 * len(self.groups), sum(self.strain_dims)))
+        centroid = np.array([[1.0 / 3.0, 1.0 / 3.0]])
         start = 0
-        for g, dim in enumerate(self.strain_dims):
-            nodes = dim // 3
+        for g, (gr, dim) in enumerate(zip(self.groups, self.strain_dims)):
+            scalar = basix.ufl.element("DG", "triangle", self.strain_degrees[gr])
+            phi = scalar.tabulate(0, centroid)[0, 0]  # (nodes,)
             for out, comp in enumerate((0, 2, 1)):  # xx, yy, xy
-                avg[3 * g + out, start + comp:start + dim:3] = 1.0 / nodes
+                avg[3 * g + out, start + comp:start + dim:3] = phi
             start += dim
         return avg
