@@ -25,18 +25,35 @@ from pathlib import Path
 from shellform.errors import InputError
 
 
-def _extreme_w(res) -> dict:
-    """The vertex value of w largest in magnitude (over all ranks) and where it is."""
+def _extremes(res) -> dict:
+    """Per displacement component (u, v, w) the vertex value largest in magnitude, over all
+    ranks, and where it is."""
     from mpi4py import MPI
 
     V = res.q.function_space
     owned = V.dofmap.index_map.size_local
-    w = res.q.x.array.reshape(-1, len(res.components))[:owned, res.components.index("w")]
+    values = res.q.x.array.reshape(-1, len(res.components))[:owned]
     xy = V.tabulate_dof_coordinates()[:owned, :2]
-    k = int(abs(w).argmax()) if owned else -1
-    mine = (abs(float(w[k])), float(w[k]), xy[k].tolist()) if owned else (-1.0, 0.0, [0.0, 0.0])
-    _, value, at = max(MPI.COMM_WORLD.allgather(mine))
-    return {"w_extreme": value, "w_extreme_at": at}
+    out = {}
+    for name in ("u", "v", "w"):
+        if name not in res.components:
+            continue
+        a = values[:, res.components.index(name)]
+        k = int(abs(a).argmax()) if owned else -1
+        mine = (abs(float(a[k])), float(a[k]), xy[k].tolist()) if owned else (-1.0, 0.0, [0.0, 0.0])
+        _, value, at = max(MPI.COMM_WORLD.allgather(mine))
+        out[name] = {"value": value, "at": at}
+    return out
+
+
+def _centre_w(res):
+    """w at the origin, or None where the blank has no vertex there (or no w)."""
+    if "w" not in res.components:
+        return None
+    try:
+        return res.value("w")
+    except InputError:
+        return None
 
 
 def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = False) -> dict:
@@ -63,8 +80,8 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
     cells = res.cell_fields()
     summary = {
         "title": s.title, "effects": list(s.effects), "cells": res.num_cells, "dofs": res.num_dofs,
-        "ranks": MPI.COMM_WORLD.size, "w_center": res.value("w") if "w" in res.components else None,
-        **(_extreme_w(res) if "w" in res.components else {}), "wall_time_s": time.perf_counter() - t0, **res.timings,
+        "ranks": MPI.COMM_WORLD.size, "w_center": _centre_w(res), "extremes": _extremes(res),
+        "wall_time_s": time.perf_counter() - t0, **res.timings,
     }
     if s.output.vtx:
         fields.write_vtx(outdir, res.q, res.components, cells)

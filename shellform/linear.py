@@ -19,6 +19,7 @@ from shellform.assembly.hybrid_element import HybridElement
 from shellform.assembly.kernels import HybridShellForms
 from shellform.edge_frames import EdgeConstraints
 from shellform.mesh import blank
+from shellform.errors import InputError
 from shellform.scene import Scene
 
 
@@ -91,6 +92,11 @@ def compile_forms(scene: Scene, msh) -> HybridShellForms:
     return HybridShellForms(msh, element, parameters(msh, scene), mapped=scene.solver.mapped)
 
 
+def along_axes(rect, named: dict) -> bool:
+    """Whether every supported (not free) edge group of the blank lies along x or y."""
+    return all(support == "free" or supports.edge_axis(rect, group) is not None for group, support in named.items())
+
+
 def boundary_conditions(scene: Scene, rect, forms: HybridShellForms):
     """The scene's named supports on the sides of the meshed rectangle (with cubic_membrane the
     in-plane slopes are held as the sheet's are: a value fixed along a side fixes its derivative
@@ -140,10 +146,13 @@ def solve(scene: Scene, comm=MPI.COMM_WORLD, blank_mesh=None) -> LinearResult:
     forms = compile_forms(scene, rect.mesh)
     t1 = time.perf_counter()
     tol = 1e-9 * rect.size
-    if scene.geometry.shape == "rectangle":  # edges along x and y: Dirichlet conditions on components
+    if along_axes(rect, scene.supports):  # supported edges along x and y: Dirichlet conditions on components
         A, b = assemble_system(forms, boundary_conditions(scene, rect, forms), scene.loads.point, tol)
         edges = None
     else:  # edges of any direction: in their own frames
+        if forms.element.cubic_membrane:
+            raise InputError("effects", "'cubic_membrane' holds supports on edges along x and y only; this blank "
+                             "has a supported curved or oblique edge (its frames are not built for the in-plane slopes)")
         edges = EdgeConstraints(forms.V, forms.element.carrier_components, rect, scene.supports)
         A, b = edges.apply(*assemble_system(forms, [], scene.loads.point, tol))
     t2 = time.perf_counter()

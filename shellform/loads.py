@@ -19,18 +19,20 @@ def vertex_dof(V, x, y, tol) -> tuple[int, bool]:
 
 
 def add_point_loads(b, V, components, points, tol):
-    """b[w at the vertex] += fz for each point load; the vertex must exist in the mesh."""
+    """b[w, u, v at the vertex] += fz, fx, fy for each point load (the components the carrier
+    has); the vertex must exist in the mesh."""
     if not points:
         return
     bs = len(components)
-    iw = components.index("w")
     array = b.getArray(readonly=False)
     for k, p in enumerate(points):
         i, found = vertex_dof(V, p.x, p.y, tol)
         if not found:
             raise InputError(f"loads.point[{k}]", f"no mesh vertex at ({p.x}, {p.y})")
         if i >= 0:
-            array[bs * i + iw] += p.fz
+            for name, f in (("w", p.fz), ("u", p.fx), ("v", p.fy)):
+                if f != 0.0:
+                    array[bs * i + components.index(name)] += f
 
 
 def value_at(u, components, name, x, y, tol) -> float:

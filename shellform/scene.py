@@ -82,7 +82,7 @@ class PointLoad:
     x: float = 0.0
     y: float = 0.0
     fz: float = 0.0  # force along +w
-    fx: float = 0.0  # in-plane forces along +x, +y (need 'membrane' and the nonlinear sheet)
+    fx: float = 0.0  # in-plane forces along +x, +y (need 'membrane')
     fy: float = 0.0
 
 
@@ -452,8 +452,7 @@ def _validate_effects(s: Scene) -> None:
         _require("membrane" in s.effects, "effects", "'cubic_membrane' interpolates the membrane: it needs 'membrane'")
         _require(not s.nonlinear, "effects", "'cubic_membrane' is an option of the linear element; the nonlinear "
                  "sheet's in-plane field is cubic already")
-        _require(s.geometry.shape == "rectangle", "effects", "'cubic_membrane' holds supports on edges along x "
-                 "and y only (a rectangle); curved and oblique edges are not built for it")
+
     for e in s.effects:
         if e in NONLINEAR_EFFECTS:
             _require("bending" in s.effects and "membrane" in s.effects, "effects",
@@ -519,9 +518,6 @@ def _validate_loads(s: Scene) -> None:
                      f"({p.x}, {p.y}) lies outside the blank [{x0}, {x1}] x [{y0}, {y1}]")
         _require((p.fx == 0 and p.fy == 0) or "membrane" in s.effects, f"loads.point[{i}]",
                  "in-plane forces (fx, fy) need the effect 'membrane'")
-        _require((p.fx == 0 and p.fy == 0) or s.nonlinear, f"loads.point[{i}]",
-                 "in-plane point forces (fx, fy) are applied by the nonlinear sheet only: add "
-                 "'geometric_nonlinearity' (or plasticity)")
     for i, mo in enumerate(loads.moment):
         _require(mo.side in SIDES, f"loads.moment[{i}].side", f"must be one of {', '.join(SIDES)}, got {mo.side!r}")
         _require(math.isfinite(mo.m), f"loads.moment[{i}].m", f"must be finite, got {mo.m}")

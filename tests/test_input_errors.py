@@ -92,8 +92,6 @@ POWER = {"hardening": "power", "yield_stress": 2.0e-3, "n": 5.0}
     ({"effects": SHEET, "loads": {"moment": {"side": "right", "m": 1.0}}}, "loads.moment"),
     ({"effects": FULL, "loads": {"moment": [{"side": "right", "m": 1.0}]}}, "loads.moment[0]"),
     ({"loads": {"point": [{"fx": 1.0}]}}, "loads.point[0]"),  # in-plane force without membrane
-    ({"effects": ["bending", "membrane"], "loads": {"point": [{"fx": 1.0}]}},
-     "loads.point[0]"),  # in-plane point force in a linear scene: the linear path applies fz only
     ({"effects": FULL, "supports": {"right": "clamped_sliding"}}, "supports.right"),
 ])
 def test_nonlinear_scene_errors_name_the_field(data, field):
