@@ -63,10 +63,10 @@ def plot_error_time(path: Path, series: dict[str, list[dict]], title: str, error
 
     fig, ax = plt.subplots(figsize=(7, 5))
     compile_s = max(r["compile_s"] for rows in series.values() for r in rows)
-    for label, rows in series.items():
+    for k, (label, rows) in enumerate(series.items()):
         t = [r["total_s"] - r["compile_s"] for r in rows]
         e = [abs(r[error]) for r in rows]
-        ax.loglog(t, e, "o-", label=label)
+        ax.loglog(t, e, "os^Dv"[k // 10 % 5] + "-", label=label)  # a new marker once the colours repeat
     ax.set_xlabel(f"wall time per solve [s]: mesh + assemble + solve (kernels compiled once: "
                   f"at most {compile_s:.1f} s)")
     ax.set_ylabel(ylabel or f"|{error}| of the centre deflection")

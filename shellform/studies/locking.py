@@ -152,6 +152,14 @@ def _against(rows: list[dict], reference: float) -> list[dict]:
     return rows
 
 
+def _roof_series(part: list[dict], ref: float, label: str, rows: list, series: dict) -> None:
+    """Errors of one family's roof rows against its overkill value, logged and collected."""
+    for r in _against(part, ref):
+        say(f"roof {label:28s} n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, {r['value'] / ref:.4f} of {ref:.5f}")
+    rows += part
+    series[f"roof, {label}"] = part
+
+
 def run(outdir: Path, levels=LEVELS, thicknesses=THICKNESSES) -> list[dict]:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -167,20 +175,11 @@ def run(outdir: Path, levels=LEVELS, thicknesses=THICKNESSES) -> list[dict]:
             series[f"roll-up t/L={t:g}, {membrane}"] = [r for r in part if np.isfinite(r["error"])]
     ref = roof_linear(ROOF_OVERKILL["linear"], cubic=True)["value"]
     for cubic in (False, True):
-        part = _against([roof_linear(n, cubic) for n in roof_levels], ref)
-        for r in part:
-            say(f"roof linear {r['membrane']:8s} n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, "
-                f"{r['value'] / ref:.4f} of {ref:.5f}")
-        rows += part
-        series[f"roof, linear element, {part[0]['membrane']}"] = part
+        part = [roof_linear(n, cubic) for n in roof_levels]
+        _roof_series(part, ref, f"linear element, {part[0]['membrane']}", rows, series)
     ref = roof_sheet(ROOF_OVERKILL["sheet"], "assumed")["value"]
     for membrane in MEMBRANE:
-        part = _against([roof_sheet(n, membrane) for n in roof_levels], ref)
-        for r in part:
-            say(f"roof sheet {membrane:10s} n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, "
-                f"{r['value'] / ref:.4f} of {ref:.5f}")
-        rows += part
-        series[f"roof, sheet {membrane}"] = part
+        _roof_series([roof_sheet(n, membrane) for n in roof_levels], ref, f"sheet {membrane}", rows, series)
     tmp = tempfile.mkdtemp(prefix="shellform-beam-") if MPI.COMM_WORLD.rank == 0 else None
     folder = Path(MPI.COMM_WORLD.bcast(tmp, root=0))  # the .geo copies of each mesh
     for load in BEAM_REFERENCE:
