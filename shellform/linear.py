@@ -151,8 +151,9 @@ def solve(scene: Scene, comm=MPI.COMM_WORLD, blank_mesh=None) -> LinearResult:
         edges = None
     else:  # edges of any direction: in their own frames
         if forms.element.cubic_membrane:
-            raise InputError("effects", "'cubic_membrane' holds supports on edges along x and y only; this blank "
-                             "has a supported curved or oblique edge (its frames are not built for the in-plane slopes)")
+            raise InputError("effects", "'cubic_membrane' holds supports on edges along x and y only; this "
+                             "blank has a supported curved or oblique edge (its frames are not built for the "
+                             "in-plane slopes)")
         edges = EdgeConstraints(forms.V, forms.element.carrier_components, rect, scene.supports)
         A, b = edges.apply(*assemble_system(forms, [], scene.loads.point, tol))
     t2 = time.perf_counter()

@@ -7,13 +7,14 @@ Compiled once per (effects, quadrature degree) on a mesh-free domain, like Eleme
     force      d/dz int S . e              (coefficients z, S)
     tangent    int de . D . te + S . d2e   (coefficients z, S, D)
     pressure   d/dz int p U_3              (dead pressure per unit p)
-    strain_gradient, geometric   B = de/dz at the points, int S . d2e (the assumed membrane strain)
+    edge_strain, edge_gradient   E and dE/dz at the edge points      (the assumed membrane strain)
+    gradient, geometric          B = de/dz at the points, int S . d2e (the assumed membrane strain)
 
 Two numba loops over the owned cells do the element around the constitutive update (which is
 shellform.material.section.update, a loop of its own so that its time is measured apart):
 
     strain_loop   gather the carrier values q, map them (z = Q q), strains e at the points
-                  (the membrane rows projected: shellform.assembly.assumed_membrane)
+                  (the membrane rows tied to the edges: shellform.assembly.assumed_membrane)
     tensor_loop   r = Q^T r_z and K = Q^T K_z Q from the resultants S and section tangents D
 
 Assembly is DOLFINx's (shellform.nonlinear.assemble).
@@ -266,8 +267,9 @@ def _pack(w, offsets, nz, nqp, z, S, D):
 
 
 @jit.njit(parallel=True)
-def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst, directions,
-                grads, weights, nt, cells, cells_coords, P, consts, beta, z, S, D, want_tangent, R_out, K_out):
+def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst,
+                directions, grads, weights, nt, cells, cells_coords, P, consts, beta, z, S, D, want_tangent, R_out,
+                K_out):
     """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
     nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
     (shellform.assembly.assumed_membrane, whose docstring has the terms)."""

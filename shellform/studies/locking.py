@@ -138,7 +138,8 @@ def curved_beam(along: int, across: int, load: str, cubic: bool, folder: Path) -
     comp = "v" if load == "in-plane" else "w"
     value = float(np.mean([res.value(comp, 0.0, float(y)) for y in np.linspace(4.12, 4.32, across + 1)]))
     ref = BEAM_REFERENCE[load]
-    return {"case": f"curved beam, {load}", "element": "linear shallow shell", "membrane": "cubic u" if cubic else "P1 u",
+    return {"case": f"curved beam, {load}", "element": "linear shallow shell",
+            "membrane": "cubic u" if cubic else "P1 u",
             "thickness": 0.1, "n": along, "cells": res.num_cells, "value": value, "reference": ref,
             "error": (value - ref) / ref, "compile_s": res.timings["compile_s"], "total_s": time.perf_counter() - t0}
 
@@ -155,7 +156,8 @@ def _against(rows: list[dict], reference: float) -> list[dict]:
 def _roof_series(part: list[dict], ref: float, label: str, rows: list, series: dict) -> None:
     """Errors of one family's roof rows against its overkill value, logged and collected."""
     for r in _against(part, ref):
-        say(f"roof {label:28s} n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, {r['value'] / ref:.4f} of {ref:.5f}")
+        say(f"roof {label:28s} n={r['n']:3d} ({r['cells']} cells): w = {r['value']:.5f}, "
+            f"{r['value'] / ref:.4f} of {ref:.5f}")
     rows += part
     series[f"roof, {label}"] = part
 
