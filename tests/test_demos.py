@@ -75,6 +75,12 @@ def test_rollup_demo():
     assert out.rstrip().endswith("OK"), out
 
 
+def test_membrane_locking_demo():
+    out = run_demo("demo_membrane_locking.py", "--n", "16")
+    assert re.search(r"^\s*16\s+64\s+7\.96e-01\s+7\.5\de-03", out, re.M), out  # locked, then not
+    assert out.rstrip().endswith("OK"), out
+
+
 def test_springback_demo():
     out = run_demo("demo_springback.py", "--n", "8", "--layers", "5")
     assert "tip force there" in out, out
