@@ -142,18 +142,18 @@ def solve(scene: Scene, comm=MPI.COMM_WORLD, blank_mesh=None) -> LinearResult:
     """The scene solved on its own mesh, or on `blank_mesh` (a BlankMesh with the scene's groups)."""
     t = time.perf_counter()
     rect = blank_mesh or mesh(scene, comm)
+    axes = along_axes(rect, scene.supports)  # supported edges along x and y: Dirichlet conditions on components
+    if not axes and "cubic_membrane" in scene.effects:
+        raise InputError("effects", "'cubic_membrane' holds supports on edges along x and y only; this blank has "
+                         "a supported curved or oblique edge (its frames are not built for the in-plane slopes)")
     t0 = time.perf_counter()
     forms = compile_forms(scene, rect.mesh)
     t1 = time.perf_counter()
     tol = 1e-9 * rect.size
-    if along_axes(rect, scene.supports):  # supported edges along x and y: Dirichlet conditions on components
+    if axes:
         A, b = assemble_system(forms, boundary_conditions(scene, rect, forms), scene.loads.point, tol)
         edges = None
     else:  # edges of any direction: in their own frames
-        if forms.element.cubic_membrane:
-            raise InputError("effects", "'cubic_membrane' holds supports on edges along x and y only; this "
-                             "blank has a supported curved or oblique edge (its frames are not built for the "
-                             "in-plane slopes)")
         edges = EdgeConstraints(forms.V, forms.element.carrier_components, rect, scene.supports)
         A, b = edges.apply(*assemble_system(forms, [], scene.loads.point, tol))
     t2 = time.perf_counter()

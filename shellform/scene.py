@@ -452,7 +452,6 @@ def _validate_effects(s: Scene) -> None:
         _require("membrane" in s.effects, "effects", "'cubic_membrane' interpolates the membrane: it needs 'membrane'")
         _require(not s.nonlinear, "effects", "'cubic_membrane' is an option of the linear element; the nonlinear "
                  "sheet's in-plane field is cubic already")
-
     for e in s.effects:
         if e in NONLINEAR_EFFECTS:
             _require("bending" in s.effects and "membrane" in s.effects, "effects",

@@ -257,3 +257,17 @@ def test_estimated_cells_match_the_built_mesh(kind, region, n, refine):
     cells = built.topology.index_map(2).size_global
     estimate = budget.estimated_cells(2.0, 1.5, region, kind, n, refine)
     assert estimate == cells if kind == "structured" else abs(estimate - cells) <= 0.2 * cells
+
+
+def test_cubic_membrane_on_a_supported_curved_edge_names_effects():
+    """cubic_membrane holds supports along x and y only: a circle with a supported rim is refused,
+    naming `effects`, before the forms are compiled."""
+    from shellform import linear
+
+    s = scene.from_dict({"effects": ["bending", "membrane", "cubic_membrane"],
+                         "geometry": {"shape": "circle", "radius": 1.0, "region": "quarter"},
+                         "mesh": {"kind": "unstructured", "n": 4},
+                         "supports": {"rim": "clamped", "left": "symmetry", "bottom": "symmetry"}})
+    with pytest.raises(InputError) as err:
+        linear.solve(s)
+    assert err.value.field == "effects"

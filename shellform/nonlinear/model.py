@@ -18,7 +18,7 @@ from mpi4py import MPI
 from shellform.assembly.kernels import check_mesh
 from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
-from shellform.assembly import assumed_membrane as membrane_projection
+from shellform.assembly import assumed_membrane
 from shellform.assembly.sheet_kernels import SheetKernels
 from shellform.material import hencky, hill79, section
 from shellform.material.update import section_update
@@ -102,8 +102,8 @@ class SheetModel:
         area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
         self.cell_area = area
         # beta = 1: the compatible membrane strain; below 1 the assumed one (docs/locking.md)
-        assumed = "assumed_membrane" in self.effects
-        beta = membrane_projection.stabilisation(self.thickness, self.cell_coords, mesh.comm) if assumed else 1.0
+        tied = "assumed_membrane" in self.effects
+        beta = assumed_membrane.stabilisation(self.thickness, self.cell_coords, mesh.comm) if tied else 1.0
         self.beta = np.full(self.num_cells, beta)
         self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element
