@@ -42,9 +42,9 @@ for extra in ((), ("assumed_membrane",)):
         t0 = time.perf_counter()
         for _ in range(args.repeat):
             if want_tangent is None:
-                k.strain_loop(m.cells, m.cell_coords, m.dofs, q.x.array, m.P, m.consts, m.beta, m.z, m.strain)
+                k.strain_loop(m.cells, m.cell_coords, m.dofs, q.x.array, m.P, m.consts, m.beta, m.tying, m.z, m.strain)
             else:
-                k.tensor_loop(m.cells, m.cell_coords, m.P, m.consts, m.beta, m.z, m.resultants, m.tangents,
+                k.tensor_loop(m.cells, m.cell_coords, m.P, m.consts, m.beta, m.tying, m.z, m.resultants, m.tangents,
                               want_tangent, m.forms.vectors, m.forms.matrices)
         times.append((time.perf_counter() - t0) / args.repeat * 1e3)
     name = "assumed" if extra else "compatible"

@@ -156,17 +156,21 @@ def test_rigid_rotation_is_strain_free(rotation):
     assert np.abs(strains[0][:, :, 3]).max() > 0.1  # the state is really bent
 
 
-@pytest.mark.parametrize("plastic", [False, True, "finite_strain"])
+@pytest.mark.parametrize("plastic", [False, True, "finite_strain", "assumed_membrane"])
 def test_consistent_tangent(plastic):
     """The assembled tangent equals a central difference of the assembled residual (Levy plate
-    at P = 95, elastic, and elastic-plastic variants with yielding layers, small and finite
-    strain)."""
+    at P = 95, elastic, elastic-plastic variants with yielding layers, small and finite strain,
+    and elastic with the assumed membrane strain tied to the edges)."""
     kw = {}
-    if plastic:
+    if plastic == "assumed_membrane":
+        kw = dict(effects=NL + ("assumed_membrane",))
+        plastic = False
+    elif plastic:
         extra = ("finite_strain",) if plastic == "finite_strain" else ()
         kw = dict(effects=NL + ("plasticity",) + extra, material=Hill79Material(
             E=1.0, nu=levy.NU, hardening="swift", K=1e-3, eps0=1e-3, n=0.2))
     p = levy.problem(4, controls=Controls(initial_step=0.05, max_step=0.1), **kw)
+    assert np.all(p.model.beta < 1.0) == ("assumed_membrane" in p.model.effects)
     d = p.driver
     d.run(90.0 / max(levy.TABLE))
     # a converged state inside the next increment, not committed: the return mapping is smooth

@@ -38,8 +38,10 @@ and B_k = dE/dz at point k:
 """
 
 import numpy as np
+from mpi4py import MPI
 
 from shellform import _jit as jit
+from shellform.assembly import slope_map
 from shellform.elements import reduced_cubic
 
 ALPHA = 0.3  # beta^2 = t^2 / (t^2 + ALPHA h^2)
@@ -71,13 +73,24 @@ def stabilisation(thickness: float, cell_coords: np.ndarray, comm, alpha: float 
     all ranks). One beta for the whole mesh: with a beta that changed from cell to cell, the
     beta part's edge terms would not cancel between neighbours and a constant stress would not
     be in equilibrium (the patch test)."""
-    from mpi4py import MPI
-
     x = cell_coords.reshape(-1, 3, 3)[:, :, :2]
     longest = np.max(np.linalg.norm(x - np.roll(x, 1, axis=1), axis=2), axis=1)
     total, count = comm.allreduce(float(longest.sum()), op=MPI.SUM), comm.allreduce(longest.size, op=MPI.SUM)
     h = total / count
     return float(np.sqrt(thickness**2 / (thickness**2 + alpha * h**2)))
+
+
+def tyings(cell_coords: np.ndarray) -> np.ndarray:
+    """(cells, 3, 27): every cell's tying matrix A (geometry only: computed once per mesh)."""
+    out = np.zeros((cell_coords.shape[0], 3, 27))
+    _tyings(np.ascontiguousarray(cell_coords), edge_directions(), out)
+    return out
+
+
+@jit.njit
+def _tyings(cell_coords, directions, out):
+    for c in range(cell_coords.shape[0]):
+        tying(slope_map.jacobian(cell_coords[c]), directions, out[c])
 
 
 @jit.njit
@@ -177,7 +190,7 @@ def tied_initial_stress(J, grads, sigma, scale, Kz):
     """Kz += scale sum_k sigma_k . d2E_k over the edge points: for the cubic dofs j, m of one
     displacement component c (z rows 3 j + c), with g = J^-T grad phi,
     sigma11 g_j1 g_m1 + sigma22 g_j2 g_m2 + sigma12 (g_j1 g_m2 + g_j2 g_m1)."""
-    det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    det = slope_map.determinant(J)
     g = np.empty((9, 2))
     for k in range(9):
         for j in range(9):  # J^-T grad_X

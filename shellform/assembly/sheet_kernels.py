@@ -139,7 +139,7 @@ class SheetKernels:
             self.geometric, ufcx_g = _cell_kernel(comm, fgeo)
             self.geometric_offsets = packed_offsets(ufcx_g, fgeo, [z, Sq, Dq])
         self.nconst = 4 if shallow is True else 0  # a constant kappa0 in every kernel that sees it
-        self.tables = (assumed_membrane.edge_directions(), assumed_membrane.cubic_gradients())
+        self.edge_gradients = assumed_membrane.cubic_gradients()  # reference, at the edge points
 
         self.setup = self._setup_loop()
         self.strain_loop = self._strain_loop()
@@ -156,7 +156,7 @@ class SheetKernels:
     def _strain_loop(self):
         el = self.element
         bound = functools.partial(strain_loop, kernel_address(self.strain), kernel_address(self.edge_strain),
-                                  *el.q_map(), el.component_columns(), el.nz, self.nconst, self.tables[0])
+                                  *el.q_map(), el.component_columns(), el.nz, self.nconst)
         return lambda *args: bound(numba.get_num_threads(), *args)
 
     def _tensor_loop(self):
@@ -166,7 +166,7 @@ class SheetKernels:
         bound = functools.partial(tensor_loop, kernel_address(self.force), kernel_address(self.tangent), geometric,
                                   kernel_address(self.gradient), kernel_address(self.edge_gradient), self.force_offsets,
                                   self.tangent_offsets, go,
-                                  *el.q_map(), el.component_columns(), el.nz, el.nqp, self.nconst, *self.tables,
+                                  *el.q_map(), el.component_columns(), el.nz, el.nqp, self.nconst, self.edge_gradients,
                                   el.weights)
         return lambda *args: bound(numba.get_num_threads(), *args)
 
@@ -227,15 +227,14 @@ def _scratch(consts, nconst):
 
 
 @jit.njit(parallel=True)
-def strain_loop(strain, edge_strain, qcols, qcodes, ccols, nz, nconst, directions, nt, cells, cells_coords, dofs, x, P,
-                consts, beta, z_out, e_out):
+def strain_loop(strain, edge_strain, qcols, qcodes, ccols, nz, nconst, nt, cells, cells_coords, dofs, x, P, consts,
+                beta, tying, z_out, e_out):
     """z = Q q and the section strains e at the quadrature points of every cell (the cells dealt
     out to the nt threads, each with its own buffers); the membrane rows are the assumed
     membrane strain where beta < 1 (assumed_membrane)."""
     for t in numba.prange(nt):
         Q = np.zeros((nz, NDOF))
         q = np.empty(NDOF)
-        A = np.zeros((3, 27))
         E_edge = np.zeros((9, 3))
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
@@ -252,8 +251,7 @@ def strain_loop(strain, edge_strain, qcols, qcodes, ccols, nz, nconst, direction
             if beta[cidx] < 1.0:
                 E_edge[:, :] = 0.0
                 jit.call_kernel(edge_strain, E_edge.reshape(E_edge.size), z_out[k], c, coords, local, perm)
-                assumed_membrane.tying(slope_map.jacobian(coords), directions, A)
-                assumed_membrane.assumed_strain(E_edge, A, beta[cidx], e_out[k])
+                assumed_membrane.assumed_strain(E_edge, tying[cidx], beta[cidx], e_out[k])
 
 
 @jit.njit
@@ -268,8 +266,7 @@ def _pack(w, offsets, nz, nqp, z, S, D):
 
 @jit.njit(parallel=True)
 def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst,
-                directions, grads, weights, nt, cells, cells_coords, P, consts, beta, z, S, D, want_tangent, R_out,
-                K_out):
+                grads, weights, nt, cells, cells_coords, P, consts, beta, tying, z, S, D, want_tangent, R_out, K_out):
     """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
     nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
     (shellform.assembly.assumed_membrane, whose docstring has the terms)."""
@@ -282,7 +279,7 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
         Sp = np.zeros((nqp, 6))
         B, Bm = np.zeros((nqp, 6, nz)), np.zeros((9, 3, nz))
         Bt, DB, wdet = np.zeros((6 * nqp, nz)), np.zeros((6 * nqp, nz)), np.zeros(nqp)
-        A, sigma = np.zeros((3, 27)), np.zeros((9, 3))
+        sigma = np.zeros((9, 3))
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
             cidx = cells[k]
@@ -296,8 +293,7 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
             if assumed:
                 Sp[:, :3] *= bk
                 wdet[:] = weights * abs(slope_map.determinant(J))
-                assumed_membrane.tying(J, directions, A)
-                assumed_membrane.tied_stress(S[k], wdet, A, sigma)
+                assumed_membrane.tied_stress(S[k], wdet, tying[cidx], sigma)
                 Bm[:, :, :] = 0.0
                 jit.call_kernel(edge_gradient, Bm.reshape(Bm.size), z[k], c, coords, local, perm)
                 assumed_membrane.tied_force(Bm, sigma, 1.0 - bk, rz)
@@ -310,7 +306,7 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
             if assumed:
                 B[:, :, :] = 0.0
                 jit.call_kernel(gradient, B.reshape(B.size), z[k], c, coords, local, perm)
-                assumed_membrane.material_tangent(B, Bm, A, bk, D[k].reshape(nqp, 36), wdet, Kz, Bt, DB)
+                assumed_membrane.material_tangent(B, Bm, tying[cidx], bk, D[k].reshape(nqp, 36), wdet, Kz, Bt, DB)
                 if geometric != 0:
                     _pack(w, go, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
                     jit.call_kernel(geometric, Kz, w, c, coords, local, perm)

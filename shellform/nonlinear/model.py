@@ -105,6 +105,7 @@ class SheetModel:
         tied = "assumed_membrane" in self.effects
         beta = assumed_membrane.stabilisation(self.thickness, self.cell_coords, mesh.comm) if tied else 1.0
         self.beta = np.full(self.num_cells, beta)
+        self.tying = assumed_membrane.tyings(self.cell_coords) if tied else np.zeros((0, 3, 27))
         self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element
         self.nqp = el.nqp
@@ -136,15 +137,15 @@ class SheetModel:
         k = self.kernels
         numba.set_num_threads(self.threads)
         t0 = time.perf_counter()
-        k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta, self.z,
-                      self.strain)
+        k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta, self.tying,
+                      self.z, self.strain)
         t1 = time.perf_counter()
         nplastic, nfail, nguard = section_update(
             self.strain, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
             elastic_tangent)
         t2 = time.perf_counter()
-        k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.z, self.resultants,
+        k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z, self.resultants,
                       self.tangents, tangent, self.forms.vectors, self.forms.matrices)
         t3 = time.perf_counter()
         return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard))
