@@ -642,3 +642,45 @@ def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
         d.contact.tool_curvature = curvature
         errors[curvature] = _tangent_error(d, lam, rows, columns)
     assert errors[True] <= (1e-5 if mu else 1e-6) and errors[False] >= 1e-4, errors
+
+
+def test_a_pass_starts_from_the_last_evaluation_turned_into_its_frames():
+    """A contact pass starts where the one before ended: the same carrier and material state,
+    another contact set and so other nodal frames. The last evaluation's element arrays, turned
+    from its frames F0 into the new F (T = F F0^T), give the residual and tangent of a fresh
+    evaluation to round-off, without running the element loops again."""
+    d, lam = _drawn_cup(2.0)
+    d._constraints(lam)
+    d.residual(lam, tangent=True)
+    s, x = d.state, d.positions()
+    released = np.flatnonzero((s.tool == 0) & ~d.sym_fixed.any(axis=1))[:5]
+    die_gap = d._gaps(x, lam)[d.die][0]
+    joined = np.flatnonzero((s.tool == FREE) & np.isfinite(die_gap))[:5]
+    assert released.size == 5 and joined.size == 5
+    s.tool[released], s.tool[joined] = FREE, d.die
+    d._constraints(lam)
+    reused = d.reused
+    d.residual(lam, tangent=True)
+    assert d.reused == reused + 1
+    R, K = d.b.copy(), d.A.copy()
+    d._memo = None  # a fresh evaluation
+    d.residual(lam, tangent=True)
+    assert d.reused == reused + 1
+    assert (R - d.b).norm() <= 1e-12 * d.b.norm()
+    K.axpy(-1.0, d.A)
+    assert K.norm() <= 1e-12 * d.A.norm()
+
+
+def test_a_full_step_that_sticks_slipping_nodes_is_kept_once_per_pass():
+    """The line search keeps an overshooting full step where it turns slipping nodes to stick
+    (the friction law's kink), once per pass; not where no node sticks, nor with stick_step off."""
+    d, lam = _drawn_cup(2.0)
+    before = d._slipping.copy()
+    assert before.sum() >= 2
+    d._slipping[np.flatnonzero(before)[:2]] = False  # as if the step had stuck two slipping nodes
+    d._kept = False
+    assert not d._keep_sticking_step(d._slipping.copy())  # nothing sticks
+    assert d._keep_sticking_step(before)
+    assert not d._keep_sticking_step(before)  # once per pass
+    d._kept, d.contact.stick_step = False, False
+    assert not d._keep_sticking_step(before)

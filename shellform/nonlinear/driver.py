@@ -25,7 +25,7 @@ converged state to disk. Nothing non-finite is ever committed.
 
 import json
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import dolfinx.fem.petsc as fem_petsc
@@ -139,6 +139,8 @@ class Driver:
         self._floor = 0.0
         self._cause = ""  # why the last Newton attempt failed, in words
         self.searching = True  # the energy line search on; an increment that fails swaps it once
+        self._memo = None  # the last evaluation (_evaluate)
+        self.evaluations = self.reused = 0  # of the element loops: run, and reused (a contact pass's first)
 
     # -- residual and tangent ----------------------------------------------------------------
     def _in_frames(self) -> np.ndarray:
@@ -156,9 +158,8 @@ class Driver:
         """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free|, scale, ev)."""
         m = self.model
         self.q.x.scatter_forward()
-        ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
+        ev = self._evaluate(tangent, elastic_tangent)
         t0 = time.perf_counter()
-        self._element_arrays(tangent)
         with self.b.localForm() as bl:
             bl.set(0.0)
         fem_petsc.assemble_vector(self.b, m.forms.vector)
@@ -189,6 +190,28 @@ class Driver:
         if self.nodal is not None:
             ext = max(ext, abs(lam) * self.nodal.magnitude)
         return self.b.norm(), max(f_int, ext, self._floor / self.controls.rtol), ev
+
+    def _evaluate(self, tangent: bool, elastic_tangent: bool):
+        """The element loops at q, turned into the solve's frames (_element_arrays); or the last
+        evaluation's arrays, turned from its frames into today's, where q, the committed material
+        state and the tangent asked for are those of the last evaluation (a contact pass starts
+        where the one before ended: only its set and frames changed). Returns the Evaluation."""
+        m, memo, q = self.model, self._memo, self.q.x.array
+        if (memo is not None and memo["version"] == m.state_version and (memo["tangent"] or not tangent)
+                and (not tangent or memo["elastic"] == elastic_tangent) and np.array_equal(memo["q"], q)):
+            self._reframe_element_arrays(memo["tangent"])
+            self.reused += 1
+            return replace(memo["ev"], element_s=0.0, constitutive_s=0.0)
+        ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
+        self.evaluations += 1
+        self._element_arrays(tangent)
+        self._memo = {"version": m.state_version, "tangent": tangent, "elastic": elastic_tangent, "q": q.copy(),
+                      "ev": ev}
+        return ev
+
+    def _reframe_element_arrays(self, tangent: bool) -> None:
+        """Hook: turn the element arrays of the last evaluation from the frames they were turned
+        into to the current ones (the edge frames never change: nothing to do)."""
 
     def _element_arrays(self, tangent: bool) -> None:
         """Hook between the element loop and assembly: the edge frames turn the arrays here (the
@@ -221,6 +244,7 @@ class Driver:
         """K v on the owned rows with the element tangents as they are (no Dirichlet rows; v a
         local array with ghosts): the change of the residual, reactions included, along v."""
         m = self.model
+        self._memo = None  # the element vectors are overwritten here
         m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, v[m.unrolled_dofs])
         Kv = fem_petsc.assemble_vector(m.forms.vector)
         Kv.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)

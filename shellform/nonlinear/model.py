@@ -130,6 +130,7 @@ class SheetModel:
         self.resultants = np.zeros((self.num_cells, self.nqp, 6))
         self.tangents = np.zeros((self.num_cells, self.nqp, 6, 6))
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
+        self.state_version = 0  # changes with the committed material state (Driver's reuse of an evaluation)
 
     # -- the element loop -------------------------------------------------------------------
     def evaluate(self, q: fem.Function, tangent: bool = True, elastic_tangent: bool = False) -> Evaluation:
@@ -157,6 +158,7 @@ class SheetModel:
         self.stretch_n[...] = self.stretch
         self._lever_before[...] = self.lever
         self.lever[...] = self.stretch  # the next increment's lever arm
+        self.state_version += 1
 
     def checkpoint(self) -> dict:
         """The committed material state; the next increment's lever arm is its stretch."""
@@ -173,11 +175,13 @@ class SheetModel:
         for key, target in pairs:
             target[...] = data[key]
         self.ep[...], self.p[...], self.stretch[...], self.lever[...] = self.ep_n, self.p_n, self.stretch_n, self.stretch_n
+        self.state_version += 1
 
     def converged_lever(self) -> None:
         """The lever arm with which the last converged increment was solved (it lags one
         increment): evaluating the committed state with it reproduces that state's forces."""
         self.lever[...] = self._lever_before
+        self.state_version += 1
 
     # -- output fields ------------------------------------------------------------------------
     def cell_fields(self) -> dict[str, np.ndarray]:

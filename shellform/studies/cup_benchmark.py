@@ -8,10 +8,12 @@ n x n quarter meshes, n = 21, 35 and 71: 882, 2,450 and 10,082 cells, about 900,
 2,450-cell cup is drawn once more on 2 MPI ranks (mpiexec -n 2; each rank takes half the
 cores for its threads). The 882 and 2,450-cell cups are drawn to 40 mm; the 10,082-cell cup
 to 5 mm only (STROKES), a run of hours to 40 mm on a 2-core machine: its row gives the cost of
-an iteration at that size, not the time of the whole draw.
+an iteration at that size, not the time of the whole draw. The 2,450-cell cup is drawn once more
+with Newton's tolerance at LOOSE_RTOL instead of the scene's 1e-6 (on 882 cells 1e-4 moves every
+reported quantity by under 1e-4, the mesh a hundred times more; docs/performance.md).
 
 Writes cup_benchmark.csv, one row per run:
-- ranks, cells, stroke, wall time, increments, Newton iterations, contact passes;
+- ranks, Newton's rtol, cells, stroke, wall time, increments, Newton iterations, contact passes;
 - one iteration's time in ms, split into the element loop, the constitutive update, the
   contact (frames, friction, set updates), DOLFINx assembly, the MUMPS solve and the rest
   (Python and other work between them), and the rest's share of the run;
@@ -21,7 +23,7 @@ and cup_benchmark.png: the iteration's split against cells, and the wall time ag
 
 Run one case alone (what the 2-rank line does under mpiexec):
 
-    python -m shellform.studies.cup_benchmark --n 35 --out DIR [--stroke MM]
+    python -m shellform.studies.cup_benchmark --n 35 --out DIR [--stroke MM] [--rtol 1e-4]
 """
 
 import argparse
@@ -41,17 +43,20 @@ LEVELS = (21, 35, 71)
 QUICK_LEVELS = (6,)
 STROKES = {71: 5.0}  # mm; the others to the scene's 40 mm
 MPI_LEVEL = 35  # the level drawn once more on 2 ranks
+LOOSE_RTOL = 1e-4  # and once more with this tolerance
 PARTS = ("element", "constitutive", "contact", "assembly", "solve")
 REPORTS = (15.0, 40.0)
-COLUMNS = ["case", "ranks", "n", "cells", "stroke_mm", "finished", "wall_s", "increments", "newton_iterations",
+COLUMNS = ["case", "ranks", "rtol", "n", "cells", "stroke_mm", "finished", "wall_s", "increments", "newton_iterations",
            "contact_passes", "iteration_ms", *(f"{p}_ms" for p in PARTS), "rest_ms", "rest_share",
            *(f"{q}_{mm:g}" for mm in REPORTS for q in ("force", "DX", "DD", "thinning")), "stopped"]
 
 
-def scene_for(n: int, stroke: float | None = None):
+def scene_for(n: int, stroke: float | None = None, rtol: float | None = None):
     """The aluminium cup on an n x n quarter mesh, drawn `stroke` mm (None: the scene's 40) with
-    the scene's increments in mm."""
+    the scene's increments in mm, and Newton's tolerance rtol (None: the scene's)."""
     s = variant(n, SCENE)
+    if rtol is not None:
+        s.process.rtol = rtol
     s.output.png = False
     s.output.fld = False
     if stroke is not None and stroke != s.tools.stroke:
@@ -63,24 +68,25 @@ def scene_for(n: int, stroke: float | None = None):
     return s
 
 
-def draw_one(n: int, out: Path, stroke: float | None = None) -> None:
+def draw_one(n: int, out: Path, stroke: float | None = None, rtol: float | None = None) -> None:
     """Draw one case into out (on however many ranks this process has)."""
     from shellform.contact.run import run as run_cup
 
-    run_cup(scene_for(n, stroke), Path(out))
+    run_cup(scene_for(n, stroke, rtol), Path(out))
 
 
-def case_folder(out: Path, n: int, ranks: int) -> Path:
-    return Path(out) / (f"n_{n}" + (f"_ranks_{ranks}" if ranks > 1 else ""))
+def case_folder(out: Path, n: int, ranks: int, rtol: float | None = None) -> Path:
+    return Path(out) / (f"n_{n}" + (f"_ranks_{ranks}" if ranks > 1 else "") + (f"_rtol_{rtol:g}" if rtol else ""))
 
 
-def row(out: Path, n: int, ranks: int) -> dict:
+def row(out: Path, n: int, ranks: int, rtol: float | None = None) -> dict:
     """A run's row from its summary.json."""
-    s = json.loads((case_folder(out, n, ranks) / "summary.json").read_text())
+    s = json.loads((case_folder(out, n, ranks, rtol) / "summary.json").read_text())
     t, its = s["wall_time_s"], max(s["newton_iterations"], 1)
     parts = {p: t.get(f"{p}_s", 0.0) for p in PARTS}
     rest = t["total"] - t["setup"] - sum(parts.values())
-    r = {"case": f"n {n}" + (f", {ranks} ranks" if ranks > 1 else ""), "ranks": s["ranks"], "n": n,
+    r = {"case": f"n {n}" + (f", {ranks} ranks" if ranks > 1 else "") + (f", rtol {rtol:g}" if rtol else ""),
+         "ranks": s["ranks"], "rtol": rtol or variant(n, SCENE).process.rtol, "n": n,
          "cells": s["cells"], "stroke_mm": s["stroke_mm"], "finished": s["stopped"] is None, "wall_s": t["total"],
          "increments": s["increments"], "newton_iterations": s["newton_iterations"],
          "contact_passes": s["contact_passes"], "iteration_ms": 1e3 * (t["total"] - t["setup"]) / its,
@@ -94,26 +100,30 @@ def row(out: Path, n: int, ranks: int) -> dict:
     return r
 
 
-def run(out: Path, levels=LEVELS, strokes=None, mpi_level: int | None = MPI_LEVEL) -> list[dict]:
-    """Draw every case one after the other, then the 2-rank case, and write the table and plot."""
+def run(out: Path, levels=LEVELS, strokes=None, mpi_level: int | None = MPI_LEVEL,
+        loose: tuple[int, float] | None = (MPI_LEVEL, LOOSE_RTOL)) -> list[dict]:
+    """Draw every case one after the other, then the 2-rank case and the case `loose` (level,
+    rtol), and write the table and plot."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     strokes = STROKES if strokes is None else strokes
-    cases = [(n, 1) for n in levels]
+    cases = [(n, 1, None) for n in levels]
     if mpi_level is not None and mpiexec() is not None:
-        cases.append((mpi_level, 2))
-    for n, ranks in cases:
-        say(f"cup-benchmark: n {n} on {ranks} rank(s)")
-        folder = case_folder(out, n, ranks)
+        cases.append((mpi_level, 2, None))
+    if loose is not None:
+        cases.append((loose[0], 1, loose[1]))
+    for n, ranks, rtol in cases:
+        say(f"cup-benchmark: n {n} on {ranks} rank(s)" + (f", rtol {rtol:g}" if rtol else ""))
+        folder = case_folder(out, n, ranks, rtol)
         if ranks == 1:
-            draw_one(n, folder, strokes.get(n))
+            draw_one(n, folder, strokes.get(n), rtol)
         else:
             cmd = [mpiexec(), "-n", str(ranks), sys.executable, "-m", "shellform.studies.cup_benchmark",
                    "--n", str(n), "--out", str(folder)]
             if strokes.get(n) is not None:
                 cmd += ["--stroke", str(strokes[n])]
             subprocess.run(cmd, check=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
-    rows = [row(out, n, ranks) for n, ranks in cases]
+    rows = [row(out, n, ranks, rtol) for n, ranks, rtol in cases]
     write_csv(out / "cup_benchmark.csv", rows, COLUMNS)
     plot(out / "cup_benchmark.png", rows)
     for r in rows:
@@ -139,9 +149,12 @@ def plot(path: Path, rows: list[dict]) -> None:
     a.set_title("one iteration, split")
     a.legend(fontsize=8)
     full = max(r["stroke_mm"] for r in rows)
-    for ranks, stroke, marker, label in ((1, True, "o-", "1 rank"), (2, True, "s", "2 ranks"),
-                                         (1, False, "x", "1 rank, shorter stroke")):
-        sel = [r for r in rows if r["ranks"] == ranks and (r["stroke_mm"] >= full) == stroke]
+    tight = min(r["rtol"] for r in rows)
+    for ranks, stroke, loose, marker, label in ((1, True, False, "o-", "1 rank"), (2, True, False, "s", "2 ranks"),
+                                                (1, False, False, "x", "1 rank, shorter stroke"),
+                                                (1, True, True, "^", "1 rank, looser Newton tolerance")):
+        sel = [r for r in rows if r["ranks"] == ranks and (r["stroke_mm"] >= full) == stroke
+               and (r["rtol"] > tight) == loose]
         if sel:
             b.plot([r["cells"] for r in sel], [r["wall_s"] for r in sel], marker, label=label)
         for r in sel:
@@ -165,8 +178,9 @@ def main(argv=None) -> None:
     parser.add_argument("--n", type=int, required=True)
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--stroke", type=float, default=None)
+    parser.add_argument("--rtol", type=float, default=None, help="Newton's tolerance (default: the scene's)")
     args = parser.parse_args(argv)
-    draw_one(args.n, args.out, args.stroke)
+    draw_one(args.n, args.out, args.stroke, args.rtol)
 
 
 if __name__ == "__main__":
