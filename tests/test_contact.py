@@ -672,13 +672,15 @@ def test_a_pass_starts_from_the_last_evaluation_turned_into_its_frames():
 
 
 def test_a_full_step_that_sticks_slipping_nodes_is_kept_once_per_pass():
-    """The line search keeps an overshooting full step where it turns slipping nodes to stick
-    (the friction law's kink), once per pass; not where no node sticks, nor with stick_step off."""
+    """With stick_step (opt-in), the line search keeps an overshooting full step where it turns
+    slipping nodes to stick (the friction law's kink), once per pass; not where no node sticks,
+    nor with stick_step off (the default)."""
     d, lam = _drawn_cup(2.0)
     before = d._slipping.copy()
     assert before.sum() >= 2
     d._slipping[np.flatnonzero(before)[:2]] = False  # as if the step had stuck two slipping nodes
-    d._kept = False
+    assert not d.contact.stick_step
+    d._kept, d.contact.stick_step = False, True
     assert not d._keep_sticking_step(d._slipping.copy())  # nothing sticks
     assert d._keep_sticking_step(before)
     assert not d._keep_sticking_step(before)  # once per pass

@@ -48,8 +48,8 @@ penetrations). A node moving along a curved tool turns its frame; the tangent ca
 
 Newton is globalised: each correction is first limited so that no node moves by more than
 `trust` thicknesses, then a line search on the energy slope dq . R(q + alpha dq) shortens it
-where it overshoots, except once per pass where the full step turns slipping nodes to stick
-(stick_step: the overshoot is the friction law's kink, which the slip tangent cannot see). The contact set is settled between passes: nodes that penetrate a tool by
+where it overshoots (with stick_step, not by default: except once per pass where the full step
+turns slipping nodes to stick, the friction law's kink, which the slip tangent cannot see). The contact set is settled between passes: nodes that penetrate a tool by
 more than `penetration` join it, nodes (not pinched) whose normal force turned tensile leave it;
 a node may switch at most `max_toggles` times per increment (no chattering).
 """
@@ -81,7 +81,7 @@ class ContactControls:
     stick_stiffness: float = 0.01  # k_t = stick_stiffness E A_i / h (module docstring)
     friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
-    stick_step: bool = True  # keep a full step that turns slipping nodes to stick, once per pass (_keep_sticking_step)
+    stick_step: bool = False  # keep a full step that turns slipping nodes to stick, once per pass (_keep_sticking_step)
     early_set: bool = True  # end a pass once the set will change and the steps are below early_step penetrations
     early_step: float = 10.0  # (1 until 2026-11-23: 19 % more iterations on 2,450 cells, docs/performance.md)
     refresh_normal: bool = True  # friction's normal forces from every iterate after the first (not per pass)
@@ -760,13 +760,14 @@ class SemiInverseDriver(Driver):
         return False, norm, scale, ev, jump
 
     def _keep_sticking_step(self, slipping) -> bool:
-        """Whether a full step that overshoots is kept all the same: once per pass, where it turns
-        slipping nodes to stick (`slipping`: before the step). The slip tangent has no stiffness
-        along the slip, so a step that shortens a node's slip meets the stick stiffness k_t that
-        the tangent did not hold: a kink of the friction law. Cut back by the line search, the step
-        stays on the slipping side of the kink, and Newton crept there by 10 % per iteration (the
-        2,450-cell aluminium cup from a restart at 30 mm: 88 iterations in 0.72 mm, 47 with the
-        full step kept; docs/performance.md). Past the kink the stick tangent is exact."""
+        """With stick_step (opt-in): whether a full step that overshoots is kept all the same, once
+        per pass, where it turns slipping nodes to stick (`slipping`: before the step). The slip
+        tangent has no stiffness along the slip, so a step that shortens a node's slip meets the
+        stick stiffness k_t that the tangent did not hold: a kink of the friction law. Cut back by
+        the line search, the step stays on the slipping side of the kink, and Newton crept there
+        by 10 % per iteration (the 2,450-cell aluminium cup restarted at 30 mm: 88 iterations in
+        0.72 mm, 47 with the full step kept). Past the kink the stick tangent is exact. Not the
+        default: on the paper's cup it costs iterations and cut-backs (docs/contact.md)."""
         if not self.contact.stick_step or self._kept:
             return False
         stuck = self.model.mesh.comm.allreduce(int(np.sum(slipping & ~self._slipping)), op=MPI.SUM)
