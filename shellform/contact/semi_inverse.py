@@ -43,14 +43,18 @@ of one pass at a time. The first iterate of a pass keeps the p of the pass befor
 with Aitken's factor. Passes remain for the contact set: they repeat until it holds, and a pass
 ends as soon as the set will change (early_set, once Newton's steps are below `early_step`
 penetrations). A node moving along a curved tool turns its frame; the tangent carries that too
-(tool_curvature: K_ab += -R0 W_ab, W the tool's shape operator). With the three, Newton's tails are quadratic again, and the NUMISHEET'93 cup needs
-771 iterations where it needed 1744 (docs/performance.md).
+(tool_curvature: K_ab += -R0 W_ab, W the tool's shape operator). With the three, Newton's tails
+are quadratic again where no layer or node crosses a kink (elastic-plastic, stick-slip) along
+the step, and the NUMISHEET'93 cup needs 771 iterations where it needed 1744
+(docs/performance.md). A pass starts from the element arrays of the last iterate, turned into
+its new frames (the carrier has not moved).
 
 Newton is globalised: each correction is first limited so that no node moves by more than
 `trust` thicknesses, then a line search on the energy slope dq . R(q + alpha dq) shortens it
-where it overshoots (with stick_step, not by default: except once per pass where the full step
-turns slipping nodes to stick, the friction law's kink, which the slip tangent cannot see). The contact set is settled between passes: nodes that penetrate a tool by
-more than `penetration` join it, nodes (not pinched) whose normal force turned tensile leave it;
+where it overshoots (with stick_step, opt-in: except once per pass where the full step turns
+slipping nodes to stick, the friction law's kink, which the slip tangent cannot see). The
+contact set is settled between passes: nodes that penetrate a tool by more than `penetration`
+join it, nodes (not pinched) whose normal force turned tensile leave it;
 a node may switch at most `max_toggles` times per increment (no chattering).
 """
 
@@ -461,8 +465,9 @@ class SemiInverseDriver(Driver):
         self._array_frames = (self.rotated.copy(), self.frames.copy())
 
     def _reframe_element_arrays(self, tangent):
-        """From the frames F0 the arrays were turned into to today's F: T = F F0^T on every block
-        turned in either (F0 = I on a block that was not turned; orthogonal, so exact to round-off)."""
+        """From the frames F0 the arrays were turned into to the current F: T = F F0^T on every
+        block turned in either (F0 = I on a block that was not turned; orthogonal, so exact to
+        round-off)."""
         m = self.model
         rotated0, F0 = self._array_frames
         turn = rotated0 | self.rotated
