@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import basix.ufl
 import numpy as np
 
+from shellform.assembly import slope_map
 from shellform.elements import reduced_cubic
 
 GROUPS = ("membrane", "bending")  # order of the element-local fields
@@ -136,23 +137,18 @@ class HybridElement:
         for v in range(3):
             if "u" in self.offsets and self.cubic_membrane:
                 for c, name in enumerate("uv"):  # blocked reduced cubic: dof 2 j + c, j = 3 v + k
-                    r = row[self.offsets["u"].start + 2 * (3 * v) + c]
-                    cols[r, 0], codes[r, 0] = bs * v + self.component(name), 1
-                    for i in range(2):
-                        r = row[self.offsets["u"].start + 2 * (3 * v + 1 + i) + c]
-                        for j in range(2):
-                            cols[r, j], codes[r, j] = bs * v + self.component(f"{name}_{'xy'[j]}"), 2 + 2 * j + i
+                    rows = [row[self.offsets["u"].start + 2 * (3 * v + k) + c] for k in range(3)]
+                    slope_map.cubic_vertex_rows(cols, codes, rows, bs * v + self.component(name),
+                                                [bs * v + self.component(f"{name}_{x}") for x in "xy"])
             elif "u" in self.offsets:
                 for i in range(2):  # blocked P1: node-major, component-minor
                     r = row[self.offsets["u"].start + 2 * v + i]
                     cols[r, 0], codes[r, 0] = bs * v + self.component("u") + i, 1
             if "w" in self.offsets:
-                r = row[self.offsets["w"].start + 3 * v]
-                cols[r, 0], codes[r, 0] = bs * v + self.component("w"), 1
+                rows = [row[self.offsets["w"].start + 3 * v + k] for k in range(3)]
+                slope_map.cubic_vertex_rows(cols, codes, rows, bs * v + self.component("w"),
+                                            [bs * v + self.component("w_x") + j for j in range(2)])
                 for i in range(2):
-                    r = row[self.offsets["w"].start + 3 * v + 1 + i]
-                    for j in range(2):
-                        cols[r, j], codes[r, j] = bs * v + self.component("w_x") + j, 2 + 2 * j + i
                     r = row[self.offsets["g"].start + 2 * v + i]
                     cols[r, 0], codes[r, 0] = bs * v + self.component("w_x") + i, 1
         return cols, codes

@@ -30,6 +30,7 @@ import basix.ufl
 import numpy as np
 
 from shellform.assembly.hybrid_element import HybridElement
+from shellform.assembly import slope_map
 from shellform.elements import reduced_cubic
 from shellform import _jit as jit
 
@@ -71,12 +72,8 @@ class SheetElement:
         codes = np.zeros((27, 2), dtype=np.int32)
         for v in range(3):
             for c in range(3):
-                r = 3 * (3 * v) + c
-                cols[r, 0], codes[r, 0] = BS * v + c, 1
-                for i in range(2):  # d/dX_i = sum_j J[j, i] d/dx_j
-                    r = 3 * (3 * v + 1 + i) + c
-                    for j in range(2):
-                        cols[r, j], codes[r, j] = BS * v + slope_column(c, j), 2 + 2 * j + i
+                slope_map.cubic_vertex_rows(cols, codes, [3 * (3 * v + k) + c for k in range(3)], BS * v + c,
+                                            [BS * v + slope_column(c, j) for j in range(2)])
         return cols, codes
 
     @staticmethod

@@ -16,6 +16,16 @@ import numpy as np
 from shellform import _jit as jit
 
 
+def cubic_vertex_rows(cols, codes, rows, value_col, slope_cols) -> None:
+    """Write one vertex of a reduced cubic into the tables: rows = (value, d/dX, d/dY) rows of
+    q_ref, value_col the carrier column of the value, slope_cols = (d/dx, d/dy) columns. The
+    reference slopes are d/dX_i = sum_j J[j, i] d/dx_j: code 2 + 2 j + i."""
+    cols[rows[0], 0], codes[rows[0], 0] = value_col, 1
+    for i in range(2):
+        for j in range(2):
+            cols[rows[1 + i], j], codes[rows[1 + i], j] = slope_cols[j], 2 + 2 * j + i
+
+
 @jit.njit
 def jacobian(coords):
     """J[a, b] = dx_a/dX_b from coordinate_dofs (3 nodes x 3, flattened) of an affine triangle."""
