@@ -10,6 +10,7 @@ from shellform.material import (
     Hill79Material, elastic_section, equivalent_stress, flow_stress, point, return_map,
     section_response, thickness_strain, through_thickness_rule, yield_derivatives,
 )
+from shellform.material.hill79 import _return_core
 
 E, NU, SY = 200e3, 0.3, 250.0
 EY = SY / E
@@ -179,6 +180,47 @@ def test_newton_converges_equibiaxial_m15(r):
             check_closest_point(e, mat, np.zeros(3), 0.0, s, ep, p)
         s, _, _, p, status = rmap(mult * EY * np.array([1.0, 1.0 + 1e-6, 1e-7]), mat)  # near it
         assert status == 1 and equivalent_stress(s, r, 1.5) == pytest.approx(SY, rel=1e-11)
+
+
+@pytest.mark.parametrize("m", [1.5, 2.0, 8.0])
+@pytest.mark.parametrize("law", [perfect, swift])
+def test_warm_start_returns_the_cold_solution(m, law):
+    """The return map started from the point's last solution (Newton's last iterate, the strain
+    moved since by up to 30 %) or from a misleading one (falls back to the radial start) gives
+    the cold start's stress, tangent and plastic strain to the local tolerance."""
+    mat = law(m, 1.5)
+    ey = flow_stress(0.0, mat)[0] / E
+    ep_n, p_n = np.array([0.003, -0.001, 0.002]), 0.004
+    rng = np.random.default_rng(1)
+    for d in DIRECTIONS:
+        e0 = ep_n + 3 * ey * np.array(d) / np.linalg.norm(d)
+        last = _return_core(*e0, *ep_n, p_n, mat)
+        assert last[-1] == 1
+        for e in (e0 * (1 + 1e-6), e0 + 0.3 * 3 * ey * rng.standard_normal(3)):
+            cold = np.array(_return_core(*e, *ep_n, p_n, mat))
+            if cold[-1] != 1:
+                continue
+            for w0, w1, w2, p_w in (last[9:13], (*(ep_n + 0.1 * rng.standard_normal(3)), p_n + 0.5)):
+                warm = np.array(_return_core(*e, *ep_n, p_n, mat, w0, w1, w2, p_w))
+                assert warm[-1] == 1
+                np.testing.assert_allclose(warm[:3], cold[:3], rtol=0, atol=1e-10 * np.abs(cold[:3]).max())
+                np.testing.assert_allclose(warm[3:9], cold[3:9], rtol=0, atol=1e-8 * E)
+                np.testing.assert_allclose(warm[9:13], cold[9:13], rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("r", RS)
+def test_hill48_closed_form_equals_the_general_one(r):
+    """m = 2 takes a branch without powers: sigma_bar, gradient and Hessian match the general
+    expressions at m = 2 (1 + 1e-12)."""
+    rng = np.random.default_rng(2)
+    for s in rng.standard_normal((20, 3)) * SY:
+        a, H, a1, H1 = np.zeros(3), np.zeros((3, 3)), np.zeros(3), np.zeros((3, 3))
+        sb = yield_derivatives(s, r, 2.0, a, H)
+        sb1 = yield_derivatives(s, r, 2.0 * (1 + 1e-12), a1, H1)
+        assert sb == pytest.approx(sb1, rel=1e-10)
+        assert equivalent_stress(s, r, 2.0) == pytest.approx(sb, rel=1e-14)
+        np.testing.assert_allclose(a, a1, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(H, H1, rtol=0, atol=1e-10 * np.abs(H).max())
 
 
 @pytest.mark.parametrize("m", [1.5, 2.0, 8.0])
@@ -371,3 +413,26 @@ def test_pack_layout():
     np.testing.assert_array_equal(mat, [E, NU, 1.5, 6.0, 2.0, 500.0, 0.01, 0.2])
     assert mat.dtype == np.float64
     np.testing.assert_array_equal(power(2.0, 1.0, 4.0)[4:7], [1.0, SY, 4.0])
+
+
+def test_strain_guard_counts_and_skips_unphysical_points():
+    """section_update leaves a point whose strain is not finite or past 1000 % untouched (its
+    resultants those of zero strain, its layers' state as it was) and counts it."""
+    from shellform.material.update import section_update
+
+    mat = swift(2.0, 1.5)
+    zeta, wz = through_thickness_rule(3)
+    e = np.zeros((3, 1, 6))
+    e[0, 0, 1] = np.nan
+    e[1, 0, 5] = 20.0 / 0.8  # curvature 25 / mm at t = 0.8: 2000 % at the faces
+    e[2, 0, 0] = 3 * SY / E  # a real, plastic point
+    ep_n, p_n = np.zeros((3, 1, 3, 3)), np.zeros((3, 1, 3))
+    ep, p = np.full_like(ep_n, 7.0), np.full_like(p_n, 7.0)
+    S, D = np.full((3, 1, 6), np.nan), np.full((3, 1, 6, 6), np.nan)
+    nplastic, nfail, nguard = section_update(e, mat, 0.8, True, False, zeta, wz, ep_n, p_n, np.ones((3, 1)), ep, p,
+                                             np.ones((3, 1)), S, D)
+    assert (nplastic, nfail, nguard) == (3, 0, 2)
+    assert np.all(S[:2] == 0.0) and np.all(np.isfinite(D))
+    assert np.all(ep[:2] == 7.0) and np.all(p[:2] == 7.0)
+    # the plastic point, warm-started from a misleading state (7.0), flows at the flow stress
+    assert np.all(p[2] > 0) and S[2, 0, 0] / 0.8 > flow_stress(0.0, mat)[0]

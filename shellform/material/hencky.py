@@ -25,11 +25,17 @@ tangent as dS/dE = P^T (dT/deps) P + L(T) (docs/material.md).
 """
 
 import math
+
+import numpy as np
+
 from shellform import _jit as jit
 
 
 SERIES_BELOW = 0.1  # x below which h, h', h'' are summed as power series
 SERIES_TERMS = 24  # 0.1^24: below rounding
+SERIES_END = 1e-17  # ... or fewer: the sum ends once x^k is below rounding
+_K = np.arange(SERIES_TERMS, dtype=np.float64)
+H0, H1, H2 = 1.0 / (2 * _K + 1), (_K + 1) / (2 * _K + 3), (_K + 2) * (_K + 1) / (2 * _K + 5)  # c_k, (k+1) c_k+1, ...
 
 
 @jit.njit
@@ -39,10 +45,12 @@ def _h(x):
         h = h1 = h2 = 0.0
         xk = 1.0  # x^k
         for k in range(SERIES_TERMS):
-            h += xk / (2 * k + 1)
-            h1 += (k + 1) * xk / (2 * k + 3)
-            h2 += (k + 2) * (k + 1) * xk / (2 * k + 5)
+            h += xk * H0[k]
+            h1 += xk * H1[k]
+            h2 += xk * H2[k]
             xk *= x
+            if xk < SERIES_END:
+                break
         return h, h1, h2
     if not x < 1.0:  # not reached: log_strain checks u^2 > q
         return math.inf, math.inf, math.inf

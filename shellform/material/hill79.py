@@ -56,6 +56,8 @@ def _sbar(s0, s1, s2, r, m):
     if not S2 > 0.0:
         return 0.0
     x, y = X / S2, Y / S2
+    if m == 2.0:  # Hill 1948's normal anisotropy: no powers
+        return math.sqrt(S2 * (x + (1.0 + 2.0 * r) * 4.0 * y) / (2.0 * (1.0 + r)))
     return math.sqrt(S2) * ((x ** (0.5 * m) + (1.0 + 2.0 * r) * 2.0**m * y ** (0.5 * m))
                             / (2.0 * (1.0 + r))) ** (1.0 / m)
 
@@ -81,12 +83,18 @@ def _hill(s0, s1, s2, r, m):
     X, Y = x * S2, y * S2
     hm = 0.5 * m
     alpha = 0.5 / (1.0 + r)
-    c = (1.0 + 2.0 * r) * 2.0**m
-    xa = x**hm
-    yb = y**hm
-    ph = (alpha * (xa + c * yb)) ** (1.0 / m)
+    if m == 2.0:  # Hill 1948's normal anisotropy: phi = sqrt(alpha (x + 4 (1 + 2r) y)), no powers
+        c = (1.0 + 2.0 * r) * 4.0
+        xa, yb = x, y
+        ph = math.sqrt(alpha * (xa + c * yb))
+        g = 1.0 / (ph * 2.0 * S)
+    else:
+        c = (1.0 + 2.0 * r) * 2.0**m
+        xa = x**hm
+        yb = y**hm
+        ph = (alpha * (xa + c * yb)) ** (1.0 / m)
+        g = ph ** (1.0 - m) / (2.0 * S)
     sb = S * ph
-    g = ph ** (1.0 - m) / (2.0 * S)
     fX = alpha * (xa / x) * g
     fY = alpha * c * (yb / y) * g
     fXX = (1.0 - m) * fX * fX / sb + (hm - 1.0) * fX / X
@@ -161,9 +169,15 @@ def _residual(s0, s1, s2, mu, g0, g1, g2, p_n, k, mat):
 
 
 @jit.njit
-def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat):
+def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat, w0=0.0, w1=0.0, w2=0.0, p_w=-1.0):
     """Return map on scalars. Returns (s0, s1, s2, D00, D01, D02, D11, D12, D22, ep0, ep1, ep2,
-    p_new, status); on failure (status -1) the elastic trial state."""
+    p_new, status); on failure (status -1) the elastic trial state.
+
+    (w0, w1, w2, p_w): a warm start, the plastic strain and p of this point's last solution in
+    the same increment (Newton's last iterate); used where it flowed (p_w > p_n). The local
+    Newton then starts from s = C (e - ep_w), dlambda = p_w - p_n, the exact solution if the
+    plastic strain did not change since, and converges in one or two steps where the radial
+    start needs four to six. Where it does not converge the radial start is tried."""
     E, nu, r, m = mat[E_], mat[NU_], mat[R_], mat[M_]
     ee0, ee1, ee2 = e0 - q0, e1 - q1, e2 - q2
     cE = E / (1.0 - nu * nu)
@@ -180,14 +194,32 @@ def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat):
         if math.isfinite(sbt):
             return elastic + (0,)
         return elastic + (-1,)
-    # scaled unknowns: s^ = s/k from the trial stress put radially onto the yield surface
     g0, g1, g2 = ee0 * E / k, ee1 * E / k, ee2 * E / k
+    if p_w > p_n:  # warm: scaled s^ = C (e - ep_w) / k, mu = E dlambda / k
+        v0, v1, v2 = e0 - w0, e1 - w1, e2 - w2
+        res = _local_newton((C00 * v0 + C01 * v1) / k, (C01 * v0 + C00 * v1) / k, C22 * v2 / k,
+                            E * (p_w - p_n) / k, g0, g1, g2, p_n, k, mat)
+        if res[0]:
+            return _closed(res, e0, e1, e2, p_n, k, mat, elastic)
+    # scaled unknowns: s^ = s/k from the trial stress put radially onto the yield surface
     s0, s1, s2 = t0 / sbt, t1 / sbt, t2 / sbt
     _, a0, a1, a2, _, _, _, _, _, _ = _hill(s0, s1, s2, r, m)
-    w0 = g0 - (s0 - nu * s1)
-    w1 = g1 - (s1 - nu * s0)
-    w2 = g2 - 2.0 * (1.0 + nu) * s2
-    mu = max(0.0, (a0 * w0 + a1 * w1 + a2 * w2) / (a0 * a0 + a1 * a1 + a2 * a2))
+    v0 = g0 - (s0 - nu * s1)
+    v1 = g1 - (s1 - nu * s0)
+    v2 = g2 - 2.0 * (1.0 + nu) * s2
+    mu = max(0.0, (a0 * v0 + a1 * v1 + a2 * v2) / (a0 * a0 + a1 * a1 + a2 * a2))
+    res = _local_newton(s0, s1, s2, mu, g0, g1, g2, p_n, k, mat)
+    if not res[0]:
+        return elastic + (-1,)
+    return _closed(res, e0, e1, e2, p_n, k, mat, elastic)
+
+
+@jit.njit
+def _local_newton(s0, s1, s2, mu, g0, g1, g2, p_n, k, mat):
+    """The closest-point equations in scaled unknowns (s^, mu) by Newton with a line search on
+    |R| from the given start. Returns (converged, s0, s1, s2, mu, a0, a1, a2, h00, h01, h02,
+    h11, h12, h22, hs) at the last iterate."""
+    E, nu = mat[E_], mat[NU_]
     tol = TOL * (1.0 + math.sqrt(g0 * g0 + g1 * g1 + g2 * g2))
     Rn, R0, R1, R2, Rf, a0, a1, a2, h00, h01, h02, h11, h12, h22, hs = _residual(
         s0, s1, s2, mu, g0, g1, g2, p_n, k, mat)
@@ -235,8 +267,16 @@ def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat):
         Rn, R0, R1, R2, Rf, a0, a1, a2, h00, h01, h02, h11, h12, h22, hs = res
     else:
         ok = Rn <= tol
-    if not ok:
-        return elastic + (-1,)
+    return ok, s0, s1, s2, mu, a0, a1, a2, h00, h01, h02, h11, h12, h22, hs
+
+
+@jit.njit
+def _closed(res, e0, e1, e2, p_n, k, mat, elastic):
+    """The outputs of _return_core from a converged local Newton `res` (status 1), or the
+    elastic trial state with status -1 where any is not finite."""
+    E, nu = mat[E_], mat[NU_]
+    c22 = 2.0 * (1.0 + nu)
+    _, s0, s1, s2, mu, a0, a1, a2, h00, h01, h02, h11, h12, h22, hs = res
     # consistent tangent D = E [X - (X a)(X a)^T / (a^T X a + H'/E)], X = (E C^-1 + mu H)^-1
     i00, i01, i02, i11, i12, i22 = _inv3(1.0 + mu * h00, -nu + mu * h01, mu * h02,
                                          1.0 + mu * h11, mu * h12, c22 + mu * h22)

@@ -31,9 +31,10 @@ def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 @jit.njit
-def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
+def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, p_w, w):
     """One layer at section strain e = (E11, E22, 2 E12): stress s conjugate to e, tangent Dt,
-    new plastic strain; returns (p_new, status, e33). w: scratch (3, 16).
+    new plastic strain; returns (p_new, status, e33). w: scratch (3, 16). ep_new and p_w hold
+    the layer's last solution on entry (the return map's warm start, hill79._return_core).
     Small strain: the return mapping on e. Finite strain: on the Hencky strain eps(e), then
     s = P^T T and Dt = P^T (dT/deps) P + L(T) (shellform.material.hencky). e33 is the layer's
     thickness strain, logarithmic when finite. elastic_tangent: dT/deps is the elastic C
@@ -46,7 +47,7 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
     else:
         eps[:] = e
     (t0, t1, t2, d00, d01, d02, d11, d12, d22, q0, q1, q2, p, st) = _return_core(
-        eps[0], eps[1], eps[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat)
+        eps[0], eps[1], eps[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat, ep_new[0], ep_new[1], ep_new[2], p_w)
     ep_new[0], ep_new[1], ep_new[2] = q0, q1, q2
     nu = mat[NU_]
     if elastic_tangent:
@@ -73,10 +74,12 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, w):
 
 @jit.njit
 def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_tangent,
-                     S, D, ep_new, p_new):
+                     S, D, ep_new, p_new, w=None):
     """Resultants S = (N, M) (6) and section tangent D (6x6) of the layered section of initial
     thickness t whose layers sit at z = zeta * lever (lever: the current thickness, t at small
-    strain); writes the layers' new plastic strains ep_new (nz, 3) and p_new (nz,).
+    strain); writes the layers' new plastic strains ep_new (nz, 3) and p_new (nz,). On entry
+    these hold the layers' last solution in this increment, the return map's warm start (or
+    ep_n, p_n, or zeros: a cold start). w: scratch (4, 16), allocated here if None.
     Returns (number of plastic layers or -1 if any layer failed, mean thickness strain)."""
     for i in range(6):
         S[i] = 0.0
@@ -85,15 +88,15 @@ def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_
     nplastic = 0
     failed = False
     e33 = 0.0
-    s = np.zeros(3)
-    Dt = np.zeros((3, 3))
-    e = np.zeros(3)
-    w = np.zeros((3, 16))
+    if w is None:
+        w = np.zeros((4, 16))
+    s, e = w[3, :3], w[3, 3:6]
+    Dt = w[3, 6:15].reshape((3, 3))
     for i in range(zeta.shape[0]):
         z = zeta[i] * lever
         for a in range(3):
             e[a] = em[a] + z * k[a]
-        p, st, e33_i = _layer(e, ep_n[i], p_n[i], mat, finite, elastic_tangent, s, Dt, ep_new[i], w)
+        p, st, e33_i = _layer(e, ep_n[i], p_n[i], mat, finite, elastic_tangent, s, Dt, ep_new[i], p_new[i], w)
         p_new[i] = p
         e33 += wz[i] * e33_i
         if st < 0:

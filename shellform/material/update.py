@@ -30,19 +30,22 @@ def section_update(e, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, leve
                    S, D, elastic_tangent=False):
     nplastic, nfail, nguard = 0, 0, 0
     for c in numba.prange(e.shape[0]):  # cells are independent: threads share them
-        Sg = np.zeros(6)
-        Dg = np.zeros((6, 6))
+        w = np.zeros((4, 16))  # scratch, once per cell
+        zero = np.zeros(3)
         for g in range(e.shape[1]):
-            em = e[c, g, :3].copy()
-            k = e[c, g, 3:].copy()
-            size = max(np.abs(em).max(), np.abs(k).max() * thickness)
-            if not np.isfinite(size) or size > 10.0:  # the strain guard: no material takes 1000 %
+            em, k = e[c, g, :3], e[c, g, 3:]
+            Sg, Dg = S[c, g], D[c, g]
+            size, real = 0.0, True  # real: every strain finite
+            for a in range(3):
+                size = max(size, abs(em[a]), abs(k[a]) * thickness)
+                real = real and math.isfinite(em[a]) and math.isfinite(k[a])
+            if not real or size > 10.0:  # the strain guard: no material takes 1000 %
                 nguard += 1
-                section.elastic_section(em * 0.0, k * 0.0, thickness, mat, Sg, Dg)
+                section.elastic_section(zero, zero, thickness, mat, Sg, Dg)
             elif plastic:
                 lever = thickness * lever_stretch[c, g] if finite else thickness
                 st, e33 = section.section_response(em, k, thickness, lever, zeta, wz, ep_n[c, g], p_n[c, g],
-                                                   mat, finite, elastic_tangent, Sg, Dg, ep[c, g], p[c, g])
+                                                   mat, finite, elastic_tangent, Sg, Dg, ep[c, g], p[c, g], w)
                 stretch[c, g] = math.exp(e33) if finite else 1.0
                 if st < 0:
                     nfail += 1
@@ -50,6 +53,4 @@ def section_update(e, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, leve
                     nplastic += st
             else:
                 section.elastic_section(em, k, thickness, mat, Sg, Dg)
-            S[c, g, :] = Sg
-            D[c, g, :, :] = Dg
     return nplastic, nfail, nguard
