@@ -13,7 +13,7 @@ carrier values with T(J) (slope_map). DOLFINx then assembles, applies boundary c
 lifts as for any form, in serial or MPI.
 
 The cfuncs are compiled at every start (they hold the addresses of this process's FFCx
-kernels); the numerical work they call is cached by numba. FFCx compiles at -O3.
+kernels); the numerical work they call is cached by numba. FFCx compiles at -O3 for this CPU.
 """
 
 from dataclasses import dataclass
@@ -42,7 +42,7 @@ try:  # the module moves in FFCx 0.12
 except ImportError:  # pragma: no cover
     from ffcx.codegeneration.numba.utils import numba_ufcx_kernel_signature
 
-JIT_OPTIONS = {"cffi_extra_compile_args": ["-O3", "-g0"]}  # FFCx's default is -O2
+JIT_OPTIONS = jit.FFCX_JIT_OPTIONS  # -O3 for this CPU, in a cache of its own (shellform._jit)
 _signature = numba_ufcx_kernel_signature(np.float64, np.float64)
 
 
