@@ -141,6 +141,7 @@ class Driver:
         self.searching = True  # the energy line search on; an increment that fails swaps it once
         self._memo = None  # the last evaluation (_evaluate)
         self.evaluations = self.reused = 0  # of the element loops: run, and reused (a contact pass's first)
+        self.solves = 0  # linear solves: Newton iterations, those of failed attempts included
 
     # -- residual and tangent ----------------------------------------------------------------
     def _in_frames(self) -> np.ndarray:
@@ -203,6 +204,9 @@ class Driver:
             self.reused += 1
             return replace(memo["ev"], element_s=0.0, constitutive_s=0.0)
         ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
+        if m.mesh.comm.size > 1:  # every rank takes the same branch on a failed update: global counts
+            counts = m.mesh.comm.allreduce(np.array([ev.plastic_layers, ev.failures, ev.guard]), op=MPI.SUM)
+            ev = replace(ev, plastic_layers=int(counts[0]), failures=int(counts[1]), guard=int(counts[2]))
         self.evaluations += 1
         self._element_arrays(tangent)
         self._memo = {"version": m.state_version, "tangent": tangent, "elastic": elastic_tangent, "q": q.copy(),
@@ -283,11 +287,12 @@ class Driver:
 
     def _linear_solve(self, out, t0) -> bool:
         self.ksp.solve(self.b, out.x.petsc_vec)
+        self.solves += 1
         self.times["solve_s"] += time.perf_counter() - t0
         if self.ksp.getConvergedReason() < 0:
             return False
         out.x.scatter_forward()
-        return bool(np.all(np.isfinite(out.x.array)))
+        return bool(self.model.mesh.comm.allreduce(bool(np.all(np.isfinite(out.x.array))), op=MPI.LAND))
 
     # -- one increment -------------------------------------------------------------------------
     def _newton(self, lam, reversal=False):
@@ -303,7 +308,7 @@ class Driver:
                 return False, it, residuals, ev
             if norm <= c.rtol * scale and jump == 0:
                 return True, it - 1, residuals, ev
-            if step <= c.stol * np.abs(self.q.x.array).max() and norm <= 1e3 * c.rtol * scale:
+            if step <= c.stol * self._largest(self.q.x.array) and norm <= 1e3 * c.rtol * scale:
                 return True, it - 1, residuals, ev
             R0 = self.b.copy()
             ok = self._solve(jump)
@@ -341,12 +346,16 @@ class Driver:
                 trial, scale, ev = self.residual(lam, tangent=True)
             jump = 0.0
             norm = trial
-            step = alpha * np.abs(self.dq.x.array).max()
+            step = alpha * self._largest(self.dq.x.array)
             residuals.append(norm)
         converged = np.isfinite(norm) and norm <= c.rtol * scale
         if not converged:
             self._cause = f"no convergence in {c.max_iterations} iterations"
         return converged, c.max_iterations, residuals, ev
+
+    def _largest(self, x: np.ndarray) -> float:
+        """max |x| over all ranks (a decision every rank must take alike)."""
+        return self.model.mesh.comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
 
     def _predict(self, dlam, x_n, x_prev):
         if self.controls.predictor and self._dlam_prev:

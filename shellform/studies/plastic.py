@@ -80,6 +80,7 @@ def solve(n, thickness_points=5, r=1.0, m=2.0) -> dict:
             "P_max_over_PL": P.max() / PL, "P_max_over_PL_discrete": P.max() / PLd,
             "rel_error": P.max() / PL - 1.0, "residual_deflection_error": abs(P_after) / P.max(),
             "increments": len(d.history), "iterations": sum(i.iterations for i in d.history),
+            "plastic_layers": max(i.plastic_layers for i in d.history),
             "compile_s": compile_s, **d.times, "total_s": time.perf_counter() - t0}
 
 
