@@ -79,7 +79,8 @@ W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
 @dataclass
 class ContactControls:
     penetration: float  # a free node may penetrate a tool by at most this much (length)
-    max_passes: int = 12  # contact passes (set and normal-force updates) per increment
+    max_passes: int = 12  # contact passes per increment, not counting those that only move the contact front
+    max_front_passes: int = 60  # ... and all passes, front ones included (a front crosses a row of nodes per pass)
     max_toggles: int = 2  # switches of one node (or of the holder) per increment before it is frozen
     gap_tol: float = 0.0  # |known corrections| at convergence (0: 1e-3 penetration)
     stick_stiffness: float = 0.01  # k_t = stick_stiffness E A_i / h (module docstring)
@@ -618,8 +619,8 @@ class SemiInverseDriver(Driver):
         self.pass_residuals = []  # |R| of every iterate, one list per pass (this increment)
         self._r_prev, self._omega = None, 1.0  # Aitken's memory of the normal-force updates
         iterations, residuals, ev = 0, [], None
-        changes, dp = 0, 0.0
-        for _ in range(self.contact.max_passes):
+        changes, dp, counted = 0, 0.0, 0
+        while counted < self.contact.max_passes and self._passes < self.contact.max_front_passes:
             self._passes += 1
             ok, its, res, ev = self._newton_fixed_set(lam)
             iterations += its
@@ -628,14 +629,15 @@ class SemiInverseDriver(Driver):
             if not ok:
                 return False, iterations, residuals, ev
             early, self._early = self._early, False
-            changes, dp, pn = self._update_pass(lam)
+            changes, dp, pn, front = self._update_pass(lam)
+            counted += not front
             if self.contact.trace:
                 say(f"    pass {self._passes}: {its} iterations, |R| {res[0]:.3e} -> {res[-1]:.3e}, {changes} set "
                     f"changes, friction change |mu dp| {dp:.3e} of |mu p| {pn:.3e}")
             self._changes += changes
             if changes == 0 and dp <= self.contact.friction_rtol * pn and not early:
                 return True, iterations, residuals, ev
-        self._cause = (f"the contact did not settle in {self.contact.max_passes} passes (last pass: {changes} "
+        self._cause = (f"the contact did not settle in {self._passes} passes (last pass: {changes} "
                        f"set changes, friction change {dp:.3g} N)")
         return False, iterations, residuals, ev
 
@@ -815,7 +817,11 @@ class SemiInverseDriver(Driver):
     def _update_pass(self, lam):
         """After a converged pass: normal forces from the reactions, the holder's faces, release
         of tensile nodes (not pinched), join of penetrating ones. Returns (set changes on all
-        ranks, |mu dp|, |mu p|)."""
+        ranks, |mu dp|, |mu p|, front): front where the set changed and every change was a
+        node's first switch in this increment, the holder unchanged. Such a pass moves the
+        contact front on (a sheet peeling off the punch's face releases one row of nodes per
+        pass: about 20 passes on 10,082 cells in the aluminium cup's first increment) and does
+        not count against max_passes; a node switching back does."""
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
         comm = self.model.mesh.comm
@@ -826,6 +832,7 @@ class SemiInverseDriver(Driver):
         if self.holder is not None:
             self._pinch(under, grow=True)
             changes = self._update_holder(x, under, net)
+        holder_changes = changes
         join, release, deepest = self._set_changes(x, lam, under, net, tensile=1e-8)
         s.tool[release] = FREE
         s.tool[join] = deepest[join]
@@ -837,10 +844,12 @@ class SemiInverseDriver(Driver):
         s.toggles[switched] += 1
         changes += int(switched.sum())
         self._frozen = int((s.toggles >= self.contact.max_toggles).sum())
-        changes = comm.allreduce(changes, op=MPI.SUM)
+        changes, back = comm.allreduce(np.array([changes, holder_changes + int((s.toggles[switched] > 1).sum())]),
+                                       op=MPI.SUM)
+        changes = int(changes)
         dp, pn = self._relax_normal(changes)
         self.times["contact_s"] += time.perf_counter() - t0
-        return changes, self.mu * dp, self.mu * pn
+        return changes, self.mu * dp, self.mu * pn, bool(changes > 0 and back == 0)
 
     def _relax_normal(self, changes):
         """The friction's normal force for the next pass from the faces' new sum p~: the fixed

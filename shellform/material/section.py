@@ -33,7 +33,7 @@ def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
 @jit.njit
 def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, p_w, w):
     """One layer at section strain e = (E11, E22, 2 E12): stress s conjugate to e, tangent Dt,
-    new plastic strain; returns (p_new, status, e33). w: scratch (3, 16). ep_new and p_w hold
+    new plastic strain; returns (p_new, status, e33). w: scratch, rows 0 to 2 (16 each). ep_new and p_w hold
     the layer's last solution on entry (the return map's warm start, hill79._return_core).
     Small strain: the return mapping on e. Finite strain: on the Hencky strain eps(e), then
     s = P^T T and Dt = P^T (dT/deps) P + L(T) (shellform.material.hencky). e33 is the layer's
