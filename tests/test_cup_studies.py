@@ -58,7 +58,7 @@ def test_cup_benchmark_short(tmp_path):
     (draw-in and force to 1e-6), the looser tolerance within 1e-4 of it in fewer iterations."""
     from shellform.studies import cup_benchmark
 
-    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_level=6, loose=(6, 1e-4))
+    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_levels=(6,), loose=(6, 1e-4))
     assert [(r["ranks"], r["cells"], r["rtol"]) for r in rows] == [(1, 72, 1e-6), (2, 72, 1e-6), (1, 72, 1e-4)]
     assert rows[2]["newton_iterations"] < rows[0]["newton_iterations"]
     for r in rows:
