@@ -3,7 +3,9 @@
 The element loop writes one vector (n) and one matrix (n x n) per owned cell. They reach
 DOLFINx as cell-wise (DG0) coefficients of two forms whose kernels copy the coefficient into
 the element tensor; DOLFINx then assembles, applies boundary conditions and communicates
-ghost contributions as for any form.
+ghost contributions as for any form. The arrays are handed to the assembler as the forms'
+packed coefficients (`coeffs`, `constants`): packing them anew copied every element matrix
+once more per assembly (16 ms at 10,082 cells, two or three times per Newton iteration).
 """
 
 import numba
@@ -48,6 +50,10 @@ class CellArrayForms:
                 self._kernels[size] = _copy_kernel(size)
         self.vector = self._form([V], self._kernels[n], self._vec_fn)
         self.matrix = self._form([V, V], self._kernels[n * n], self._mat_fn)
+        # packed as DOLFINx would pack them: one row per entity of the cell integral (self.cells)
+        self.vector_coeffs = {(IntegralType.cell, 0): self.vectors.reshape(ncells, n)}
+        self.matrix_coeffs = {(IntegralType.cell, 0): self.matrices.reshape(ncells, n * n)}
+        self.constants = np.zeros(0)
 
     def _form(self, spaces, kernel, coefficient):
         integrals = {IntegralType.cell: [(0, kernel.address, self.cells, np.array([0], dtype=np.int8))]}

@@ -163,7 +163,7 @@ class Driver:
         t0 = time.perf_counter()
         with self.b.localForm() as bl:
             bl.set(0.0)
-        fem_petsc.assemble_vector(self.b, m.forms.vector)
+        fem_petsc.assemble_vector(self.b, m.forms.vector, constants=m.forms.constants, coeffs=m.forms.vector_coeffs)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # scale of the residual: the element forces before they cancel in the sum (round-off)
         f_int = np.sqrt(m.mesh.comm.allreduce(float(np.sum(m.forms.vectors**2)), op=MPI.SUM))
@@ -171,7 +171,8 @@ class Driver:
         R = self.b.getArray(readonly=False)
         if tangent:
             self.A.zeroEntries()
-            fem_petsc.assemble_matrix(self.A, m.forms.matrix, bcs=self.bcs)
+            fem_petsc.assemble_matrix(self.A, m.forms.matrix, bcs=self.bcs, constants=m.forms.constants,
+                                      coeffs=m.forms.matrix_coeffs)
             self.A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
             self.A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
         if self.nodal is not None:
@@ -250,7 +251,7 @@ class Driver:
         m = self.model
         self._memo = None  # the element vectors are overwritten here
         m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, v[m.unrolled_dofs])
-        Kv = fem_petsc.assemble_vector(m.forms.vector)
+        Kv = fem_petsc.assemble_vector(m.forms.vector, constants=m.forms.constants, coeffs=m.forms.vector_coeffs)
         Kv.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         out = Kv.getArray(readonly=True).copy()
         Kv.destroy()
