@@ -38,8 +38,7 @@ class SpringbackDriver(Driver):
     def _set_dirichlet(self, lam, dofs=None):
         d = self.bc_dofs if dofs is None else dofs
         self.g[d] = self.held[d]
-        jump = np.abs(self.g[d] - self.q.x.array[d]).max() if d.size else 0.0
-        return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
+        return self._largest(self.g[d] - self.q.x.array[d])
 
 
 def release(contact_driver, controls: Controls | None = None, verbose=False) -> SpringbackDriver:

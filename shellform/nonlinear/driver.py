@@ -152,8 +152,7 @@ class Driver:
         """g = lam qbar on the Dirichlet dofs (or on `dofs`); returns the largest jump |g - q| there."""
         g, d = self.g, self.bc_dofs if dofs is None else dofs
         g[d] = lam * self.prescribed.x.array[d] if self.prescribed else 0.0
-        jump = np.abs(g[d] - self._in_frames()[d]).max() if d.size else 0.0
-        return self.model.mesh.comm.allreduce(float(jump), op=MPI.MAX)
+        return self._largest(g[d] - self._in_frames()[d])
 
     def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
         """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free|, scale, ev)."""
