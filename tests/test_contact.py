@@ -706,3 +706,20 @@ def test_passes_that_only_move_the_contact_front_are_not_counted():
     (passes, q, force), (passes2, q2, force2) = states
     assert passes2 == passes > 2
     assert force2 == force and np.array_equal(q2, q)
+
+
+def test_the_trace_names_every_node_that_switches(capsys):
+    """contact.trace logs each node that joins or leaves a tool, with its position and force:
+    in the aluminium cup's first increment (the blank peeling off the punch's face, the holder
+    closed throughout) one line per counted set change."""
+    s = scene.load(ROOT / "demos" / "numisheet93_aluminium.toml")
+    s.mesh.n = 16
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.contact.trace = True
+    p.driver.run(s.process.initial_step)
+    lines = capsys.readouterr().out.splitlines()
+    switches = [ln for ln in lines if " joins tool " in ln or " leaves tool " in ln]
+    h = p.driver.history[0].contact
+    assert h["holder_closed"] and h["set_changes"] > 0
+    assert len(switches) == h["set_changes"]
+    assert all("net normal force" in ln for ln in switches if " leaves tool " in ln)

@@ -93,7 +93,7 @@ class ContactControls:
     tool_curvature: bool = True  # the frames' turning on curved tools in the tangent
     consistent_friction: bool = True  # with refresh_normal: the slip force's dp/dq in the tangent
     holder_spread: str = "area"  # "area" or "rigid" (holder.py)
-    trace: bool = False  # log every pass, step and iterate (the nodes with the largest residual)
+    trace: bool = False  # log every pass, step and iterate (the nodes with the largest residual) and each node that switches
 
 
 class ContactState:
@@ -833,6 +833,11 @@ class SemiInverseDriver(Driver):
             changes = self._update_holder(x, under, net)
         holder_changes = changes
         join, release, deepest = self._set_changes(x, lam, under, net, tensile=1e-8)
+        if self.contact.trace:
+            for i in np.flatnonzero(release | join):
+                say(f"      node {i} at {self.X[i, :2].round(2)} -> {x[i].round(3)}: "
+                    + (f"leaves tool {s.tool[i]} (net normal force {net[i]:.3g} N)" if release[i] else
+                       f"joins tool {deepest[i]}") + f", switch {s.toggles[i] + 1}")
         s.tool[release] = FREE
         s.tool[join] = deepest[join]
         if self.holder is not None:
