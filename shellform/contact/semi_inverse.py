@@ -93,7 +93,7 @@ class ContactControls:
     tool_curvature: bool = True  # the frames' turning on curved tools in the tangent
     consistent_friction: bool = True  # with refresh_normal: the slip force's dp/dq in the tangent
     holder_spread: str = "area"  # "area" or "rigid" (holder.py)
-    trace: bool = False  # log every pass, step and iterate (the nodes with the largest residual) and each node that switches
+    trace: bool = False  # log every pass, step and iterate (the largest residuals) and each node that switches
 
 
 class ContactState:
