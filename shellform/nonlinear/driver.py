@@ -35,6 +35,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from shellform.errors import InputError
+from shellform.nonlinear.free_rows import FreeRowsLU, lu_solver
 from shellform.results.log import Progress
 
 
@@ -68,6 +69,7 @@ class Controls:
     cut: float = 0.25
     line_search: int = 6  # halvings
     predictor: bool = True
+    free_rows: bool = True  # factorise the free rows only (free_rows.py); False: the whole assembled matrix
 
     def check(self):
         for name in ("initial_step", "min_step", "max_step", "rtol"):
@@ -128,12 +130,10 @@ class Driver:
         self.A = fem_petsc.create_matrix(model.forms.matrix, kind="baij")
         self.b = fem_petsc.create_vector(V)
         self.dq = fem.Function(V)
-        self.ksp = PETSc.KSP().create(V.mesh.comm)
-        self.ksp.setOperators(self.A)
-        self.ksp.setType("preonly")
-        self.ksp.getPC().setType("lu")
-        self.ksp.getPC().setFactorSolverType("mumps")
-        self.ksp.setFromOptions()  # PETSc options (PETSC_OPTIONS, e.g. -mat_mumps_icntl_7 5) may refine these
+        self.ksp = lu_solver(self.A)  # PETSc options (PETSC_OPTIONS, e.g. -mat_mumps_icntl_7 5) may refine it
+        imap = V.dofmap.index_map
+        self.free_lu = FreeRowsLU(V.mesh.comm, imap.size_local * V.dofmap.index_map_bs,
+                                  imap.local_range[0] * V.dofmap.index_map_bs)
         self._dlam_prev = None
         self._direction = None
         self._floor = 0.0
@@ -286,10 +286,15 @@ class Driver:
         return self._linear_solve(out, t0)
 
     def _linear_solve(self, out, t0) -> bool:
-        self.ksp.solve(self.b, out.x.petsc_vec)
+        if self.controls.free_rows:
+            owned = self.free_lu.owned
+            ok = self.free_lu.solve(self.A, self.b, out.x.petsc_vec, self.bc_dofs[self.bc_dofs < owned])
+        else:
+            self.ksp.solve(self.b, out.x.petsc_vec)
+            ok = self.ksp.getConvergedReason() >= 0
         self.solves += 1
         self.times["solve_s"] += time.perf_counter() - t0
-        if self.ksp.getConvergedReason() < 0:
+        if not self.model.mesh.comm.allreduce(ok, op=MPI.LAND):
             return False
         out.x.scatter_forward()
         return bool(self.model.mesh.comm.allreduce(bool(np.all(np.isfinite(out.x.array))), op=MPI.LAND))

@@ -1,0 +1,94 @@
+"""The Newton system solved on its free rows only.
+
+DOLFINx assembles the tangent with the known (Dirichlet) rows and columns replaced by the
+identity, the known corrections lifted to the right-hand side:
+
+    [ K_ff  0 ] [dq_f]   [b_f]
+    [ 0     I ] [dq_k] = [b_k]        so  dq_k = b_k,  K_ff dq_f = b_f.
+
+MUMPS factorises the pattern it is given, and the assembled pattern still couples every known
+row to its neighbours (with explicit zeros). In the cup a third of the unknowns are known
+(the pinched flange's w and slopes, the nodes on the tools' normals, symmetry): factorising
+K_ff alone takes half the flops of the whole matrix (1.08e9 -> 5.1e8 on the 2,450-cell
+aluminium cup, docs/performance.md). K_ff is taken from the assembled matrix (a copy into AIJ,
+whose rows and columns can be picked one by one, then the submatrix). Its symbolic
+factorisation is kept until a row it eliminated turns free (a node leaves its tool): rows that
+become known meanwhile stay in K_ff as identity rows.
+"""
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+
+def lu_solver(A: PETSc.Mat) -> PETSc.KSP:
+    """A direct solve with MUMPS; PETSc options (PETSC_OPTIONS) may refine it."""
+    ksp = PETSc.KSP().create(A.getComm())
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    ksp.setFromOptions()
+    return ksp
+
+
+class FreeRowsLU:
+    """dq = K^-1 b for a tangent K whose known rows and columns are the identity.
+
+    owned: the number of owned scalar unknowns; first: the global index of the first one."""
+
+    GROWTH = 1.1  # known rows beyond the eliminated ones (a fraction of them) before they are eliminated too
+
+    def __init__(self, comm, owned: int, first: int):
+        self.comm, self.owned, self.first = comm, owned, first
+        self._known = None  # the owned known rows the factorisation is for
+        self._free = np.zeros(0, dtype=np.int32)
+        self._aij = self._sub = self._ksp = self._is = None
+        self._b = self._x = None
+        self.symbolic = 0  # symbolic factorisations (each change of the eliminated rows)
+
+    def _rows(self, known: np.ndarray) -> None:
+        """New free rows: a new submatrix and a new symbolic factorisation."""
+        for obj in (self._sub, self._ksp, self._is, self._b, self._x):
+            if obj is not None:
+                obj.destroy()
+        mask = np.ones(self.owned, dtype=bool)
+        mask[known] = False
+        self._known = known.copy()
+        self._free = np.flatnonzero(mask).astype(np.int32)
+        self._is = PETSc.IS().createGeneral(self._free + np.int32(self.first), comm=self.comm)
+        self._sub = self._ksp = None
+        self.symbolic += 1
+
+    def _stale(self, known: np.ndarray) -> bool:
+        """Whether the rows eliminated so far no longer fit: one of them is free now, or the
+        known rows have grown by more than GROWTH of them. Rows that became known since stay in
+        K_ff, identity rows that solve to their known value, and the symbolic factorisation
+        stays valid."""
+        if self._known is None:
+            return True
+        if known.size > self.GROWTH * max(self._known.size, 1):
+            return True
+        mask = np.zeros(self.owned, dtype=bool)
+        mask[known] = True
+        return not mask[self._known].all()
+
+    def solve(self, A: PETSc.Mat, b: PETSc.Vec, x: PETSc.Vec, known: np.ndarray) -> bool:
+        """x = A^-1 b with A assembled (its `known` owned rows, local indices, the identity);
+        False where the factorisation failed."""
+        if self.comm.allreduce(self._stale(known), op=MPI.LOR):  # every rank takes the new rows
+            self._rows(np.sort(known))
+        self._aij = A.convert("aij", self._aij if self._aij is not None else PETSc.Mat())
+        self._sub = self._aij.createSubMatrix(self._is, self._is, self._sub)
+        if self._ksp is None:
+            self._ksp = lu_solver(self._sub)
+            self._x, self._b = self._sub.createVecs()
+        else:
+            self._ksp.setOperators(self._sub)
+        rhs = b.getArray(readonly=True)
+        self._b.getArray()[:] = rhs[self._free]
+        self._ksp.solve(self._b, self._x)
+        out = x.getArray()
+        out[self._free] = self._x.getArray(readonly=True)
+        out[self._known] = rhs[self._known]
+        return self._ksp.getConvergedReason() >= 0
