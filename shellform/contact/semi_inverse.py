@@ -186,6 +186,7 @@ class SemiInverseDriver(Driver):
         self._early, self._step = False, np.inf  # a pass ended early; the last accepted step's largest move
         self._kept = False  # a full step kept for sticking nodes in this pass (_keep_sticking_step)
         self._dlift = 0.0  # the open holder's lift in this Newton iteration
+        self._stable_rows = np.zeros(0, dtype=np.int32)  # known rows the free-row solve takes out (_constraints)
         self._lift_fn = fem.Function(V)  # the unit lift of the open holder's nodes (known rows)
         self._slip_rows = None  # (coef, g) of the slip forces' dp/dq (_add_slip_pressure_tangent)
         self._lift_response = fem.Function(V)
@@ -370,6 +371,13 @@ class SemiInverseDriver(Driver):
         slopes = self.q.x.array.reshape(-1, BS)[:n_own, W_SLOPES]
         known[flat, W_SLOPES.start:W_SLOPES.stop] = -slopes[flat]
         flags[flat, W_SLOPES.start:W_SLOPES.stop] = 1.0
+        # the rows the free-row solve takes out: the flat flange's (w too where pinched) and the
+        # supports'; a node's normal on a punch or die switches too often (Driver._eliminable)
+        stable = np.zeros((n_own, BS), dtype=bool)
+        stable[flat, W_SLOPES] = True
+        stable[self.pinched, 2] = True
+        stable |= self.sym_all
+        self._stable_rows = np.flatnonzero(stable.ravel()).astype(np.int32)
         rub = np.flatnonzero((s.tool != FREE) | (s.normal > 0))
         self._rub = (rub, shift[rub], x, frames[rub])
         self._friction_forces()
@@ -459,6 +467,8 @@ class SemiInverseDriver(Driver):
         self.bc_dofs = np.unique(np.concatenate(dofs)).astype(np.int32) if dofs else np.zeros(0, np.int32)
 
     # -- Driver hooks -------------------------------------------------------------------------
+    def _eliminable(self):
+        return self._stable_rows
     def _element_arrays(self, tangent):
         m = self.model
         rotate_cell_arrays(m.dofs, self.rotated, self.frames, m.forms.vectors, m.forms.matrices, tangent)
