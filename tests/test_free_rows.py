@@ -68,3 +68,10 @@ def test_a_drawn_cup_takes_the_same_path_on_the_free_rows():
     assert its == its0
     assert np.abs(q - q0).max() <= 1e-10 * np.abs(q0).max()
     assert symbolic0 == 0 and 0 < symbolic < sum(its)
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="a serial count")
+def test_the_whole_matrix_is_factorised_where_few_rows_would_be_taken_out():
+    lu = FreeRowsLU(MPI.COMM_SELF, 100, 0)
+    assert lu.MIN_SHARE == 0.12
+    assert not lu.pays(np.arange(11)) and lu.pays(np.arange(12))
