@@ -468,7 +468,9 @@ class SemiInverseDriver(Driver):
 
     # -- Driver hooks -------------------------------------------------------------------------
     def _eliminable(self):
+        """The known rows the free-row solve takes out: those that stay known (_constraints)."""
         return self._stable_rows
+
     def _element_arrays(self, tangent):
         m = self.model
         rotate_cell_arrays(m.dofs, self.rotated, self.frames, m.forms.vectors, m.forms.matrices, tangent)

@@ -7,13 +7,15 @@ identity, the known corrections lifted to the right-hand side:
     [ 0     I ] [dq_k] = [b_k]        so  dq_k = b_k,  K_ff dq_f = b_f.
 
 MUMPS factorises the pattern it is given, and the assembled pattern still couples every known
-row to its neighbours (with explicit zeros). In the cup a third of the unknowns are known
+row to its neighbours (with explicit zeros). In the cup a quarter of the unknowns are known
 (the pinched flange's w and slopes, the nodes on the tools' normals, symmetry): factorising
 K_ff alone takes half the flops of the whole matrix (1.08e9 -> 5.1e8 on the 2,450-cell
 aluminium cup, docs/performance.md). K_ff is taken from the assembled matrix (a copy into AIJ,
-whose rows and columns can be picked one by one, then the submatrix). Its symbolic
-factorisation is kept until a row it eliminated turns free (a node leaves its tool): rows that
-become known meanwhile stay in K_ff as identity rows.
+whose rows and columns can be picked one by one, then the submatrix). The driver says which
+known rows may be taken out (the contact driver: those that stay known); the others stay in
+K_ff as identity rows, which solve to their known values. The symbolic factorisation is kept
+until a row taken out turns free, and where the rows to take out are too few to pay for the
+copies (MIN_SHARE) the whole matrix is factorised instead.
 """
 
 import numpy as np
@@ -40,31 +42,32 @@ class FreeRowsLU:
     GROWTH = 1.1  # known rows beyond the eliminated ones (a fraction of them) before they are eliminated too
     MIN_SHARE = 0.12  # below this share of the rows to take out, the whole matrix is factorised
 
-    def pays(self, eliminable: np.ndarray) -> bool:
-        """Whether taking these rows out pays for the copy, the submatrix and the symbolic
-        factorisations it costs: at least MIN_SHARE of all rows. Measured on the aluminium cup's
-        2,450 cells on 2 ranks: with the open holder late in the stroke only the flange's slopes
-        are known (about 9 % of the rows) and the free rows cost 33 to 49 ms more per iteration
-        than the whole matrix; with the pinched flange (15 to 24 %) they save 2 to 10 ms."""
-        counts = self.comm.allreduce(np.array([eliminable.size, self.owned]), op=MPI.SUM)
-        return counts[0] >= self.MIN_SHARE * counts[1]
-
     def __init__(self, comm, owned: int, first: int):
         self.comm, self.owned, self.first = comm, owned, first
-        self._known = None  # the owned known rows the factorisation is for
+        self._eliminated = None  # the owned known rows taken out of the factorised matrix
         self._free = np.zeros(0, dtype=np.int32)
         self._aij = self._sub = self._ksp = self._is = None
         self._b = self._x = None
         self.symbolic = 0  # symbolic factorisations (each change of the eliminated rows)
 
-    def _rows(self, known: np.ndarray) -> None:
-        """New free rows: a new submatrix and a new symbolic factorisation."""
+    def pays(self, eliminable: np.ndarray) -> bool:
+        """Whether taking these rows out pays for the copy, the submatrix and the symbolic
+        factorisations it costs: at least MIN_SHARE of all rows. Measured on the aluminium cup's
+        2,450 cells on 2 ranks, every known row taken out: once the holder had opened late in
+        the stroke, the free rows cost 33 to 49 ms more per iteration than the whole matrix (the
+        rows changed at every pass; only the flange's slopes, about 9 % of the rows, stay known
+        there); with the pinched flange (15 to 24 % of the rows) they saved 2 to 10 ms."""
+        counts = self.comm.allreduce(np.array([eliminable.size, self.owned]), op=MPI.SUM)
+        return counts[0] >= self.MIN_SHARE * counts[1]
+
+    def _rows(self, eliminated: np.ndarray) -> None:
+        """New rows taken out: a new submatrix and a new symbolic factorisation."""
         for obj in (self._sub, self._ksp, self._is, self._b, self._x):
             if obj is not None:
                 obj.destroy()
         mask = np.ones(self.owned, dtype=bool)
-        mask[known] = False
-        self._known = known.copy()
+        mask[eliminated] = False
+        self._eliminated = eliminated.copy()
         self._free = np.flatnonzero(mask).astype(np.int32)
         self._is = PETSc.IS().createGeneral(self._free + np.int32(self.first), comm=self.comm)
         self._sub = self._ksp = None
@@ -75,13 +78,13 @@ class FreeRowsLU:
         rows that may be eliminated have grown by more than GROWTH of them. Rows that became
         known since stay in K_ff, identity rows that solve to their known value, and the
         symbolic factorisation stays valid."""
-        if self._known is None:
+        if self._eliminated is None:
             return True
-        if eliminable.size > self.GROWTH * max(self._known.size, 1):
+        if eliminable.size > self.GROWTH * max(self._eliminated.size, 1):
             return True
         mask = np.zeros(self.owned, dtype=bool)
         mask[known] = True
-        return not mask[self._known].all()
+        return not mask[self._eliminated].all()
 
     def solve(self, A: PETSc.Mat, b: PETSc.Vec, x: PETSc.Vec, known: np.ndarray,
               eliminable: np.ndarray | None = None) -> bool:
@@ -93,7 +96,6 @@ class FreeRowsLU:
         stale = self._stale(known, eliminable)
         if self.comm.allreduce(stale, op=MPI.LOR):  # every rank takes the new rows
             self._rows(np.sort(eliminable))
-        rhs_known = known
         self._aij = A.convert("aij", self._aij if self._aij is not None else PETSc.Mat())
         self._sub = self._aij.createSubMatrix(self._is, self._is, self._sub)
         if self._ksp is None:
@@ -106,5 +108,5 @@ class FreeRowsLU:
         self._ksp.solve(self._b, self._x)
         out = x.getArray()
         out[self._free] = self._x.getArray(readonly=True)
-        out[rhs_known] = rhs[rhs_known]
+        out[known] = rhs[known]
         return self._ksp.getConvergedReason() >= 0
