@@ -24,7 +24,7 @@ and cup_benchmark.png: the iteration's split against cells, and the wall time ag
 
 Run one case alone (what the 2-rank line does under mpiexec):
 
-    python -m shellform.studies.cup_benchmark --n 35 --out DIR [--stroke MM] [--rtol 1e-4]
+    python -m shellform.studies.cup_benchmark --n 35 --out DIR [--stroke MM] [--rtol 1e-4] [--trace]
 """
 
 import argparse
@@ -69,11 +69,12 @@ def scene_for(n: int, stroke: float | None = None, rtol: float | None = None):
     return s
 
 
-def draw_one(n: int, out: Path, stroke: float | None = None, rtol: float | None = None) -> None:
-    """Draw one case into out (on however many ranks this process has)."""
+def draw_one(n: int, out: Path, stroke: float | None = None, rtol: float | None = None, trace: bool = False) -> None:
+    """Draw one case into out (on however many ranks this process has); trace: log every contact
+    pass, iterate and switching node."""
     from shellform.contact.run import run as run_cup
 
-    run_cup(scene_for(n, stroke, rtol), Path(out))
+    run_cup(scene_for(n, stroke, rtol), Path(out), trace=trace)
 
 
 def case_folder(out: Path, n: int, ranks: int, rtol: float | None = None) -> Path:
@@ -194,8 +195,9 @@ def main(argv=None) -> None:
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--stroke", type=float, default=None)
     parser.add_argument("--rtol", type=float, default=None, help="Newton's tolerance (default: the scene's)")
+    parser.add_argument("--trace", action="store_true", help="log every contact pass, iterate and switching node")
     args = parser.parse_args(argv)
-    draw_one(args.n, args.out, args.stroke, args.rtol)
+    draw_one(args.n, args.out, args.stroke, args.rtol, args.trace)
 
 
 if __name__ == "__main__":
