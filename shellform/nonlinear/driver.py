@@ -285,16 +285,18 @@ class Driver:
             del arr
         return self._linear_solve(out, t0)
 
-    def _eliminable(self) -> np.ndarray | None:
-        """The known owned rows the free-row solve may take out (None: all of them)."""
-        return None
+    def _known_rows(self) -> np.ndarray:
+        """The owned known (Dirichlet) rows, local indices."""
+        return self.bc_dofs[self.bc_dofs < self.free_lu.owned]
+
+    def _eliminable(self) -> np.ndarray:
+        """The known owned rows the free-row solve may take out (here: all of them)."""
+        return self._known_rows()
 
     def _linear_solve(self, out, t0) -> bool:
-        known = self.bc_dofs[self.bc_dofs < self.free_lu.owned]
         eliminable = self._eliminable()
-        eliminable = known if eliminable is None else eliminable
         if self.controls.free_rows and self.free_lu.pays(eliminable):
-            ok = self.free_lu.solve(self.A, self.b, out.x.petsc_vec, known, eliminable)
+            ok = self.free_lu.solve(self.A, self.b, out.x.petsc_vec, self._known_rows(), eliminable)
         else:
             self.ksp.solve(self.b, out.x.petsc_vec)
             ok = self.ksp.getConvergedReason() >= 0
