@@ -54,13 +54,17 @@ def test_numisheet_cost_short(tmp_path):
 @pytest.mark.mpi
 def test_cup_benchmark_short(tmp_path):
     """cup-benchmark on a 6 x 6 quarter mesh, 1 mm, on 1 and 2 ranks, with Newton's tolerance at
-    1e-6 and 1e-4: the split of an iteration adds up to its time, the two ranks draw the same cup
-    (draw-in and force to 1e-6), the looser tolerance within 1e-4 of it in fewer iterations."""
+    1e-6 and 1e-4, and on one core: the split of an iteration adds up to its time, the two ranks
+    draw the same cup (draw-in and force to 1e-6), the looser tolerance within 1e-4 of it in fewer
+    iterations, the one-core run (one thread) the same cup as the first row's to 1e-9."""
     from shellform.studies import cup_benchmark
 
-    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_levels=(6,), loose=(6, 1e-4))
+    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_levels=(6,), loose=(6, 1e-4),
+                             one_core=(6,))
     assert [(r["ranks"], r["cells"], r["rtol"]) for r in rows] == [(1, 72, 1e-6), (2, 72, 1e-6), (1, 72, 1e-4),
-                                                                  (2, 72, 1e-4)]
+                                                                  (2, 72, 1e-4), (1, 72, 1e-6)]
+    assert rows[4]["case"] == "n 6, one core" and rows[4]["threads"] == 1
+    assert rows[4]["newton_iterations"] == rows[0]["newton_iterations"]
     assert rows[2]["newton_iterations"] < rows[0]["newton_iterations"]
     for r in rows:
         assert r["finished"] and r["stroke_mm"] == pytest.approx(1.0)
@@ -69,7 +73,7 @@ def test_cup_benchmark_short(tmp_path):
         assert all(r[f"{p}_ms"] > 0 for p in cup_benchmark.PARTS) and 0 <= r["rest_share"] < 1
     assert (tmp_path / "cup_benchmark.png").stat().st_size > 0
     with open(tmp_path / "cup_benchmark.csv") as f:
-        assert len(list(csv.DictReader(f))) == 4
+        assert len(list(csv.DictReader(f))) == 5
     for rtol in (None, 1e-4):
         one, two = (json.loads((cup_benchmark.case_folder(tmp_path, 6, k, rtol) / "summary.json").read_text())
                     for k in (1, 2))
@@ -78,6 +82,10 @@ def test_cup_benchmark_short(tmp_path):
             for k in ("DX", "DY", "DD"):
                 assert b["draw_in_mm"][k] == pytest.approx(a["draw_in_mm"][k], rel=1e-6)
     one = json.loads((cup_benchmark.case_folder(tmp_path, 6, 1) / "summary.json").read_text())
+    alone = json.loads((cup_benchmark.case_folder(tmp_path, 6, 1, one_core=True) / "summary.json").read_text())
+    for a, b in zip(one["reports"], alone["reports"], strict=True):
+        assert b["punch_force_kN"] == pytest.approx(a["punch_force_kN"], rel=1e-9)
+        assert b["draw_in_mm"]["DX"] == pytest.approx(a["draw_in_mm"]["DX"], rel=1e-9)
     loose = json.loads((cup_benchmark.case_folder(tmp_path, 6, 1, 1e-4) / "summary.json").read_text())
     for a, b in zip(one["reports"], loose["reports"]):
         assert b["punch_force_kN"] == pytest.approx(a["punch_force_kN"], rel=1e-4)

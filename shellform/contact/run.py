@@ -163,7 +163,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
         else:
             sprung = cup.springback(outdir, p, s.title, before, released)
     summary = {
-        "title": s.title, "effects": list(s.effects), "ranks": comm.size,
+        "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
         "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],

@@ -86,7 +86,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
     p.driver.progress.close()
     d = p.driver
     summary = {
-        "title": s.title, "effects": list(s.effects), "ranks": comm.size,
+        "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global,
         "dofs": p.model.V.dofmap.index_map.size_global * 9, "reports": reports,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),

@@ -6,7 +6,9 @@ demos/numisheet93_aluminium.toml (every input stated there) at the scene's incre
 n x n quarter meshes, n = 21, 35 and 71: 882, 2,450 and 10,082 cells, about 900, 2,500 and
 10,000 elements. The runs go one after the other, so that each wall time is the run's own; the
 2,450 and 10,082-cell cups are drawn once more on 2 MPI ranks (mpiexec -n 2; each rank takes
-half the cores for its threads). The 882 and 2,450-cell cups are drawn to 40 mm; the 10,082-cell cup
+half the cores for its threads), and the 10,082-cell cup once more on one core (one rank, one
+thread: NUMBA_NUM_THREADS=1), the baseline against which the ranks' speed-up says how the MPI
+engine scales (one rank alone already runs its element and material loops on every core). The 882 and 2,450-cell cups are drawn to 40 mm; the 10,082-cell cup
 to 5 mm only (STROKES), a run of hours to 40 mm on a 2-core machine: its row gives the cost of
 an iteration at that size, not the time of the whole draw. The 2,450-cell cup is drawn once more
 with Newton's tolerance at 1e-4 (LOOSE) instead of the scene's 1e-6, on 1 and on 2 ranks (on 882
@@ -14,7 +16,7 @@ cells 1e-4 moves every reported quantity by under 1e-4, the mesh a hundred times
 docs/performance.md).
 
 Writes cup_benchmark.csv, one row per run:
-- ranks, Newton's rtol, cells, stroke, wall time, increments, Newton iterations, contact passes;
+- ranks, threads per rank, Newton's rtol, cells, stroke, wall time, increments, Newton iterations, contact passes;
 - one iteration's time in ms, split into the element loop, the constitutive update, the
   contact (frames, friction, set updates), DOLFINx assembly, the MUMPS solve and the rest
   (Python and other work between them), and the rest's share of the run;
@@ -44,10 +46,11 @@ LEVELS = (21, 35, 71)
 QUICK_LEVELS = (6,)
 STROKES = {71: 5.0}  # mm; the others to the scene's 40 mm
 MPI_LEVELS = (35, 71)  # the levels drawn once more on 2 ranks (issue 12's 2-rank target: the 10,000-cell cup)
+ONE_CORE = (71,)  # the levels drawn once more on one core (1 rank, 1 thread): the baseline of the ranks' speed-up
 LOOSE = (35, 1e-4)  # the level drawn once more with this Newton tolerance
 PARTS = ("element", "constitutive", "contact", "assembly", "solve")
 REPORTS = (15.0, 40.0)
-COLUMNS = ["case", "ranks", "rtol", "n", "cells", "stroke_mm", "finished", "wall_s", "increments", "newton_iterations",
+COLUMNS = ["case", "ranks", "threads", "rtol", "n", "cells", "stroke_mm", "finished", "wall_s", "increments", "newton_iterations",
            "contact_passes", "iteration_ms", *(f"{p}_ms" for p in PARTS), "rest_ms", "rest_share",
            *(f"{q}_{mm:g}" for mm in REPORTS for q in ("force", "DX", "DD", "thinning")), "stopped"]
 
@@ -77,18 +80,20 @@ def draw_one(n: int, out: Path, stroke: float | None = None, rtol: float | None 
     run_cup(scene_for(n, stroke, rtol), Path(out), trace=trace)
 
 
-def case_folder(out: Path, n: int, ranks: int, rtol: float | None = None) -> Path:
-    return Path(out) / (f"n_{n}" + (f"_ranks_{ranks}" if ranks > 1 else "") + (f"_rtol_{rtol:g}" if rtol else ""))
+def case_folder(out: Path, n: int, ranks: int, rtol: float | None = None, one_core: bool = False) -> Path:
+    return Path(out) / (f"n_{n}" + (f"_ranks_{ranks}" if ranks > 1 else "") + (f"_rtol_{rtol:g}" if rtol else "")
+                        + ("_one_core" if one_core else ""))
 
 
-def row(out: Path, n: int, ranks: int, rtol: float | None = None) -> dict:
+def row(out: Path, n: int, ranks: int, rtol: float | None = None, one_core: bool = False) -> dict:
     """A run's row from its summary.json."""
-    s = json.loads((case_folder(out, n, ranks, rtol) / "summary.json").read_text())
+    s = json.loads((case_folder(out, n, ranks, rtol, one_core) / "summary.json").read_text())
     t, its = s["wall_time_s"], max(s["newton_iterations"], 1)
     parts = {p: t.get(f"{p}_s", 0.0) for p in PARTS}
     rest = t["total"] - t["setup"] - sum(parts.values())
-    r = {"case": f"n {n}" + (f", {ranks} ranks" if ranks > 1 else "") + (f", rtol {rtol:g}" if rtol else ""),
-         "ranks": s["ranks"], "rtol": rtol or variant(n, SCENE).process.rtol, "n": n,
+    r = {"case": f"n {n}" + (f", {ranks} ranks" if ranks > 1 else "") + (f", rtol {rtol:g}" if rtol else "")
+         + (", one core" if one_core else ""),
+         "ranks": s["ranks"], "threads": s.get("threads", ""), "rtol": rtol or variant(n, SCENE).process.rtol, "n": n,
          "cells": s["cells"], "stroke_mm": s["stroke_mm"], "finished": s["stopped"] is None, "wall_s": t["total"],
          "increments": s["increments"], "newton_iterations": s["newton_iterations"],
          "contact_passes": s["contact_passes"], "iteration_ms": 1e3 * (t["total"] - t["setup"]) / its,
@@ -112,34 +117,38 @@ def warm_up() -> None:
 
 
 def run(out: Path, levels=LEVELS, strokes=None, mpi_levels=MPI_LEVELS,
-        loose: tuple[int, float] | None = LOOSE) -> list[dict]:
-    """Draw every case one after the other, then the 2-rank cases and the case `loose` (level,
-    rtol) on 1 and 2 ranks, and write the table and plot."""
+        loose: tuple[int, float] | None = LOOSE, one_core=ONE_CORE) -> list[dict]:
+    """Draw every case one after the other, then the 2-rank cases, the case `loose` (level,
+    rtol) on 1 and 2 ranks and the `one_core` levels on one core, and write the table and plot."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     strokes = STROKES if strokes is None else strokes
-    cases = [(n, 1, None) for n in levels]
+    cases = [(n, 1, None, False) for n in levels]
     if mpiexec() is not None:
-        cases += [(n, 2, None) for n in mpi_levels]
+        cases += [(n, 2, None, False) for n in mpi_levels]
     if loose is not None:
-        cases.append((loose[0], 1, loose[1]))
+        cases.append((loose[0], 1, loose[1], False))
         if mpiexec() is not None:
-            cases.append((loose[0], 2, loose[1]))
+            cases.append((loose[0], 2, loose[1], False))
+    cases += [(n, 1, None, True) for n in one_core]
     warm_up()
-    for n, ranks, rtol in cases:
-        say(f"cup-benchmark: n {n} on {ranks} rank(s)" + (f", rtol {rtol:g}" if rtol else ""))
-        folder = case_folder(out, n, ranks, rtol)
-        if ranks == 1:
+    for n, ranks, rtol, alone in cases:
+        say(f"cup-benchmark: n {n} on {ranks} rank(s)" + (f", rtol {rtol:g}" if rtol else "")
+            + (", one core" if alone else ""))
+        folder = case_folder(out, n, ranks, rtol, alone)
+        if ranks == 1 and not alone:
             draw_one(n, folder, strokes.get(n), rtol)
-        else:
-            cmd = [mpiexec(), "-n", str(ranks), sys.executable, "-m", "shellform.studies.cup_benchmark",
-                   "--n", str(n), "--out", str(folder)]
-            if strokes.get(n) is not None:
-                cmd += ["--stroke", str(strokes[n])]
-            if rtol is not None:
-                cmd += ["--rtol", str(rtol)]
-            subprocess.run(cmd, check=True, env=dict(os.environ, OMP_NUM_THREADS="1"))
-    rows = [row(out, n, ranks, rtol) for n, ranks, rtol in cases]
+            continue
+        cmd = [sys.executable, "-m", "shellform.studies.cup_benchmark", "--n", str(n), "--out", str(folder)]
+        if strokes.get(n) is not None:
+            cmd += ["--stroke", str(strokes[n])]
+        if rtol is not None:
+            cmd += ["--rtol", str(rtol)]
+        env = dict(os.environ, OMP_NUM_THREADS="1")
+        if alone:
+            env["NUMBA_NUM_THREADS"] = "1"  # one rank on one core: no threads over the cells
+        subprocess.run([mpiexec(), "-n", str(ranks), *cmd] if ranks > 1 else cmd, check=True, env=env)
+    rows = [row(out, n, ranks, rtol, alone) for n, ranks, rtol, alone in cases]
     write_csv(out / "cup_benchmark.csv", rows, COLUMNS)
     plot(out / "cup_benchmark.png", rows)
     for r in rows:
@@ -155,7 +164,8 @@ def plot(path: Path, rows: list[dict]) -> None:
     import matplotlib.pyplot as plt
 
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
-    labels = [f"{r['cells']}\n{r['ranks']} rank" + ("s" if r["ranks"] > 1 else "") for r in rows]
+    labels = [f"{r['cells']}\n{r['ranks']} rank" + ("s" if r["ranks"] > 1 else "")
+              + (", 1 core" if r["case"].endswith("one core") else "") for r in rows]
     bottom = [0.0] * len(rows)
     for p in (*PARTS, "rest"):
         h = [r[f"{p}_ms"] for r in rows]
@@ -170,7 +180,7 @@ def plot(path: Path, rows: list[dict]) -> None:
                                                 (1, False, False, "x", "1 rank, shorter stroke"),
                                                 (1, True, True, "^", "1 rank, looser Newton tolerance")):
         sel = [r for r in rows if r["ranks"] == ranks and (r["stroke_mm"] >= full) == stroke
-               and (r["rtol"] > tight) == loose]
+               and (r["rtol"] > tight) == loose and not r["case"].endswith("one core")]
         if sel:
             b.plot([r["cells"] for r in sel], [r["wall_s"] for r in sel], marker, label=label)
         for r in sel:
