@@ -163,9 +163,11 @@ def plot(path: Path, rows: list[dict]) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
-    labels = [f"{r['cells']}\n{r['ranks']} rank" + ("s" if r["ranks"] > 1 else "")
-              + (", 1 core" if r["case"].endswith("one core") else "") for r in rows]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(13, 4.8))
+    tight = min(r["rtol"] for r in rows)
+    labels = [f"{r['cells']:,}\n{r['ranks']} rank" + ("s" if r["ranks"] > 1 else "")
+              + ("\n1 core" if r["case"].endswith("one core") else "")
+              + (f"\nrtol {r['rtol']:g}" if r["rtol"] > tight else "") for r in rows]
     bottom = [0.0] * len(rows)
     for p in (*PARTS, "rest"):
         h = [r[f"{p}_ms"] for r in rows]
@@ -173,12 +175,14 @@ def plot(path: Path, rows: list[dict]) -> None:
         bottom = [x + y for x, y in zip(bottom, h)]
     a.set_ylabel("ms per Newton iteration (stacked)")
     a.set_title("one iteration, split")
+    a.tick_params(axis="x", labelsize=7)
     a.legend(fontsize=8)
     full = max(r["stroke_mm"] for r in rows)
-    tight = min(r["rtol"] for r in rows)
     for ranks, stroke, loose, marker, label in ((1, True, False, "o-", "1 rank"), (2, True, False, "s", "2 ranks"),
                                                 (1, False, False, "x", "1 rank, shorter stroke"),
-                                                (1, True, True, "^", "1 rank, looser Newton tolerance")):
+                                                (2, False, False, "+", "2 ranks, shorter stroke"),
+                                                (1, True, True, "^", "1 rank, looser Newton tolerance"),
+                                                (2, True, True, "v", "2 ranks, looser Newton tolerance")):
         sel = [r for r in rows if r["ranks"] == ranks and (r["stroke_mm"] >= full) == stroke
                and (r["rtol"] > tight) == loose and not r["case"].endswith("one core")]
         if sel:
