@@ -8,8 +8,8 @@ n x n quarter meshes, n = 21, 35 and 71: 882, 2,450 and 10,082 cells, about 900,
 2,450 and 10,082-cell cups are drawn once more on 2 MPI ranks (mpiexec -n 2; each rank takes
 half the cores for its threads), and the 10,082-cell cup once more on one core (one rank, one
 thread: NUMBA_NUM_THREADS=1), the baseline against which the ranks' speed-up says how the MPI
-engine scales (one rank alone already runs its element and material loops on every core). The 882 and 2,450-cell cups are drawn to 40 mm; the 10,082-cell cup
-to 5 mm only (STROKES), a run of hours to 40 mm on a 2-core machine: its row gives the cost of
+engine scales (one rank alone already runs its element and material loops on every core). The
+882 and 2,450-cell cups are drawn to 40 mm; the 10,082-cell cup to 5 mm only (STROKES), a run of hours to 40 mm on a 2-core machine: its row gives the cost of
 an iteration at that size, not the time of the whole draw. The 2,450-cell cup is drawn once more
 with Newton's tolerance at 1e-4 (LOOSE) instead of the scene's 1e-6, on 1 and on 2 ranks (on 882
 cells 1e-4 moves every reported quantity by under 1e-4, the mesh a hundred times more;
