@@ -671,6 +671,43 @@ def test_a_pass_starts_from_the_last_evaluation_turned_into_its_frames():
     assert K.norm() <= 1e-12 * d.A.norm()
 
 
+def test_a_trials_tangent_is_assembled_only_when_a_solve_asks_for_it():
+    """Newton's trials assemble R at once and K only before a solve (Controls.lazy_tangent):
+    the element tangents then come from the trial's stresses and section tangents without the
+    element loops running again, and R and K equal an eager evaluation's to round-off (of the
+    element forces' scale). Drawn
+    with the tangent eager and lazy, the coarse cup takes the same iterations to the same
+    state, and the lazy run computes one tangent per solve, fewer than its evaluations."""
+    d, lam = _drawn_cup(2.0)
+    evaluations, tangents = d.evaluations, d.tangents
+    d._memo = None
+    _, scale, _ = d._trial(lam)
+    R = d.b.copy()
+    assert d._later is not None and d.tangents == tangents and d.evaluations == evaluations + 1
+    d._tangent_now()
+    assert d._later is None and d.tangents == tangents + 1 and d.evaluations == evaluations + 1
+    K = d.A.copy()
+    assert (R - d.b).norm() <= 1e-15 * scale  # the same R (converged: small against the element forces)
+    d._memo = None
+    d.residual(lam, tangent=True)
+    assert (R - d.b).norm() <= 1e-14 * scale
+    K.axpy(-1.0, d.A)
+    assert K.norm() <= 1e-12 * d.A.norm()
+
+    runs = {}
+    for lazy in (False, True):
+        s = _cup()
+        p = DrawingProblem.from_scene(s, verbose=False)
+        p.driver.controls.lazy_tangent = lazy
+        p.driver.run(1.5 / s.tools.stroke)
+        runs[lazy] = p.driver
+    eager, lazy = runs[False], runs[True]
+    assert [h.iterations for h in lazy.history] == [h.iterations for h in eager.history]
+    assert np.allclose(lazy.q.x.array, eager.q.x.array, rtol=0, atol=1e-9 * np.abs(eager.q.x.array).max())
+    assert eager.tangents == eager.evaluations
+    assert lazy.evaluations == eager.evaluations and lazy.tangents == lazy.solves < lazy.evaluations
+
+
 def test_a_full_step_that_sticks_slipping_nodes_is_kept_once_per_pass():
     """With stick_step (opt-in), the line search keeps an overshooting full step where it turns
     slipping nodes to stick (the friction law's kink), once per pass; not where no node sticks,

@@ -4,8 +4,8 @@ Writes into the output folder (forces and draw-in for the whole blank):
     summary.json             stroke_mm, draw_in_mm (DX, DY, DD) and punch_force_kN at every
                              reported stroke; max_thickness_strain and where; the sheet's
                              volume change (V - V0)/V0 (elastic only, with finite strains); increments,
-                             Newton iterations, contact passes, element evaluations (run and
-                             reused); wall_time_s and its split;
+                             Newton iterations, contact passes, element evaluations (run,
+                             reused, and how many computed a tangent); wall_time_s and its split;
                              over_the_stroke: the worst penetration, z-balance, holder share
                              and count of free nodes under the closed holder
     reports.json             the reports so far (rewritten at each; a resumed run takes them over)
@@ -171,7 +171,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
         "reports": reports, **limits, "springback": sprung,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
-        "element_evaluations": {"run": d.evaluations, "reused": d.reused},
+        "element_evaluations": {"run": d.evaluations, "reused": d.reused, "tangents": d.tangents},
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "resumed_from_stroke_mm": resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},

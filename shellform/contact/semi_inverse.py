@@ -672,7 +672,7 @@ class SemiInverseDriver(Driver):
         c = self.controls
         self._kept = False  # a full step kept for sticking nodes in this pass
         jump = self._constraints(lam)
-        norm, scale, ev = self.residual(lam, tangent=True)
+        norm, scale, ev = self._trial(lam)
         residuals = [norm]
         for it in range(c.max_iterations + 1):
             if not np.isfinite(norm) or ev.failed:
@@ -758,7 +758,7 @@ class SemiInverseDriver(Driver):
             self.q.x.array[:] = x0 + alpha * dq
             self.state.lift[0] = lift0 + alpha * self._dlift
             jump = self._constraints(lam)
-            norm, scale, ev = self.residual(lam, tangent=True)
+            norm, scale, ev = self._trial(lam)
             if not np.isfinite(norm) or ev.failed:
                 alpha *= 0.5  # outside the material's reach: shorten
                 continue

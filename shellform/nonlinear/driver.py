@@ -69,6 +69,7 @@ class Controls:
     cut: float = 0.25
     line_search: int = 6  # halvings
     predictor: bool = True
+    lazy_tangent: bool = True  # Newton's trial states assemble K only when a solve asks for it
     free_rows: bool = True  # factorise the free rows only (free_rows.py); False: the whole assembled matrix
 
     def check(self):
@@ -140,7 +141,9 @@ class Driver:
         self._cause = ""  # why the last Newton attempt failed, in words
         self.searching = True  # the energy line search on; an increment that fails swaps it once
         self._memo = None  # the last evaluation (_evaluate)
+        self._later = None  # (lam, elastic_tangent) of a trial whose tangent is not assembled yet (_trial)
         self.evaluations = self.reused = 0  # of the element loops: run, and reused (a contact pass's first)
+        self.tangents = 0  # element tangents computed (at most one per evaluation)
         self.solves = 0  # linear solves: Newton iterations, those of failed attempts included
 
     # -- residual and tangent ----------------------------------------------------------------
@@ -157,6 +160,7 @@ class Driver:
     def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
         """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free|, scale, ev)."""
         m = self.model
+        self._later = None
         self.q.x.scatter_forward()
         ev = self._evaluate(tangent, elastic_tangent)
         t0 = time.perf_counter()
@@ -198,12 +202,21 @@ class Driver:
         state and the tangent asked for are those of the last evaluation (a contact pass starts
         where the one before ended: only its set and frames changed). Returns the Evaluation."""
         m, memo, q = self.model, self._memo, self.q.x.array
-        if (memo is not None and memo["version"] == m.state_version and (memo["tangent"] or not tangent)
-                and (not tangent or memo["elastic"] == elastic_tangent) and np.array_equal(memo["q"], q)):
+        same = (memo is not None and memo["version"] == m.state_version and np.array_equal(memo["q"], q)
+                and (not tangent or memo["elastic"] == elastic_tangent))
+        if same and (memo["tangent"] or not tangent):
             self._reframe_element_arrays(memo["tangent"])
             self.reused += 1
             return replace(memo["ev"], element_s=0.0, constitutive_s=0.0)
+        if same:  # the state's tangent, left for later (_trial): the element tangents alone
+            t0 = time.perf_counter()
+            m.tensor_arrays(tangent=True)
+            self.tangents += 1
+            self._element_arrays(True)
+            memo["tangent"] = True
+            return replace(memo["ev"], element_s=time.perf_counter() - t0, constitutive_s=0.0)
         ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
+        self.tangents += tangent
         if m.mesh.comm.size > 1:  # every rank takes the same branch on a failed update: global counts
             counts = m.mesh.comm.allreduce(np.array([ev.plastic_layers, ev.failures, ev.guard]), op=MPI.SUM)
             ev = replace(ev, plastic_layers=int(counts[0]), failures=int(counts[1]), guard=int(counts[2]))
@@ -212,6 +225,28 @@ class Driver:
         self._memo = {"version": m.state_version, "tangent": tangent, "elastic": elastic_tangent, "q": q.copy(),
                       "ev": ev}
         return ev
+
+    def _trial(self, lam, elastic_tangent: bool = False):
+        """residual(lam, tangent=True) for Newton's iterates and line-search trials, the tangent
+        left for later (Controls.lazy_tangent): the element tangents, K's assembly and its nodal
+        terms are computed only when a solve needs them (_tangent_now), so that neither the
+        iterate that converges nor a rejected trial pays for a K that is never factorised (about
+        a sixth of the cup's evaluations). The round-off floor of the scale is then the last
+        assembled tangent's."""
+        if not self.controls.lazy_tangent:
+            return self.residual(lam, tangent=True, elastic_tangent=elastic_tangent)
+        out = self.residual(lam, tangent=False, elastic_tangent=elastic_tangent)
+        self._later = (lam, elastic_tangent)
+        return out
+
+    def _tangent_now(self) -> None:
+        """Assemble the tangent that the last _trial left for later: the element tangents from
+        that evaluation's stresses and section tangents, then residual and K as residual() does
+        (R comes out the same)."""
+        if self._later is not None:
+            lam, elastic = self._later
+            self._later = None
+            self.residual(lam, tangent=True, elastic_tangent=elastic)
 
     def _reframe_element_arrays(self, tangent: bool) -> None:
         """Hook: turn the element arrays of the last evaluation from the frames they were turned
@@ -247,6 +282,7 @@ class Driver:
     def apply_tangent(self, v: np.ndarray) -> np.ndarray:
         """K v on the owned rows with the element tangents as they are (no Dirichlet rows; v a
         local array with ghosts): the change of the residual, reactions included, along v."""
+        self._tangent_now()
         m = self.model
         self._memo = None  # the element vectors are overwritten here
         m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, v[m.unrolled_dofs])
@@ -266,6 +302,7 @@ class Driver:
 
     def _solve(self, jump):
         """dq = -K^-1 R with dq_D = g - q_D (lifted: the free rows see -K_fD (g - q_D))."""
+        self._tangent_now()
         t0 = time.perf_counter()
         self.b.scale(-1.0)
         if jump > 0:
@@ -276,6 +313,7 @@ class Driver:
         """The free rows' response to a jump `delta` on the Dirichlet rows alone (no residual),
         with the factorised tangent: out = K^-1 (-K_fD delta + extra) with out_D = delta
         (`extra`, owned rows: what K_fD delta misses of the assembled tangent's columns)."""
+        self._tangent_now()
         t0 = time.perf_counter()
         self.b.set(0.0)
         self._lift(delta)
@@ -313,7 +351,7 @@ class Driver:
         After a load reversal the first tangent is the elastic one (elastic unloading)."""
         c = self.controls
         jump = self._set_dirichlet(lam)
-        norm, scale, ev = self.residual(lam, tangent=True, elastic_tangent=reversal)
+        norm, scale, ev = self._trial(lam, elastic_tangent=reversal)
         residuals, step = [norm], np.inf
         for it in range(1, c.max_iterations + 1):
             if not np.isfinite(norm) or ev.failed:
@@ -336,7 +374,7 @@ class Driver:
                        else self.dq.x.array)
             for _ in range(c.line_search + 1):
                 self.q.x.array[:] = x0 + alpha * step_xy
-                trial, scale, ev = self.residual(lam, tangent=True)
+                trial, scale, ev = self._trial(lam)
                 if not np.isfinite(trial) or ev.failed:
                     alpha *= 0.5  # outside the material's reach: shorten
                     continue
@@ -356,7 +394,7 @@ class Driver:
                 held = self._in_frames()
                 held[self.bc_dofs] = self.g[self.bc_dofs]  # the prescribed values
                 self.q.x.array[:] = self.edge_frames.from_frames(held) if self.edge_frames is not None else held
-                trial, scale, ev = self.residual(lam, tangent=True)
+                trial, scale, ev = self._trial(lam)
             jump = 0.0
             norm = trial
             step = alpha * self._largest(self.dq.x.array)

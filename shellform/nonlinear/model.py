@@ -146,10 +146,16 @@ class SheetModel:
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
             elastic_tangent)
         t2 = time.perf_counter()
-        k.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z, self.resultants,
-                      self.tangents, tangent, self.forms.vectors, self.forms.matrices)
+        self.tensor_arrays(tangent)
         t3 = time.perf_counter()
         return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard))
+
+    def tensor_arrays(self, tangent: bool) -> None:
+        """The element vectors (and tangents) from the last evaluation's strains, stresses and
+        section tangents: with tangent=True after an evaluation without, its K alone."""
+        numba.set_num_threads(self.threads)
+        self.kernels.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z,
+                                 self.resultants, self.tangents, tangent, self.forms.vectors, self.forms.matrices)
 
     def commit(self) -> None:
         """Accept the trial material state (an increment converged)."""
