@@ -211,10 +211,11 @@ class Driver:
         if same:  # the state's tangent, left for later (_trial): the element tangents alone
             t0 = time.perf_counter()
             m.tensor_arrays(tangent=True)
+            seconds = time.perf_counter() - t0
             self.tangents += 1
             self._element_arrays(True)
             memo["tangent"] = True
-            return replace(memo["ev"], element_s=time.perf_counter() - t0, constitutive_s=0.0)
+            return replace(memo["ev"], element_s=seconds, constitutive_s=0.0)
         ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
         self.tangents += tangent
         if m.mesh.comm.size > 1:  # every rank takes the same branch on a failed update: global counts
