@@ -59,7 +59,7 @@ def test_cup_benchmark_short(tmp_path):
     iterations, the one-core run (one thread) the same cup as the first row's to 1e-9."""
     from shellform.studies import cup_benchmark
 
-    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_levels=(6,), loose=(6, 1e-4),
+    rows = cup_benchmark.run(tmp_path, levels=(6,), strokes={6: 1.0}, mpi_levels=(6,), loose=(6, (1e-4,)),
                              one_core=(6,))
     assert [(r["ranks"], r["cells"], r["rtol"]) for r in rows] == [(1, 72, 1e-6), (2, 72, 1e-6), (1, 72, 1e-4),
                                                                   (2, 72, 1e-4), (1, 72, 1e-6)]
