@@ -33,6 +33,7 @@ args = parser.parse_args()
 
 p = DrawingProblem.from_scene(scene_for(args.n, 3.0), verbose=False)
 p.driver.run(args.stroke / 3.0)
+p.driver.residual(p.driver.lam, tangent=True)  # the converged state's tangent (Newton assembles it only to solve)
 A = p.driver.A
 opts = PETSc.Options()
 for key, value in zip(args.options[::2], args.options[1::2]):
