@@ -88,7 +88,8 @@ class ContactControls:
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
     stick_step: bool = False  # keep a full step that turns slipping nodes to stick, once per pass (_keep_sticking_step)
     early_set: bool = True  # end a pass once the set will change and the steps are below early_step penetrations
-    early_step: float = 10.0  # (1 until 2026-11-23: 19 % more iterations on 2,450 cells, docs/performance.md)
+    early_step: float = 10.0  # (1 until 2026-11-23: 19 % more iterations on the aluminium cup's 2,450 cells; but the
+    # paper's cup on 24 x 24 takes 21 % more with 10, and cuts back: docs/contact.md)
     refresh_normal: bool = True  # friction's normal forces from every iterate after the first (not per pass)
     tool_curvature: bool = True  # the frames' turning on curved tools in the tangent
     consistent_friction: bool = True  # with refresh_normal: the slip force's dp/dq in the tangent
