@@ -708,6 +708,41 @@ def test_a_trials_tangent_is_assembled_only_when_a_solve_asks_for_it():
     assert lazy.evaluations == eager.evaluations and lazy.tangents == lazy.solves < lazy.evaluations
 
 
+def test_failed_early_ending_passes_end_only_near_convergence_from_then_on():
+    """Contact passes that fail while they end early on a set change (early_step 10) end only
+    near convergence from then on (early_step 1), and the increment is tried again from the
+    same start before it is cut back; its iterations count both tries. A failure at early_step
+    1 is returned to the driver (which cuts back)."""
+    s = _cup()
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(1.0 / s.tools.stroke)
+    assert d.contact.early_step == 10.0
+    starts, real = [], d._contact_passes
+
+    def first_fails(lam, reversal=False):
+        starts.append((d.contact.early_step, d.q.x.array.copy()))
+        if len(starts) == 1:
+            d.q.x.array[:] += 1e-3  # a failed try leaves its last iterate behind
+            d._cause = "a failure for the test"
+            return False, 7, [1.0], None
+        return real(lam, reversal)
+
+    d._contact_passes = first_fails
+    lam = d.lam + 0.2 / s.tools.stroke
+    ok, its, _, _ = d._newton(lam)
+    assert ok and [e for e, _ in starts] == [10.0, 1.0] and d.contact.early_step == 1.0
+    assert np.array_equal(starts[0][1], starts[1][1])
+    assert its > 7
+
+    def fails(lam, reversal=False):
+        starts.append((d.contact.early_step, None))
+        return False, 3, [1.0], None
+
+    d._contact_passes = fails
+    assert d._newton(lam)[:2] == (False, 3) and len(starts) == 3
+
+
 def test_a_full_step_that_sticks_slipping_nodes_is_kept_once_per_pass():
     """With stick_step (opt-in), the line search keeps an overshooting full step where it turns
     slipping nodes to stick (the friction law's kink), once per pass; not where no node sticks,
