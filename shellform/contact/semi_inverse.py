@@ -622,8 +622,8 @@ class SemiInverseDriver(Driver):
         above 1), they end only near convergence from then on (early_step 1), and the increment
         is tried once more at the same step before the driver cuts it back. An early end judges
         the set on an iterate whose steps are still up to early_step penetrations long: on the
-        paper's cup on 24 x 24 such passes failed to converge in 25 iterations four times (the
-        cut-backs cost 1167 iterations where early_step 1 takes 962; the NUMISHEET'93 cup
+        paper's cup on 24 x 24 such passes failed four times (the cut-backs cost 1167
+        iterations where early_step 1 takes 962; the NUMISHEET'93 cup
         saves 19 % with the early end and never fails): docs/contact.md. The increment's
         iterations count both tries."""
         start = self.q.x.array.copy()
