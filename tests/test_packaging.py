@@ -1,5 +1,6 @@
 """Packaging: forms/ installs as shellform.forms, and every package folder is in the wheel."""
 
+import os
 import subprocess
 import sys
 import tomllib
@@ -26,3 +27,16 @@ def test_every_package_folder_is_listed():
     found = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "shellform").rglob("__init__.py")}
     assert found | {"shellform.forms"} == listed
     assert config["package-dir"] == {"shellform.forms": "forms"}
+
+
+def test_one_blas_thread_unless_the_user_sets_it():
+    """Importing shellform sets OPENBLAS_NUM_THREADS=1 before the DOLFINx runtime loads (MUMPS's
+    spinning BLAS workers took a third of the element loop's cores), and leaves a value the
+    user set alone."""
+    code = "import os, shellform; print(os.environ['OPENBLAS_NUM_THREADS'])"
+    for given, expected in ((None, "1"), ("2", "2")):
+        env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+        if given is not None:
+            env["OPENBLAS_NUM_THREADS"] = given
+        out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+        assert out.stdout.strip() == expected
