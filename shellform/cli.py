@@ -113,25 +113,26 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     import shellform  # noqa: F401  (DOLFINx runtime first)
+    from shellform.results.log import say  # every line below once per run, on rank 0
 
     try:
         if args.command == "run":
             summary = run_scene(args.scene, args.out, trace=args.trace, resume=args.resume)
             if "draw_in_mm" in summary:
                 last = summary["draw_in_mm"][-1] if summary["draw_in_mm"] else {}
-                print(f"shellform: {summary['title']}: {summary['cells']} cells, stroke {summary['stroke_mm']:.2f} mm, "
-                      f"draw-in {last}, max thickness strain {summary['max_thickness_strain']:.4f}, "
-                      f"{summary['wall_time_s']['total']:.1f} s; results in {args.out}")
+                say(f"shellform: {summary['title']}: {summary['cells']} cells, stroke {summary['stroke_mm']:.2f} mm, "
+                    f"draw-in {last}, max thickness strain {summary['max_thickness_strain']:.4f}, "
+                    f"{summary['wall_time_s']['total']:.1f} s; results in {args.out}")
             elif "reports" in summary:
                 last = summary["reports"][-1] if summary["reports"] else {}
-                print(f"shellform: {summary['title']}: {summary['cells']} cells, {summary['increments']} "
-                      f"increments, load factor {last.get('load_factor')}, w = {last.get('w')}, "
-                      f"{summary['wall_time_s']:.2f} s; results in {args.out}")
+                say(f"shellform: {summary['title']}: {summary['cells']} cells, {summary['increments']} "
+                    f"increments, load factor {last.get('load_factor')}, w = {last.get('w')}, "
+                    f"{summary['wall_time_s']:.2f} s; results in {args.out}")
             else:
-                print(f"shellform: {summary['title']}: {summary['cells']} cells, w_center = "
-                      f"{summary['w_center']}, {summary['wall_time_s']:.2f} s; results in {args.out}")
+                say(f"shellform: {summary['title']}: {summary['cells']} cells, w_center = "
+                    f"{summary['w_center']}, {summary['wall_time_s']:.2f} s; results in {args.out}")
             if summary.get("stopped"):
-                print(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
+                say(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
                 return 3
         else:
             import importlib
@@ -140,7 +141,7 @@ def main(argv=None) -> int:
             kwargs = {"levels": study.QUICK_LEVELS} if args.quick and hasattr(study, "QUICK_LEVELS") else {}
             study.run(args.out, **kwargs)
     except InputError as err:
-        print(f"shellform: input error: {err}", file=sys.stderr)
+        say(f"shellform: input error: {err}", file=sys.stderr)
         return 2
     return 0
 

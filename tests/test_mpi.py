@@ -190,3 +190,24 @@ def test_curved_and_oblique_supports_on_two_ranks_match_serial(tmp_path, monkeyp
     for name, w in parallel.items():
         serial = linear.solve(scene.load(root / "demos" / f"{name}.toml")).value("w")
         assert w == pytest.approx(serial, rel=1e-10), name
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_two_ranks_say_each_line_once(tmp_path):
+    """Under mpiexec -n 2 the closing line of a run and an input error are printed once (by
+    rank 0), not once per rank."""
+    shellform_cmd = str(Path(sys.executable).parent / "shellform")
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    good = tmp_path / "good.toml"
+    good.write_text('title = "once"\n[mesh]\nn = 4\n[supports]\nleft = "clamped"\n[loads]\npressure = 1.0\n'
+                    '[output]\nvtx = false\npng = false\n')
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[material]\nthickness = -1.0\n")
+    runs = {name: subprocess.run([mpiexec(), "-n", "2", shellform_cmd, "run", str(path), "--out", str(tmp_path / name)],
+                                 capture_output=True, text=True, timeout=300, env=env)
+            for name, path in (("good", good), ("bad", bad))}
+    assert runs["good"].returncode == 0, runs["good"].stderr[-2000:]
+    assert runs["good"].stdout.count("shellform: once:") == 1, runs["good"].stdout
+    assert runs["bad"].returncode == 2
+    assert runs["bad"].stderr.count("shellform: input error: material.thickness") == 1, runs["bad"].stderr

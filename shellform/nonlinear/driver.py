@@ -94,6 +94,7 @@ class Increment:
     cutbacks: int
     seconds: dict = field(default_factory=dict)
     contact: dict = field(default_factory=dict)  # contact passes, set changes (contact driver)
+    change: float = 0.0  # |q_n+1 - q_n|, 2-norm over all ranks (the path's stiffness: |dlam| / change)
 
 
 class Driver:
@@ -405,6 +406,33 @@ class Driver:
             self._cause = f"no convergence in {c.max_iterations} iterations"
         return converged, c.max_iterations, residuals, ev
 
+    def limit_point(self, failed: float, softening: float = 0.05) -> str | None:
+        """Why stepping stopped, where the load cannot grow further: a limit point of the path
+        (a collapse load, a snap-through). Along the path the stiffness k_n = |dlambda_n| / |dq_n|
+        of the converged increments has fallen below `softening` times the first one's; the limit
+        load factor is estimated where k, extrapolated linearly in lambda from the last two
+        increments, reaches zero, within [the last converged lambda, the failed one]. None where
+        the stiffness held up (a failure of another kind)."""
+        path = [h for h in self.history if h.change > 0]
+        if len(path) < 2:
+            return None
+        k = [abs(h.dlam) / h.change for h in path]
+        if k[-1] > softening * k[0]:
+            return None
+        lam_c, lam_b = path[-1].lam, path[-2].lam
+        slope = (k[-1] - k[-2]) / (lam_c - lam_b)  # dk / dlambda
+        estimate = lam_c - k[-1] / slope if slope * (failed - lam_c) < 0 else failed
+        lo, hi = sorted((lam_c, failed))
+        estimate = min(max(estimate, lo), hi)
+        return (f"the structure reached its limit load at about load factor {estimate:.4g} (last converged "
+                f"{lam_c:.6g}; no equilibrium found at {failed:.6g}): along the path its stiffness "
+                f"|dlambda|/|dq| fell to {k[-1] / k[0]:.2g} times the first increment's")
+
+    def _norm(self, x: np.ndarray) -> float:
+        """The 2-norm of a carrier array over the owned dofs of all ranks."""
+        owned = self.free_lu.owned
+        return float(np.sqrt(self.model.mesh.comm.allreduce(float(np.dot(x[:owned], x[:owned])), op=MPI.SUM)))
+
     def _largest(self, x: np.ndarray) -> float:
         """max |x| over all ranks (a decision every rank must take alike)."""
         return self.model.mesh.comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
@@ -462,9 +490,9 @@ class Driver:
                 if dlam < c.min_step:
                     self._restore_converged()
                     path = self.save_checkpoint()
-                    raise ConvergenceFailure(
+                    raise ConvergenceFailure(self.limit_point(lam) or (
                         f"increment at lambda {self.lam:.6g} -> {lam:.6g} did not converge ({self._cause}) and "
-                        f"the step fell below min_step {c.min_step:g}", path)
+                        f"the step fell below min_step {c.min_step:g}"), path)
                 self._dlam_prev = None  # no extrapolation after a failure
             self._commit()
             reversal = False
@@ -472,7 +500,7 @@ class Driver:
             self.lam = lam
             self._dlam_prev = dlam
             inc = Increment(len(self.history) + 1, lam, dlam, its, res, ev.plastic_layers, cutbacks,
-                            {"wall_s": time.perf_counter() - t0}, self._increment_info())
+                            {"wall_s": time.perf_counter() - t0}, self._increment_info(), self._norm(self.q.x.array - x_n))
             self.history.append(inc)
             if self.verbose:
                 self.progress.increment(

@@ -1,7 +1,7 @@
 """A nonlinear scene from its TOML to results on disk: scene -> problem -> driver -> files.
 
 Writes into the output folder:
-    summary.json       per reported load factor and at the end of every stage of the path:
+    summary.json       per reported load factor, at the end of every stage of the path and at a stop:
                        centre displacement, peak equivalent plastic strain and thickness
                        strain; increments, Newton iterations, time split
     increments.csv     every increment: load factor, step, iterations, residuals, plastic layers
@@ -83,6 +83,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
     except ConvergenceFailure as err:
         stopped = str(err)
         p.driver.progress.note(f"shellform: stopped: {err}")
+        reports.append(_record(p, s))  # the last converged state, which the driver restored
     p.driver.progress.close()
     d = p.driver
     summary = {

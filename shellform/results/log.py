@@ -11,9 +11,10 @@ import time
 from mpi4py import MPI
 
 
-def say(*args):
+def say(*args, file=None):
+    """print() on rank 0 only (one line per run, not one per rank)."""
     if MPI.COMM_WORLD.rank == 0:
-        print(*args, flush=True)
+        print(*args, file=file, flush=True)
 
 
 class Progress:
