@@ -18,6 +18,7 @@
 """
 
 import argparse
+import signal
 import sys
 import time
 from pathlib import Path
@@ -113,6 +114,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     import shellform  # noqa: F401  (DOLFINx runtime first)
+    from shellform.nonlinear.interrupt import Interrupted
     from shellform.results.log import say  # every line below once per run, on rank 0
 
     try:
@@ -133,7 +135,7 @@ def main(argv=None) -> int:
                     f"{summary['w_center']}, {summary['wall_time_s']:.2f} s; results in {args.out}")
             if summary.get("stopped"):
                 say(f"shellform: the run stopped early: {summary['stopped']}", file=sys.stderr)
-                return 3
+                return 128 + summary["signal"] if summary.get("signal") else 3
         else:
             import importlib
 
@@ -143,6 +145,13 @@ def main(argv=None) -> int:
     except InputError as err:
         say(f"shellform: input error: {err}", file=sys.stderr)
         return 2
+    except Interrupted as err:  # outside a run's own handling (a study): its state is on disk
+        say(f"shellform: {err}" + (f"; the last converged state: {err.checkpoint}" if err.checkpoint else ""),
+            file=sys.stderr)
+        return 128 + err.signal
+    except KeyboardInterrupt:  # before any increment converged, or a second Ctrl-C
+        say("shellform: interrupted; nothing newer than the last checkpoint was kept", file=sys.stderr)
+        return 128 + signal.SIGINT
     return 0
 
 

@@ -36,6 +36,7 @@ from petsc4py import PETSc
 
 from shellform.errors import InputError
 from shellform.nonlinear.free_rows import FreeRowsLU, lu_solver
+from shellform.nonlinear.interrupt import Interrupted, StopRequests
 from shellform.results.log import Progress
 
 
@@ -112,6 +113,7 @@ class Driver:
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
         self.verbose = verbose
         self.progress = Progress()  # a run sets its own (label, total, unit)
+        self.stops = StopRequests(model.mesh.comm)  # Ctrl-C and SIGTERM while it steps (interrupt.py)
         self.fingerprint = ""  # what a checkpoint must match to be resumed (set by a run)
         V = model.V
         self.q = fem.Function(V, name="carrier")
@@ -460,7 +462,21 @@ class Driver:
         return ok, its + its2, res, ev
 
     def run(self, target: float = 1.0, on_increment=None):
-        """Step lambda from its current value to `target` (up or down)."""
+        """Step lambda from its current value to `target` (up or down). A SIGINT or SIGTERM
+        meanwhile stops it after the increment under way: the last converged state is written
+        (save_checkpoint) and Interrupted raised."""
+        with self.stops:
+            return self._run(target, on_increment)
+
+    def _stop_if_requested(self) -> None:
+        """After an attempt at an increment: where a stop was requested, write the last
+        converged state (q holds it) and raise Interrupted."""
+        signum = self.stops.requested()
+        if signum:
+            self._restore_converged()
+            raise Interrupted(signum, self.save_checkpoint())
+
+    def _run(self, target, on_increment):
         c = self.controls
         direction = 1.0 if target >= self.lam else -1.0
         reversal = self._direction is not None and direction != self._direction
@@ -482,6 +498,7 @@ class Driver:
                 if ok:
                     break
                 self.q.x.array[:] = x_n
+                self._stop_if_requested()
                 cutbacks += 1
                 dlam *= c.cut
                 if self.verbose:
@@ -509,6 +526,7 @@ class Driver:
                     f"|R| {res[0]:.2e} -> {res[-1]:.2e}  plastic layers {ev.plastic_layers}")
             if on_increment is not None:
                 on_increment(self)
+            self._stop_if_requested()
             if its <= c.easy_iterations and cutbacks == 0:
                 dlam = min(dlam * c.growth, c.max_step)
         return self.history

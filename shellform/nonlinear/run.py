@@ -8,7 +8,8 @@ Writes into the output folder:
     nodal.bp, cells.bp the final state for ParaView (displacement, slopes; plastic and thickness
                        strain per cell)
     deformed.png       the final shape (serial runs)
-    last_converged.*   only if the run stops: the last converged state
+    last_converged.*   only if the run stops (no convergence, a limit load, Ctrl-C or SIGTERM):
+                       the last converged state
 """
 
 import time
@@ -19,6 +20,7 @@ from mpi4py import MPI
 
 from shellform.mesh import blank
 from shellform.nonlinear.driver import ConvergenceFailure, Controls
+from shellform.nonlinear.interrupt import Interrupted
 from shellform.nonlinear.loads import EdgeMoment, PointForce, SheetLoads
 from shellform.nonlinear.problem import SheetProblem
 from shellform.scene import Scene
@@ -69,7 +71,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
     t0 = time.perf_counter()
     p = problem(s, comm, outdir)
     setup_s = time.perf_counter() - t0
-    reports, stopped = [], None
+    reports, stopped, signum = [], None, 0
     p.driver.progress = Progress("load factor", max(abs(x) for x in s.process.path))
     targets = sorted(set(s.process.report))
     try:
@@ -80,9 +82,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
             for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
                 p.driver.run(r)
                 reports.append(_record(p, s))
-    except ConvergenceFailure as err:
+    except (ConvergenceFailure, Interrupted) as err:
         stopped = str(err)
-        p.driver.progress.note(f"shellform: stopped: {err}")
+        if isinstance(err, Interrupted):
+            signum = err.signal
+            stopped = f"{err} at load factor {p.driver.lam:.6g}"
+        p.driver.progress.note(f"shellform: stopped: {stopped}")
         reports.append(_record(p, s))  # the last converged state, which the driver restored
     p.driver.progress.close()
     d = p.driver
@@ -91,7 +96,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
         "cells": p.model.mesh.topology.index_map(2).size_global,
         "dofs": p.model.V.dofmap.index_map.size_global * 9, "reports": reports,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
-        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,
+        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
     }
     rows = [{"increment": h.number, "load_factor": h.lam, "step": h.dlam, "iterations": h.iterations,
