@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from shellform.studies.common import mpiexec
+
 STRIP = """title = "strip stepped slowly"
 effects = ["bending", "membrane", "plasticity"]
 [geometry]
@@ -39,13 +41,16 @@ png = false
 """
 
 
-def interrupted_run(tmp_path: Path, scene_text: str, signum: int, after: int, name="scene.toml"):
-    """Run `shellform run` in a child process, send it `signum` once it has printed `after`
-    converged increments; (the finished process, the increment lines it printed, --out)."""
+def interrupted_run(tmp_path: Path, scene_text: str, signum: int, after: int, name="scene.toml", ranks=1):
+    """Run `shellform run` in a child process (under mpiexec with ranks > 1), send it `signum`
+    once it has printed `after` converged increments; (exit status, its stderr, the increment
+    lines it printed, --out)."""
     scene = tmp_path / name
     scene.write_text(scene_text)
     out = tmp_path / "out"
     cmd = [str(Path(sys.executable).parent / "shellform"), "run", str(scene), "--out", str(out)]
+    if ranks > 1:
+        cmd = [mpiexec(), "-n", str(ranks), *cmd]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     lines = []
     for line in proc.stdout:
@@ -75,3 +80,16 @@ def test_a_signal_stops_a_load_stepped_run_at_its_last_converged_increment(tmp_p
     assert 3 <= summary["increments"] == len(lines) < 100
     assert summary["reports"][-1]["load_factor"] == pytest.approx(last, rel=1e-9)
     assert list(out.glob("last_converged*"))
+
+
+@pytest.mark.mpi
+@pytest.mark.timeout(300)
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_ctrl_c_to_mpiexec_stops_every_rank_at_the_same_increment(tmp_path):
+    """Ctrl-C to mpiexec -n 2 (which passes it on to the ranks): both ranks stop after the same
+    increment, and the run says so once."""
+    code, err, lines, out = interrupted_run(tmp_path, STRIP, signal.SIGINT, after=3, ranks=2)
+    assert code == 130, err
+    assert err.count("stopped by the user (SIGINT)") == 1 and "Traceback" not in err, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["ranks"] == 2 and summary["increments"] == len(lines) >= 3
