@@ -151,6 +151,7 @@ class Output:
     vtx: bool = True
     png: bool = True
     fld: bool = True  # tool scenes with plasticity: the forming-limit view (results/fld.py)
+    checkpoint_every: float = 60.0  # tool scenes: seconds of wall time between checkpoints (0: at reports only)
 
 
 @dataclass
@@ -380,6 +381,8 @@ def validate(s: Scene) -> None:
                  f"nonlinear sheet: needs one of the effects {', '.join(NONLINEAR_EFFECTS)}")
     _validate_loads(s)
     _validate_process(s)
+    every = s.output.checkpoint_every
+    _require(math.isfinite(every) and every >= 0, "output.checkpoint_every", f"must be finite and >= 0, got {every}")
     _validate_tools(s)
     _validate_size(s)
 

@@ -271,3 +271,8 @@ def test_cubic_membrane_on_a_supported_curved_edge_names_effects():
     with pytest.raises(InputError) as err:
         linear.solve(s)
     assert err.value.field == "effects"
+
+
+@pytest.mark.parametrize("value", [-1.0, float("inf"), float("nan")])
+def test_checkpoint_interval_names_its_field(value):
+    assert_names_field({"output": {"checkpoint_every": value}}, "output.checkpoint_every")
