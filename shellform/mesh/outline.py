@@ -20,6 +20,7 @@ from mpi4py import MPI
 
 import dolfinx.mesh
 from shellform.errors import InputError
+from shellform.mesh import quality
 from shellform.mesh.blank_mesh import BlankMesh
 from shellform.mesh.gmsh_model import gmsh_session, mesh_on_root
 from shellform.mesh.rectangle import rectangle
@@ -65,6 +66,8 @@ def _read_file(path, mtime) -> tuple[tuple[str, ...], int, tuple[float, float]]:
             gmsh.open(str(path))
         except Exception as exc:  # noqa: BLE001  (gmsh raises plain Exceptions)
             raise InputError("geometry.file", f"gmsh cannot read {path}: {exc}") from None
+        if not gmsh.model.getEntities():
+            raise InputError("geometry.file", f"{path} holds no geometry and no mesh (an empty file?)")
         groups = tuple(n for _, n in _named_curves(gmsh)) or ("boundary",)
         triangles = sum(len(tags) for t, tags in zip(*gmsh.model.mesh.getElements(2)[:2]) if t == TRIANGLE)
         x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(-1, -1)
@@ -219,6 +222,7 @@ def from_file(comm, path, n=8, refine=0) -> BlankMesh:
         if kinds != {TRIANGLE}:
             other = ", ".join(gmsh.model.mesh.getElementProperties(k)[0] for k in sorted(kinds - {TRIANGLE}))
             raise InputError("geometry.file", f"{path} holds {other}: shellform needs linear triangles only")
+        _check_triangles(gmsh, path)
         z = gmsh.model.mesh.getNodes()[1].reshape(-1, 3)[:, 2]
         if np.abs(z).max(initial=0.0) > 1e-9:
             raise InputError("geometry.file", f"{path}: the blank must lie in the plane z = 0 "
@@ -234,6 +238,18 @@ def from_file(comm, path, n=8, refine=0) -> BlankMesh:
     if not curves:  # no named curves: the whole boundary is one group
         return _whole_boundary(data.mesh)
     return _blank(data, [name for _, name in curves], tags={name: tag for tag, name in curves})
+
+
+def _check_triangles(gmsh, path):
+    """shellform.mesh.quality.check of the triangles DOLFINx gets: those of the file's physical
+    surfaces, or of all its surfaces where it names none."""
+    named = [e for _, g in gmsh.model.getPhysicalGroups(2) for e in gmsh.model.getEntitiesForPhysicalGroup(2, g)]
+    entities = sorted(set(named)) if named else [t for _, t in gmsh.model.getEntities(2)]
+    cells, nodes = zip(*(gmsh.model.mesh.getElementsByType(TRIANGLE, e) for e in entities))
+    tags, x, _ = gmsh.model.mesh.getNodes()
+    order = np.argsort(tags)
+    index = order[np.searchsorted(tags, np.concatenate(nodes), sorter=order)]
+    quality.check(x.reshape(-1, 3), index.reshape(-1, 3), np.concatenate(cells), tags, source=str(path))
 
 
 def _generate(gmsh, h, refine):
