@@ -134,7 +134,7 @@ def _check_folds(p, t, nodes, where, source):
         k, m = first[folded[0]], second[folded[0]]
         raise InputError(FIELD, f"{source}: {where(cell[m])} and {where(cell[k])} lie on the same side of their "
                          f"shared edge: the mesh folds over itself there (an inverted triangle; "
-                         f"{folded.size} such edges)")
+                         f"folded edges: {folded.size})")
 
 
 def _pieces(t) -> np.ndarray:
