@@ -46,6 +46,15 @@ def group_names(g) -> tuple[str, ...]:
     return _read_file(g.file, Path(g.file).stat().st_mtime)[0]
 
 
+def symmetry_lines(g) -> tuple[str, ...]:
+    """The groups of a [geometry] section on the mirror lines of a region that is part of the
+    blank: x = 0 and y = 0 of a quarter (left, bottom), y = 0 of a half (bottom). None for a
+    full region, a polygon or a file: their symmetry lines are the groups the scene declares."""
+    if g.shape not in ("rectangle", "circle"):
+        return ()
+    return {"full": (), "half": ("bottom",), "quarter": ("left", "bottom")}.get(g.region, ())
+
+
 def file_cells(g, n: int, refine: int) -> int:
     """Triangles a file blank makes: those of its mesh (a .msh), or a gmsh estimate from its
     bounding box at h = width / n (a .geo or CAD file), times 4^refine."""
@@ -115,6 +124,15 @@ def polygon_problem(vertices) -> str | None:
             c, d = v[j], v[(j + 1) % n]
             if (cross(a, b, c) * cross(a, b, d) < 0) and (cross(c, d, a) * cross(c, d, b) < 0):
                 return f"edge {i + 1} crosses edge {j + 1}: the outline must not intersect itself"
+    for k in range(n):  # a vertex on an edge it does not end: the outline touches itself
+        for i in range(n):
+            if k in (i, (i + 1) % n):
+                continue
+            a, b = v[i], v[(i + 1) % n]
+            t = np.clip(np.dot(v[k] - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+            if np.hypot(*(a + t * (b - a) - v[k])) <= 1e-9 * scale:
+                return (f"vertex {k} {tuple(map(float, v[k]))} lies on edge {i + 1} (vertices {i} to {(i + 1) % n}): "
+                        "the outline must not touch itself")
     return None
 
 
