@@ -50,9 +50,11 @@ def symmetry_lines(g) -> tuple[str, ...]:
     """The groups of a [geometry] section on the mirror lines of a region that is part of the
     blank: x = 0 and y = 0 of a quarter (left, bottom), y = 0 of a half (bottom). None for a
     full region, a polygon or a file: their symmetry lines are the groups the scene declares."""
-    if g.shape not in ("rectangle", "circle"):
-        return ()
-    return {"full": (), "half": ("bottom",), "quarter": ("left", "bottom")}.get(g.region, ())
+    if g.shape == "rectangle":
+        return ("left", "bottom") if g.region == "quarter" else ()
+    if g.shape == "circle":
+        return {"full": (), "half": ("bottom",), "quarter": ("left", "bottom")}.get(g.region, ())
+    return ()
 
 
 def file_cells(g, n: int, refine: int) -> int:
@@ -263,11 +265,13 @@ def _check_triangles(gmsh, path):
     surfaces, or of all its surfaces where it names none."""
     named = [e for _, g in gmsh.model.getPhysicalGroups(2) for e in gmsh.model.getEntitiesForPhysicalGroup(2, g)]
     entities = sorted(set(named)) if named else [t for _, t in gmsh.model.getEntities(2)]
-    cells, nodes = zip(*(gmsh.model.mesh.getElementsByType(TRIANGLE, e) for e in entities))
+    blocks = [gmsh.model.mesh.getElementsByType(TRIANGLE, e) for e in entities]
+    cells = np.concatenate([np.zeros(0, dtype=np.uint64)] + [c for c, _ in blocks])
+    nodes = np.concatenate([np.zeros(0, dtype=np.uint64)] + [v for _, v in blocks])
     tags, x, _ = gmsh.model.mesh.getNodes()
     order = np.argsort(tags)
-    index = order[np.searchsorted(tags, np.concatenate(nodes), sorter=order)]
-    quality.check(x.reshape(-1, 3), index.reshape(-1, 3), np.concatenate(cells), tags, source=str(path))
+    index = order[np.searchsorted(tags, nodes, sorter=order)] if nodes.size else nodes
+    quality.check(x.reshape(-1, 3), index.reshape(-1, 3), cells, tags, source=str(path))
 
 
 def _generate(gmsh, h, refine):
