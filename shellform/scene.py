@@ -462,7 +462,8 @@ def _validate_size(s: Scene) -> None:
     else:
         x0, x1, _, _ = outline.region_bounds(g)
         cells = budget.gmsh_cells(outline.region_area(g), (x1 - x0) / m.n, m.refine)
-    nonlinear, layers = s.nonlinear or s.tools is not None, s.process.thickness_points if "plasticity" in s.effects else 0
+    nonlinear = s.nonlinear or s.tools is not None
+    layers = s.process.thickness_points if "plasticity" in s.effects else 0  # a plastic section's points
     need, have = budget.estimated_bytes(cells, nonlinear, layers=layers), budget.available_bytes()
     usual = min(layers, Process().thickness_points)
     _require(need <= have or budget.estimated_bytes(cells, nonlinear, layers=usual) > have, "process.thickness_points",

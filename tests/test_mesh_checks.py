@@ -45,7 +45,8 @@ def file_scene(path: Path, supports=None) -> scene.Scene:
     return scene.from_dict({"effects": ["bending"], "geometry": {"shape": "file", "file": str(path)},
                             "mesh": {"kind": "unstructured", "n": 4},
                             "material": {"E": 12 * (1 - 0.3**2), "nu": 0.3, "thickness": 1.0},
-                            "supports": {"edge": "clamped"} if supports is None else supports, "loads": {"pressure": 1.0}})
+                            "supports": {"edge": "clamped"} if supports is None else supports,
+                            "loads": {"pressure": 1.0}})
 
 
 def refused(path: Path, *words: str) -> str:

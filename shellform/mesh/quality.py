@@ -114,7 +114,8 @@ def _check_folds(p, t, nodes, where, source):
     pairs, index, count = _edges(t)
     if np.any(count > 2):
         k = np.flatnonzero(count[index] > 2)[0]
-        raise InputError(FIELD, f"{source}: the edge of nodes {nodes[pairs[k][0]]} and {nodes[pairs[k][1]]} is shared by "
+        raise InputError(FIELD, f"{source}: the edge of nodes {nodes[pairs[k][0]]} and {nodes[pairs[k][1]]} is "
+                         f"shared by "
                          f"{count[index[k]]} triangles, one of them {where(k // 3)}: the mesh overlaps itself")
     # which side of its (sorted) edge each triangle's third corner lies on
     flat = p.reshape(-1, 3, 2)
