@@ -28,6 +28,9 @@ CONTACT_EFFECTS = ("contact", "friction")  # the rigid tools of [tools] (shellfo
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
 NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
 SIDES = ("left", "right", "bottom", "top")
+# what a mirror line needs (u_n = 0, w,n = 0; shellform/supports.py): symmetry, or a support holding more
+MIRROR_SUPPORTS = ("symmetry", "clamped", "clamped_sliding")
+MAY_BE_INFINITE = ("surface.R1", "surface.R2")  # inf: flat along that direction
 REGIONS = ("full", "quarter")  # rectangle
 CIRCLE_REGIONS = ("full", "half", "quarter")
 MESH_KINDS = ("structured", "unstructured")
@@ -343,6 +346,7 @@ def _require(cond, name, message):
 
 
 def validate(s: Scene) -> None:
+    _validate_finite(s)
     _validate_effects(s)
     _validate_geometry(s)
     m = s.mesh
@@ -379,12 +383,37 @@ def validate(s: Scene) -> None:
         _require(v in SUPPORTS, f"supports.{group}", f"unknown support {v!r}; known supports: {', '.join(SUPPORTS)}")
         _require(v not in NONLINEAR_SUPPORTS or s.nonlinear, f"supports.{group}", f"{v!r} is a support of the "
                  f"nonlinear sheet: needs one of the effects {', '.join(NONLINEAR_EFFECTS)}")
+    for group in outline.symmetry_lines(s.geometry):
+        v = s.supports.get(group, "free")
+        _require(v in MIRROR_SUPPORTS, f"supports.{group}",
+                 f"the {s.geometry.region} {s.geometry.shape} is mirrored across this edge to make the whole blank: "
+                 f"it needs 'symmetry' (or {' or '.join(repr(m) for m in MIRROR_SUPPORTS[1:])}), got {v!r}")
     _validate_loads(s)
     _validate_process(s)
     every = s.output.checkpoint_every
     _require(math.isfinite(every) and every >= 0, "output.checkpoint_every", f"must be finite and >= 0, got {every}")
     _validate_tools(s)
     _validate_size(s)
+
+
+def _validate_finite(s: Scene) -> None:
+    """Every number of the scene is finite (surface.R1 and R2 may be inf: flat)."""
+    def numbers(value, name):
+        if isinstance(value, list):
+            for i, item in enumerate(value):
+                yield from numbers(item, f"{name}[{i}]" if hasattr(item, "__dataclass_fields__") else name)
+        elif hasattr(value, "__dataclass_fields__"):
+            for f in fields(value):
+                yield from numbers(getattr(value, f.name), f"{name}.{f.name}")
+        elif isinstance(value, float):
+            yield name, value
+
+    for section in ("geometry", "surface", "mesh", "material", "loads", "process", "tools"):
+        for name, v in numbers(getattr(s, section), section):
+            if name in MAY_BE_INFINITE:
+                _require(not math.isnan(v), name, f"must be a number (inf: flat), got {v}")
+            else:
+                _require(math.isfinite(v), name, f"must be finite, got {v}")
 
 
 def _validate_geometry(s: Scene) -> None:
@@ -436,7 +465,13 @@ def _validate_size(s: Scene) -> None:
     else:
         x0, x1, _, _ = outline.region_bounds(g)
         cells = budget.gmsh_cells(outline.region_area(g), (x1 - x0) / m.n, m.refine)
-    need, have = budget.estimated_bytes(cells, s.nonlinear or s.tools is not None), budget.available_bytes()
+    nonlinear = s.nonlinear or s.tools is not None
+    layers = s.process.thickness_points if "plasticity" in s.effects else 0  # a plastic section's points
+    need, have = budget.estimated_bytes(cells, nonlinear, layers=layers), budget.available_bytes()
+    usual = min(layers, Process().thickness_points)
+    _require(need <= have or budget.estimated_bytes(cells, nonlinear, layers=usual) > have, "process.thickness_points",
+             f"{layers:,} points through the thickness on {cells:,} cells need about {need / 1e9:.3g} GB; "
+             f"this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
     _require(need <= have, "mesh.n", f"n = {m.n} (refine {m.refine}) makes about {cells:,} cells, which need about "
              f"{need / 1e9:.3g} GB; this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
 

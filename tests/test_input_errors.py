@@ -1,5 +1,8 @@
 """Bad input gets a clear error naming the field, before any computation."""
 
+import tomllib
+from pathlib import Path
+
 import pytest
 from dolfinx import mesh
 from mpi4py import MPI
@@ -272,6 +275,117 @@ def test_cubic_membrane_on_a_supported_curved_edge_names_effects():
         linear.solve(s)
     assert err.value.field == "effects"
 
+
+# -- issue 30: symmetry lines, the thickness points' memory, non-finite numbers, polygons ------
+SQUARE_CUP = Path(__file__).resolve().parents[1] / "demos" / "square_cup.toml"
+DISC = {"shape": "circle", "radius": 1.0}
+
+
+def square_cup(supports=None, process=None) -> dict:
+    """demos/square_cup.toml as parsed TOML, with its [supports] (or [process]) replaced."""
+    data = tomllib.loads(SQUARE_CUP.read_text())
+    if supports is not None:
+        data["supports"] = supports
+    data["process"] = {**data.get("process", {}), **(process or {})}
+    return data
+
+
+@pytest.mark.parametrize("data, field", [
+    (square_cup(supports={}), "supports.left"),  # the quarter cup without its symmetry lines
+    (square_cup(supports={"left": "free", "bottom": "free"}), "supports.left"),
+    (square_cup(supports={"left": "symmetry"}), "supports.bottom"),
+    ({"geometry": {"region": "quarter"}, "supports": {"left": "symmetry", "bottom": "simply_supported"}},
+     "supports.bottom"),  # a hinge on the mirror line
+    ({"geometry": {**DISC, "region": "half"}, "mesh": {"kind": "unstructured"}, "supports": {"rim": "clamped"}},
+     "supports.bottom"),
+    ({"geometry": {**DISC, "region": "quarter"}, "mesh": {"kind": "unstructured"},
+      "supports": {"rim": "clamped", "bottom": "symmetry"}}, "supports.left"),
+])
+def test_a_half_or_quarter_needs_its_symmetry_lines(data, field):
+    assert_names_field(data, field)
+    with pytest.raises(InputError, match="mirrored across this edge.*needs 'symmetry'"):
+        scene.from_dict(data)
+
+
+def test_a_clamped_mirror_line_is_a_symmetric_model():
+    """Clamped (or clamped_sliding) holds all a mirror line needs: the whole blank clamped along it."""
+    s = scene.from_dict({"geometry": {"region": "quarter"}, "supports": {"left": "clamped", "bottom": "symmetry"}})
+    assert s.symmetry_copies == 4
+    scene.from_dict({"effects": SHEET, "geometry": {"region": "quarter"},
+                     "supports": {"left": "clamped_sliding", "bottom": "symmetry"}})
+
+
+def test_demo_scenes_still_validate():
+    for path in sorted(SQUARE_CUP.parent.glob("*.toml")):
+        scene.load(path)
+
+
+@pytest.mark.parametrize("thickness_points, field", [(1_000_000, "process.thickness_points"), (50, None)])
+def test_thickness_points_are_bounded_by_the_memory_budget(thickness_points, field):
+    """A million points through the thickness: numpy's Gauss rule alone asks for 7.28 TiB; refused
+    before anything is built, naming process.thickness_points; 50 points fit."""
+    data = square_cup(process={"thickness_points": thickness_points})
+    if field is None:
+        assert scene.from_dict(data).process.thickness_points == thickness_points
+        return
+    with pytest.raises(InputError) as err:
+        scene.from_dict(data)
+    assert err.value.field == field and "1,000,000 points through the thickness" in err.value.message
+    assert "GB" in err.value.message
+
+
+INF, NAN = float("inf"), float("nan")
+
+
+@pytest.mark.parametrize("data, field", [
+    ({"material": {"thickness": INF}}, "material.thickness"),
+    ({"material": {"thickness": NAN}}, "material.thickness"),
+    ({"material": {"E": INF}}, "material.E"),
+    ({"material": {"nu": NAN}}, "material.nu"),
+    ({"material": {"r": INF}}, "material.r"),
+    ({"material": {"m": INF}}, "material.m"),
+    ({"effects": PLASTIC, "material": {**POWER, "yield_stress": INF}}, "material.yield_stress"),
+    ({"geometry": {"lx": INF}}, "geometry.lx"),
+    ({"geometry": {**DISC, "radius": INF}, "mesh": {"kind": "unstructured"}}, "geometry.radius"),
+    ({"geometry": {"shape": "polygon", "vertices": [[0, 0], [1, 0], [0, INF]]}, "mesh": {"kind": "unstructured"}},
+     "geometry.vertices"),
+    ({"loads": {"pressure": NAN}}, "loads.pressure"),
+    ({"loads": {"point": [{"x": 0.0, "fz": INF}]}}, "loads.point[0].fz"),
+    ({"process": {"max_step": INF}}, "process.max_step"),
+    ({"process": {"rtol": NAN}}, "process.rtol"),
+    ({"process": {"path": [1.0, INF]}}, "process.path"),
+    ({"process": {"report": [INF]}}, "process.report"),
+    (cup(tools={"stroke": INF}), "tools.stroke"),
+])
+def test_inf_and_nan_must_be_finite(data, field):
+    with pytest.raises(InputError) as err:
+        scene.from_dict(data)
+    assert (err.value.field, err.value.message.split(",")[0]) == (field, "must be finite")
+
+
+def test_a_flat_surface_may_have_infinite_radii_but_not_nan():
+    assert scene.from_dict({"surface": {"R1": INF, "R2": INF}}).kappa0 == (0.0, 0.0)
+    assert_names_field({"surface": {"R1": NAN}}, "surface.R1")
+
+
+@pytest.mark.parametrize("vertices", [
+    [[0, 0], [4, 0], [4, 3], [2, 0], [0, 3]],  # vertex 3 on edge 1: two triangles pinched at a point
+    [[0, 0], [2, 0], [2, 2], [1, 0]],  # edge 4 runs back along edge 1
+    [[0, 0], [4, 0], [4, 4], [0, 0.0], [-1, 2]],  # vertex 3 repeats vertex 0
+])
+def test_a_polygon_vertex_on_another_edge_names_geometry_vertices(vertices):
+    with pytest.raises(InputError, match="lies on edge") as err:
+        scene.from_dict({"geometry": {"shape": "polygon", "vertices": vertices}, "mesh": {"kind": "unstructured"}})
+    assert err.value.field == "geometry.vertices"
+
+
+def test_sheet_model_says_an_infinite_thickness_must_be_finite():
+    from shellform.material import Hill79Material
+    from shellform.nonlinear.model import SheetModel
+
+    msh = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    with pytest.raises(InputError, match="material.thickness: must be finite, got inf"):
+        SheetModel(msh, Hill79Material(E=1.0, nu=0.3).pack(), float("inf"))
 
 @pytest.mark.parametrize("value", [-1.0, float("inf"), float("nan")])
 def test_checkpoint_interval_names_its_field(value):

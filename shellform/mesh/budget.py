@@ -6,7 +6,11 @@ Bytes per cell, measured on the 2-core machine (peak resident memory, `shellform
 - linear plate or shell: 5.4 kB per cell (square plate, 320k -> 1.28M cells: 1.8 -> 7.0 GB);
 - nonlinear sheet (layers, tangents, contact): about 50 kB per cell (square cup, 4,608 cells:
   0.82 GB with a base of about 0.6 GB);
-- a process's base (Python, DOLFINx, PETSc, the compiled kernels): 0.6 GB.
+- a process's base (Python, DOLFINx, PETSc, the compiled kernels): 0.6 GB;
+- each point through the thickness of a plastic section (process.thickness_points): its plastic
+  strain and p, committed and trial, 2 x (3 + 1) doubles at 6 quadrature points per cell (384 B),
+  and numpy's Gauss-Legendre rule of n points, which builds an n x n companion matrix and the
+  eigensolver's copy of it (16 n^2 bytes measured; 24 n^2 counted).
 The estimate is rounded up (6 and 60 kB) and meant to catch meshes that are orders of
 magnitude too large, not to predict a run's memory.
 """
@@ -17,6 +21,8 @@ import os
 LINEAR_BYTES_PER_CELL = 6e3
 NONLINEAR_BYTES_PER_CELL = 60e3
 BASE_BYTES = 0.6e9
+LAYER_BYTES_PER_CELL = 384
+RULE_BYTES_PER_POINT_SQUARED = 24
 
 
 def structured_ny(lx: float, ly: float, region: str, n: int) -> int:
@@ -63,6 +69,9 @@ def available_bytes() -> float:
     return float(min(limits))
 
 
-def estimated_bytes(cells: int, nonlinear: bool, ranks: int = 1) -> float:
+def estimated_bytes(cells: int, nonlinear: bool, ranks: int = 1, layers: int = 0) -> float:
+    """Peak memory of a run on that many cells; layers: the points through the thickness of a
+    plastic section (0: an elastic section, no layers)."""
     per_cell = NONLINEAR_BYTES_PER_CELL if nonlinear else LINEAR_BYTES_PER_CELL
-    return cells * per_cell + ranks * BASE_BYTES
+    return (cells * (per_cell + layers * LAYER_BYTES_PER_CELL) + RULE_BYTES_PER_POINT_SQUARED * float(layers) ** 2
+            + ranks * BASE_BYTES)

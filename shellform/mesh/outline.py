@@ -20,6 +20,7 @@ from mpi4py import MPI
 
 import dolfinx.mesh
 from shellform.errors import InputError
+from shellform.mesh import quality
 from shellform.mesh.blank_mesh import BlankMesh
 from shellform.mesh.gmsh_model import gmsh_session, mesh_on_root
 from shellform.mesh.rectangle import rectangle
@@ -45,6 +46,17 @@ def group_names(g) -> tuple[str, ...]:
     return _read_file(g.file, Path(g.file).stat().st_mtime)[0]
 
 
+def symmetry_lines(g) -> tuple[str, ...]:
+    """The groups of a [geometry] section on the mirror lines of a region that is part of the
+    blank: x = 0 and y = 0 of a quarter (left, bottom), y = 0 of a half (bottom). None for a
+    full region, a polygon or a file: their symmetry lines are the groups the scene declares."""
+    if g.shape == "rectangle":
+        return ("left", "bottom") if g.region == "quarter" else ()
+    if g.shape == "circle":
+        return {"full": (), "half": ("bottom",), "quarter": ("left", "bottom")}.get(g.region, ())
+    return ()
+
+
 def file_cells(g, n: int, refine: int) -> int:
     """Triangles a file blank makes: those of its mesh (a .msh), or a gmsh estimate from its
     bounding box at h = width / n (a .geo or CAD file), times 4^refine."""
@@ -65,6 +77,8 @@ def _read_file(path, mtime) -> tuple[tuple[str, ...], int, tuple[float, float]]:
             gmsh.open(str(path))
         except Exception as exc:  # noqa: BLE001  (gmsh raises plain Exceptions)
             raise InputError("geometry.file", f"gmsh cannot read {path}: {exc}") from None
+        if not gmsh.model.getEntities():
+            raise InputError("geometry.file", f"{path} holds no geometry and no mesh (an empty file?)")
         groups = tuple(n for _, n in _named_curves(gmsh)) or ("boundary",)
         triangles = sum(len(tags) for t, tags in zip(*gmsh.model.mesh.getElements(2)[:2]) if t == TRIANGLE)
         x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(-1, -1)
@@ -112,6 +126,15 @@ def polygon_problem(vertices) -> str | None:
             c, d = v[j], v[(j + 1) % n]
             if (cross(a, b, c) * cross(a, b, d) < 0) and (cross(c, d, a) * cross(c, d, b) < 0):
                 return f"edge {i + 1} crosses edge {j + 1}: the outline must not intersect itself"
+    for k in range(n):  # a vertex on an edge it does not end: the outline touches itself
+        for i in range(n):
+            if k in (i, (i + 1) % n):
+                continue
+            a, b = v[i], v[(i + 1) % n]
+            t = np.clip(np.dot(v[k] - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+            if np.hypot(*(a + t * (b - a) - v[k])) <= 1e-9 * scale:
+                return (f"vertex {k} {tuple(map(float, v[k]))} lies on edge {i + 1} (vertices {i} to {(i + 1) % n}): "
+                        "the outline must not touch itself")
     return None
 
 
@@ -219,6 +242,7 @@ def from_file(comm, path, n=8, refine=0) -> BlankMesh:
         if kinds != {TRIANGLE}:
             other = ", ".join(gmsh.model.mesh.getElementProperties(k)[0] for k in sorted(kinds - {TRIANGLE}))
             raise InputError("geometry.file", f"{path} holds {other}: shellform needs linear triangles only")
+        _check_triangles(gmsh, path)
         z = gmsh.model.mesh.getNodes()[1].reshape(-1, 3)[:, 2]
         if np.abs(z).max(initial=0.0) > 1e-9:
             raise InputError("geometry.file", f"{path}: the blank must lie in the plane z = 0 "
@@ -234,6 +258,20 @@ def from_file(comm, path, n=8, refine=0) -> BlankMesh:
     if not curves:  # no named curves: the whole boundary is one group
         return _whole_boundary(data.mesh)
     return _blank(data, [name for _, name in curves], tags={name: tag for tag, name in curves})
+
+
+def _check_triangles(gmsh, path):
+    """shellform.mesh.quality.check of the triangles DOLFINx gets: those of the file's physical
+    surfaces, or of all its surfaces where it names none."""
+    named = [e for _, g in gmsh.model.getPhysicalGroups(2) for e in gmsh.model.getEntitiesForPhysicalGroup(2, g)]
+    entities = sorted(set(named)) if named else [t for _, t in gmsh.model.getEntities(2)]
+    blocks = [gmsh.model.mesh.getElementsByType(TRIANGLE, e) for e in entities]
+    cells = np.concatenate([np.zeros(0, dtype=np.uint64)] + [c for c, _ in blocks])
+    nodes = np.concatenate([np.zeros(0, dtype=np.uint64)] + [v for _, v in blocks])
+    tags, x, _ = gmsh.model.mesh.getNodes()
+    order = np.argsort(tags)
+    index = order[np.searchsorted(tags, nodes, sorter=order)] if nodes.size else nodes
+    quality.check(x.reshape(-1, 3), index.reshape(-1, 3), cells, tags, source=str(path))
 
 
 def _generate(gmsh, h, refine):

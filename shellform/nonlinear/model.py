@@ -74,7 +74,9 @@ class SheetModel:
     def __init__(self, mesh, material, thickness: float, effects=("geometric_nonlinearity",),
                  thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4):
         check_mesh(mesh)
-        if not (np.isfinite(thickness) and thickness > 0):
+        if not np.isfinite(thickness):
+            raise InputError("material.thickness", f"must be finite, got {thickness}")
+        if not thickness > 0:
             raise InputError("material.thickness", f"must be > 0, got {thickness}")
         self.mesh, self.effects = mesh, tuple(effects)
         self.nonlinear = "geometric_nonlinearity" in self.effects
