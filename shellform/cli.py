@@ -60,21 +60,22 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
     from mpi4py import MPI
 
     from shellform import linear, scene
-    from shellform.results import fields
+    from shellform.results import fields, run_folder
     from shellform.results.tables import write_json
 
     s = scene.load(path)
-    outdir.mkdir(parents=True, exist_ok=True)
+    run_folder.check_writable(outdir)  # before any computation: InputError("--out")
     if s.tools is not None:
         from shellform.contact import run as contact_run
 
-        return contact_run.run(s, outdir, trace=trace, resume=resume)
+        return contact_run.run(s, outdir, trace=trace, resume=resume, scene_path=path)
     if resume:
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
     if s.nonlinear:
         from shellform.nonlinear import run as nonlinear_run
 
-        return nonlinear_run.run(s, outdir)
+        return nonlinear_run.run(s, outdir, scene_path=path)
+    run_folder.start(outdir, s, path)
     t0 = time.perf_counter()
     res = linear.solve(s)
     cells = res.cell_fields()
