@@ -3,7 +3,8 @@
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
                                             (--trace: a tool scene logs every contact iterate;
                                             --resume: a tool scene continues from DIR's last
-                                            converged state)
+                                            converged state; without it DIR is cleared of an
+                                            older run's files, or refused if another scene's)
     shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
                                             against time), strip (finite-strain plasticity against
                                             closed forms), assembly, newton (benchmarks), cup-hard
@@ -104,7 +105,9 @@ def main(argv=None) -> int:
     p_run.add_argument("scene", type=Path)
     p_run.add_argument("--out", type=Path, required=True)
     p_run.add_argument("--resume", action="store_true",
-                       help="a tool scene: continue from the last converged state in --out (longer stroke, other steps)")
+                       help="a tool scene: continue from the last converged state in --out, on any number of ranks, "
+                            "with this scene's stroke (not shorter), steps, friction and holder force; "
+                            "refused where anything else differs (docs/reliability.md)")
     p_run.add_argument("--trace", action="store_true",
                        help="tool scenes: log every contact pass, Newton step and iterate (diagnosis)")
     p_study = sub.add_parser("study", help="run a convergence study")

@@ -40,7 +40,6 @@ import json
 import time
 from pathlib import Path
 
-import numpy as np
 from mpi4py import MPI
 
 from shellform.contact import springback
@@ -66,6 +65,8 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     import csv
 
     saved = checkpoint.read(outdir, comm)
+    if not p.driver.fingerprint:
+        p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     differ, changed = run_folder.compare(saved.meta.get("fingerprint") or {}, p.driver.fingerprint)
     if differ:
         raise InputError("resume", f"the checkpoint {saved.path} was written for another scene, mesh or code: "
