@@ -151,31 +151,47 @@ def _never_meshed(monkeypatch):
 
 @pytest.mark.timeout(60)
 @pytest.mark.parametrize("scene", ["square_plate.toml", "square_cup.toml"])
-@pytest.mark.parametrize("where", ["an existing file", "under a file", "read-only"])
+@pytest.mark.parametrize("where", ["an existing file", "under a file", "read-only", "read-only mount"])
 def test_an_unwritable_out_is_an_input_error_before_any_computation(tmp_path, monkeypatch, capsys, scene, where):
     """--out naming a file, or a folder under a file (what fails for root too), or a read-only
-    folder (a normal user only: root writes there), exits 2 with one line naming --out, before
-    the scene is meshed; nothing is written. Today: FileExistsError / NotADirectoryError
+    folder (a normal user only: root writes there), or a read-only mount (every write there
+    fails with EROFS, for root too: simulated), exits 2 with one line naming --out, before the
+    scene is meshed; nothing is written. Today: FileExistsError / NotADirectoryError
     tracebacks, or an ADIOS2 abort after the whole computation."""
     if where == "read-only" and os.geteuid() == 0:
         pytest.skip("root writes into a read-only folder (chmod 555)")
     _never_meshed(monkeypatch)
     blocker = tmp_path / "a_file"
     blocker.write_text("not a folder\n")
-    out = {"an existing file": blocker, "under a file": blocker / "sub", "read-only": tmp_path / "ro"}[where]
+    out = {"an existing file": blocker, "under a file": blocker / "sub", "read-only": tmp_path / "ro",
+           "read-only mount": tmp_path / "mount"}[where]
     if where == "read-only":
         out.mkdir()
         out.chmod(0o555)
+    if where == "read-only mount":
+        import builtins
+        import errno
+
+        out.mkdir()
+        real_open = builtins.open
+
+        def read_only(file, mode="r", *args, **kwargs):
+            if any(c in mode for c in "wax+") and Path(file).resolve().is_relative_to(out):
+                raise OSError(errno.EROFS, "Read-only file system", str(file))
+            return real_open(file, mode, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", read_only)
     try:
         rc = cli.main(["run", str(ROOT / "demos" / scene), "--out", str(out)])
     finally:
         if where == "read-only":
             out.chmod(0o755)
+    monkeypatch.undo()
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2
     assert err and err[-1].startswith("shellform: input error: --out: ") and str(out) in err[-1]
     assert blocker.read_text() == "not a folder\n"
-    if where == "read-only":
+    if where.startswith("read-only"):
         assert list(out.iterdir()) == []
 
 

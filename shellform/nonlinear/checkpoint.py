@@ -43,12 +43,13 @@ class Numbering:
         imap = V.dofmap.index_map
         n_local = imap.size_local + imap.num_ghosts
         g = mesh.geometry
-        dofs, gdofs = V.dofmap.list, g.dofmaps[0] if hasattr(g, "dofmaps") else g.dofmap
-        if dofs.shape != gdofs.shape:
-            raise RuntimeError("checkpoints need a carrier with one node per geometry node")
-        inputs = np.asarray(g.input_global_indices, dtype=np.int64)
-        node = np.full(n_local, -1, dtype=np.int64)
-        node[dofs] = inputs[gdofs]  # a P1 carrier on a P1 geometry: the same vertex order per cell
+        dofs, gdofs = V.dofmap.list, g.dofmaps[0]
+        geometry_node = np.full(n_local, -1, dtype=np.int64)
+        geometry_node[dofs] = gdofs  # a P1 carrier on a P1 geometry: the same vertex order per cell
+        if dofs.shape != gdofs.shape or not np.allclose(V.tabulate_dof_coordinates()[:n_local],
+                                                          g.x[geometry_node]):
+            raise RuntimeError("checkpoints need a carrier with its nodes at the geometry's nodes")
+        node = np.asarray(g.input_global_indices, dtype=np.int64)[geometry_node]
         self.nodes = node[: imap.size_local]
         self.cells = np.asarray(mesh.topology.original_cell_index[:num_cells], dtype=np.int64)
         self.comm = mesh.comm
@@ -62,7 +63,7 @@ def mesh_hash(V) -> str:
     owned = g.index_map().size_local
     inputs = np.asarray(g.input_global_indices, dtype=np.int64)
     num_cells = mesh.topology.index_map(mesh.topology.dim).size_local
-    gdofs = g.dofmaps[0] if hasattr(g, "dofmaps") else g.dofmap
+    gdofs = g.dofmaps[0]
     pieces = comm.gather((inputs[:owned], g.x[:owned], mesh.topology.original_cell_index[:num_cells],
                           inputs[gdofs[:num_cells]]), root=0)
     digest = None
