@@ -494,22 +494,22 @@ class Driver:
         """Everything the next increment starts from, as of the last converged increment, in the
         groups of shellform.nonlinear.checkpoint: per owned node the carrier, per owned cell the
         material state, and the load factor."""
-        owned = self.q.function_space.dofmap.index_map.size_local
-        return {"nodes": {"q": self.q_n.reshape(owned + self._ghost_nodes(), -1)[:owned]},
-                "cells": dict(self.model.checkpoint()), "global": {"lam": np.array(self.lam)}}
+        return {"nodes": {"q": self._owned_nodes(self.q_n)}, "cells": dict(self.model.checkpoint()),
+                "global": {"lam": np.array(self.lam)}}
 
-    def _ghost_nodes(self) -> int:
-        return self.q.function_space.dofmap.index_map.num_ghosts
+    def _owned_nodes(self, values: np.ndarray) -> np.ndarray:
+        """A carrier array as rows of its owned nodes (a view)."""
+        imap = self.q.function_space.dofmap.index_map
+        return values.reshape(imap.size_local + imap.num_ghosts, -1)[: imap.size_local]
 
     def restore_state(self, state: dict, lam_scale: float = 1.0) -> None:
         """Continue from a checkpoint_state (this rank's rows; lam_scale: its load factor in this
         run's units)."""
-        owned = self.q.function_space.dofmap.index_map.size_local
-        q = self.q.x.array.reshape(owned + self._ghost_nodes(), -1)
-        if "q" not in state["nodes"] or state["nodes"]["q"].shape != q[:owned].shape:
+        q = self._owned_nodes(self.q.x.array)
+        if "q" not in state["nodes"] or state["nodes"]["q"].shape != q.shape:
             raise InputError("resume", "the checkpoint's carrier does not fit this model (another mesh)")
         self.model.restore(state["cells"])
-        q[:owned] = state["nodes"]["q"]
+        q[...] = state["nodes"]["q"]
         self.q.x.scatter_forward()
         self.q_n = self.q.x.array.copy()
         self.lam = float(state["global"]["lam"]) * lam_scale
