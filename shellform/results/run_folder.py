@@ -19,6 +19,7 @@ import os
 import shutil
 import time
 from dataclasses import asdict
+from fnmatch import fnmatch
 from functools import lru_cache
 from pathlib import Path
 
@@ -181,9 +182,15 @@ def resumed(outdir: Path, s, scene_path=None, comm=MPI.COMM_WORLD) -> None:
 
 
 def clear(outdir: Path) -> None:
-    """Remove what a shellform run writes (OUTPUTS) from outdir; nothing else."""
+    """Remove what a shellform run writes (OUTPUTS, and the temporary files of writes that a
+    kill interrupted: .NAME.PID.tmp) from outdir; nothing else."""
+    outdir = Path(outdir)
+    for f in outdir.glob(".*.*.tmp"):
+        name = f.name[1:].rsplit(".", 2)[0]
+        if any(fnmatch(name, pattern) for pattern in OUTPUTS):
+            f.unlink(missing_ok=True)
     for pattern in OUTPUTS:
-        for f in Path(outdir).glob(pattern):
+        for f in outdir.glob(pattern):
             if f.is_dir():
                 shutil.rmtree(f, ignore_errors=True)
             else:
