@@ -3,7 +3,8 @@
     shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
                                             (--trace: a tool scene logs every contact iterate;
                                             --resume: a tool scene continues from DIR's last
-                                            converged state)
+                                            converged state; without it DIR is cleared of an
+                                            older run's files, or refused if another scene's)
     shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
                                             against time), strip (finite-strain plasticity against
                                             closed forms), assembly, newton (benchmarks), cup-hard
@@ -61,21 +62,22 @@ def run_scene(path: Path, outdir: Path, trace: bool = False, resume: bool = Fals
     from mpi4py import MPI
 
     from shellform import linear, scene
-    from shellform.results import fields
+    from shellform.results import fields, run_folder
     from shellform.results.tables import write_json
 
     s = scene.load(path)
-    outdir.mkdir(parents=True, exist_ok=True)
+    run_folder.check_writable(outdir)  # before any computation: InputError("--out")
     if s.tools is not None:
         from shellform.contact import run as contact_run
 
-        return contact_run.run(s, outdir, trace=trace, resume=resume)
+        return contact_run.run(s, outdir, trace=trace, resume=resume, scene_path=path)
     if resume:
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
     if s.nonlinear:
         from shellform.nonlinear import run as nonlinear_run
 
-        return nonlinear_run.run(s, outdir)
+        return nonlinear_run.run(s, outdir, scene_path=path)
+    run_folder.start(outdir, s, path)
     t0 = time.perf_counter()
     res = linear.solve(s)
     cells = res.cell_fields()
@@ -104,7 +106,9 @@ def main(argv=None) -> int:
     p_run.add_argument("scene", type=Path)
     p_run.add_argument("--out", type=Path, required=True)
     p_run.add_argument("--resume", action="store_true",
-                       help="a tool scene: continue from the last converged state in --out (longer stroke, other steps)")
+                       help="a tool scene: continue from the last converged state in --out, on any number of ranks, "
+                            "with this scene's stroke (not shorter), steps, friction and holder force; "
+                            "refused where anything else differs (docs/reliability.md)")
     p_run.add_argument("--trace", action="store_true",
                        help="tool scenes: log every contact pass, Newton step and iterate (diagnosis)")
     p_study = sub.add_parser("study", help="run a convergence study")

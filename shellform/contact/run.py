@@ -27,8 +27,11 @@ Writes into the output folder (forces and draw-in for the whole blank):
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
                              after the tools withdraw (contact/springback.py); summary.json:
                              wall angle, flange edge, re-yield, residual resultants
-    last_converged.*         the last converged state (at every report, at the end, at a stop):
+    checkpoint.npz           the last converged state (at every report, at the end, at a stop),
+                             any number of ranks, and the one before (checkpoint.previous.npz):
                              `shellform run SCENE --out DIR --resume` continues from it
+    history.json             every increment so far (with the checkpoint)
+    run.json                 the run: scene file and hash, title, code version, started, resumed
 
 DX, DY, DD: shellform.results.cup.
 """
@@ -37,14 +40,14 @@ import json
 import time
 from pathlib import Path
 
-import numpy as np
 from mpi4py import MPI
 
 from shellform.contact import springback
 from shellform.contact.problem import DrawingProblem
 from shellform.errors import InputError
+from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
-from shellform.results import cup
+from shellform.results import cup, run_folder
 from shellform.results.log import Progress
 from shellform.results.tables import write_csv, write_json
 from shellform.scene import Scene
@@ -54,36 +57,28 @@ from shellform.scene import Scene
 CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
 
 
-def fingerprint(s: Scene, comm) -> dict:
-    """What a checkpoint must share with the scene that resumes it: the blank and its mesh, the
-    material, the effects that shape the state, the section, the tools' shapes and the ranks.
-    (Stroke, friction, holder force, steps and reports may change.)"""
-    tools = {k: v for k, v in vars(s.tools).items() if k not in ("stroke", "friction", "blank_holder_force")}
-    return {"geometry": vars(s.geometry), "mesh": vars(s.mesh), "material": vars(s.material),
-            "effects": sorted(e for e in s.effects if e != "friction"),
-            "thickness_points": s.process.thickness_points, "tools": tools, "ranks": comm.size}
-
-
-def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list]:
-    """Restore the last converged state in outdir; the force-stroke rows and reports up to it."""
+def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list, dict]:
+    """Restore the last complete checkpoint in outdir (checkpoint.read: the previous one where
+    the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
+    or where it lies past this scene's stroke; the force-stroke rows and reports up to it, and
+    what the summary records of the resume."""
     import csv
 
-    path = outdir / f"last_converged.rank{comm.rank}.npz"
-    if not path.exists():
-        raise InputError("resume", f"no checkpoint {path}: run the scene into {outdir} first")
-    data = np.load(path)
-    saved = json.loads(str(data["fingerprint"]))
-    now = json.loads(json.dumps(fingerprint(s, comm), default=str))
-    differ = []
-    for k, v in now.items():
-        if isinstance(v, dict):
-            differ += [f"{k}.{f}" for f in v if saved.get(k, {}).get(f) != v[f]]
-        elif saved.get(k) != v:
-            differ.append(k)
+    saved = checkpoint.read(outdir, comm)
+    if not p.driver.fingerprint:
+        p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
+    differ, changed = run_folder.compare(saved.meta.get("fingerprint") or {}, p.driver.fingerprint)
     if differ:
-        raise InputError("resume", f"the checkpoint {path} was written for another scene or mesh: "
+        raise InputError("resume", f"the checkpoint {saved.path} was written for another scene, mesh or code: "
                                    f"{', '.join(differ)} differ")
-    p.driver.restore_state(data)
+    glob = saved.arrays
+    at = float(glob["global.lam"]) * abs(float(glob["global.contact_travel"][0]))
+    if at > s.tools.stroke * (1 + 1e-12) + 1e-12:
+        raise InputError("tools.stroke", f"{s.tools.stroke:g} mm is shorter than the stroke of the checkpoint "
+                                         f"{saved.path}, {at:.6g} mm: resume with a stroke of at least that")
+    for line in saved.damaged:
+        p.driver.progress.note(f"shellform: resume: {line}; using {saved.path}")
+    p.driver.resume(saved)
     upto = p.stroke + 1e-9
     curve, reports = [], []
     if (outdir / "force_stroke.csv").exists():
@@ -91,22 +86,26 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
             curve = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f) if float(r["stroke_mm"]) <= upto]
     if (outdir / "reports.json").exists():
         reports = [r for r in json.loads((outdir / "reports.json").read_text()) if r["stroke_mm"] <= upto]
-    return curve, reports
+    info = {"from_stroke_mm": p.stroke, "checkpoint": saved.path.name, "damaged": saved.damaged,
+            "increments_before": len(p.driver.history), "changed": changed}
+    return curve, reports, info
 
 
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) -> dict:
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> dict:
     """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
     continue from the last converged state in outdir (written at every report, at the end and
-    at a stop), with this scene's stroke, steps, friction and holder force."""
+    at a stop), with this scene's stroke, steps, friction and holder force (the summary's
+    "resumed" records what changed); without resume the folder is this run's alone
+    (run_folder.start). scene_path: the scene's file, for run.json."""
     outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
+    run_folder.start(outdir, s, scene_path, resume, comm)
     t0 = time.perf_counter()
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
-    p.driver.fingerprint = json.dumps(fingerprint(s, comm), default=str)
+    p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     curve, reports, stopped, resumed = [], [], None, None
     if resume:
-        curve, reports = _resume(p, s, outdir, comm)
-        resumed = p.stroke
+        curve, reports, resumed = _resume(p, s, outdir, comm)
+        run_folder.resumed(outdir, s, scene_path, comm)
     setup_s = time.perf_counter() - t0
     series = cup.CupSeries(p, outdir / "cup.bp") if s.output.vtx else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
@@ -172,7 +171,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False) 
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "element_evaluations": {"run": d.evaluations, "reused": d.reused, "tangents": d.tangents},
-        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "resumed_from_stroke_mm": resumed,
+        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,
+        "resumed_from_stroke_mm": resumed["from_stroke_mm"] if resumed else None, "resumed": resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
     }

@@ -172,6 +172,7 @@ class SemiInverseDriver(Driver):
         self.x_n = self.X[:n].copy()  # positions at the start of the increment
         self.lam_n = 0.0
         self.pinched = np.zeros(n, dtype=bool)
+        self.pinched_n = self.pinched.copy()  # of the last converged increment
         self._under = np.zeros(n, dtype=bool)  # under the holder in this increment (_pinch)
         self._previous = None  # the committed state before the last (the predictor's)
         self._r_prev, self._omega = None, 1.0
@@ -924,40 +925,49 @@ class SemiInverseDriver(Driver):
         self._previous = {"lam": self.lam_n, "tool": c.tool, "normal": c.normal}
         self.committed = s.copy()
         self.x_n = self.positions()
+        self.pinched_n = self.pinched.copy()
         self.lam_n = self._lam_trial
         if self.model.plastic:
             _, e33 = self._nodal_areas_and_thickness_strain()
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
 
     # -- checkpoints -------------------------------------------------------------------------
-    STATE = ("tool", "pressure", "holder_face", "normal", "friction", "closed", "lift")
+    NODES = ("tool", "pressure", "holder_face", "normal", "friction")  # ContactState, per owned node
+    GLOBAL = ("closed", "lift")  # ContactState, the holder's (the same on every rank)
 
     def checkpoint_state(self) -> dict:
-        """The sheet's state and the contact's: the committed contact set, forces and friction
-        history, the holder's state, the pinched nodes, positions and thicknesses of the last
-        converged increment."""
-        c = self.committed
-        return {**super().checkpoint_state(), **{f"contact_{k}": getattr(c, k) for k in self.STATE},
-                "contact_pinched": self.pinched, "contact_x_n": self.x_n, "contact_lam_n": self.lam_n,
-                "contact_half_thickness": self.half_thickness, "contact_travel": self.travel}
+        """The sheet's state and the contact's, as of the last converged increment: per owned
+        node the committed contact set, forces and friction history, the pinched nodes, the
+        positions and half thicknesses; the holder's state, the load factor and the tools'
+        travel (shellform.nonlinear.checkpoint numbers the nodes globally)."""
+        c, own = self.committed, super().checkpoint_state()
+        own["nodes"].update({f"contact_{k}": getattr(c, k) for k in self.NODES})
+        own["nodes"].update({"contact_pinched": self.pinched_n, "contact_x_n": self.x_n,
+                             "contact_half_thickness": self.half_thickness})
+        own["global"].update({f"contact_{k}": getattr(c, k) for k in self.GLOBAL})
+        own["global"].update({"contact_lam_n": np.array(self.lam_n), "contact_travel": self.travel})
+        return own
 
-    def restore_state(self, data, lam_scale: float | None = None) -> None:
-        """As Driver's; the load factor is rescaled to this run's tool travel (a longer or
-        shorter stroke continues from the same punch position)."""
+    def restore_state(self, state: dict, lam_scale: float | None = None) -> None:
+        """As Driver's; the load factor is rescaled to this run's tool travel (a longer stroke
+        continues from the same punch position)."""
+        nodes, glob = state["nodes"], state["global"]
         if lam_scale is None:
-            lam_scale = float(data["contact_travel"][0] / self.travel[0])
-        super().restore_state(data, lam_scale)
-        if data["contact_tool"].shape != self.state.tool.shape:
+            lam_scale = float(glob["contact_travel"][0] / self.travel[0])
+        super().restore_state(state, lam_scale)
+        if nodes["contact_tool"].shape != self.state.tool.shape:
             raise InputError("resume", "the checkpoint's contact state does not fit this model")
         c = ContactState(self.n_owned)
-        for k in self.STATE:
-            if f"contact_{k}" in data:  # (a checkpoint from before the lift: closed or no force)
-                getattr(c, k)[...] = data[f"contact_{k}"]
+        for k in self.NODES:
+            getattr(c, k)[...] = nodes[f"contact_{k}"]
+        for k in self.GLOBAL:
+            getattr(c, k)[...] = glob[f"contact_{k}"]
         self.committed, self.state = c, c.copy()
-        self.pinched = data["contact_pinched"].copy()
-        self.x_n = data["contact_x_n"].copy()
-        self.lam_n = float(data["contact_lam_n"]) * lam_scale
-        self.half_thickness = data["contact_half_thickness"].copy()
+        self.pinched = nodes["contact_pinched"].copy()
+        self.pinched_n = self.pinched.copy()
+        self.x_n = nodes["contact_x_n"].copy()
+        self.lam_n = float(glob["contact_lam_n"]) * lam_scale
+        self.half_thickness = nodes["contact_half_thickness"].copy()
         self._previous = None
 
     def _restore_converged(self):

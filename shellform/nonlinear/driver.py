@@ -23,7 +23,6 @@ grow by 1.5. Below min_step the run stops with ConvergenceFailure, after writing
 converged state to disk. Nothing non-finite is ever committed.
 """
 
-import json
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -35,9 +34,11 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from shellform.errors import InputError
+from shellform.nonlinear import checkpoint
 from shellform.nonlinear.free_rows import FreeRowsLU, lu_solver
 from shellform.nonlinear.interrupt import Interrupted, StopRequests
 from shellform.results.log import Progress
+from shellform.results.tables import write_json
 
 
 class ConvergenceFailure(RuntimeError):
@@ -114,9 +115,11 @@ class Driver:
         self.verbose = verbose
         self.progress = Progress()  # a run sets its own (label, total, unit)
         self.stops = StopRequests(model.mesh.comm)  # Ctrl-C and SIGTERM while it steps (interrupt.py)
-        self.fingerprint = ""  # what a checkpoint must match to be resumed (set by a run)
+        self.fingerprint = {}  # what defines the run, written into its checkpoints (set by a run)
+        self._numbering = None  # the checkpoints' global numbers of nodes and cells (numbering())
         V = model.V
         self.q = fem.Function(V, name="carrier")
+        self.q_n = self.q.x.array.copy()  # the carrier of the last converged increment
         self.prescribed = prescribed  # Function with qbar on the Dirichlet dofs (or None: zero)
         self.bc_dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])).astype(np.int32) \
             if bcs else np.zeros(0, dtype=np.int32)
@@ -512,6 +515,7 @@ class Driver:
                         f"the step fell below min_step {c.min_step:g}"), path)
                 self._dlam_prev = None  # no extrapolation after a failure
             self._commit()
+            self.q_n = self.q.x.array.copy()
             reversal = False
             x_prev = x_n
             self.lam = lam
@@ -533,31 +537,59 @@ class Driver:
 
     # -- disk ----------------------------------------------------------------------------------
     def checkpoint_state(self) -> dict:
-        """Everything the next increment starts from: load factor, carrier, material state."""
-        return {"lam": self.lam, "q": self.q.x.array, **self.model.checkpoint()}
+        """Everything the next increment starts from, as of the last converged increment, in the
+        groups of shellform.nonlinear.checkpoint: per owned node the carrier, per owned cell the
+        material state, and the load factor."""
+        return {"nodes": {"q": self._owned_nodes(self.q_n)}, "cells": dict(self.model.checkpoint()),
+                "global": {"lam": np.array(self.lam)}}
 
-    def restore_state(self, data, lam_scale: float = 1.0) -> None:
-        """Continue from a checkpoint_state (lam_scale: its load factor in this run's units)."""
-        if "q" not in data or data["q"].shape != self.q.x.array.shape:
-            raise InputError("resume", "the checkpoint's carrier does not fit this model (another mesh or "
-                                       "number of ranks)")
-        self.model.restore(data)
-        self.q.x.array[:] = data["q"]
+    def _owned_nodes(self, values: np.ndarray) -> np.ndarray:
+        """A carrier array as rows of its owned nodes (a view)."""
+        imap = self.q.function_space.dofmap.index_map
+        return values.reshape(imap.size_local + imap.num_ghosts, -1)[: imap.size_local]
+
+    def restore_state(self, state: dict, lam_scale: float = 1.0) -> None:
+        """Continue from a checkpoint_state (this rank's rows; lam_scale: its load factor in this
+        run's units)."""
+        q = self._owned_nodes(self.q.x.array)
+        if "q" not in state["nodes"] or state["nodes"]["q"].shape != q.shape:
+            raise InputError("resume", "the checkpoint's carrier does not fit this model (another mesh)")
+        self.model.restore(state["cells"])
+        q[...] = state["nodes"]["q"]
         self.q.x.scatter_forward()
-        self.lam = float(data["lam"]) * lam_scale
+        self.q_n = self.q.x.array.copy()
+        self.lam = float(state["global"]["lam"]) * lam_scale
         self._direction = 1.0 if self.lam > 0 else None
         self._dlam_prev = None
 
+    def numbering(self) -> checkpoint.Numbering:
+        """The global numbers of this rank's nodes and cells in a checkpoint (made once)."""
+        if self._numbering is None:
+            self._numbering = checkpoint.Numbering(self.model.V, self.model.num_cells)
+        return self._numbering
+
     def save_checkpoint(self):
-        """The last converged state (checkpoint_state, per rank, npz, with the run's fingerprint)
-        and the history (json)."""
+        """Write the last converged state (checkpoint_state, gathered into one rank-independent
+        file by rank 0, with the run's fingerprint and the history of every increment so far) as
+        checkpoint_dir/checkpoint.npz, keeping the one before (shellform.nonlinear.checkpoint);
+        and the history as history.json. Collective; safe at any time of a run (it writes the
+        state of the last converged increment, not a Newton iterate). Returns the path (None
+        without a checkpoint_dir)."""
         if self.checkpoint_dir is None:
             return None
-        d = self.checkpoint_dir
-        d.mkdir(parents=True, exist_ok=True)
-        rank = self.model.mesh.comm.rank
-        path = d / f"last_converged.rank{rank}.npz"
-        np.savez(path, fingerprint=self.fingerprint, **self.checkpoint_state())
-        if rank == 0:
-            (d / "history.json").write_text(json.dumps([asdict(h) for h in self.history], indent=1))
+        history = [asdict(h) for h in self.history]
+        path = checkpoint.save(self.checkpoint_dir, self.numbering(), self.checkpoint_state(),
+                               {"fingerprint": self.fingerprint, "history": history})
+        write_json(self.checkpoint_dir / "history.json", history)
         return path
+
+    def resume(self, saved: checkpoint.Checkpoint, lam_scale: float | None = None) -> None:
+        """Continue from a checkpoint read by shellform.nonlinear.checkpoint.read (written on any
+        number of ranks): its state (restore_state) and its history, so that the increments,
+        iterations and cut-backs counted afterwards are the whole run's."""
+        state = saved.local(self.numbering())
+        if lam_scale is None:
+            self.restore_state(state)
+        else:
+            self.restore_state(state, lam_scale)
+        self.history = [Increment(**h) for h in saved.meta.get("history", [])]

@@ -178,8 +178,8 @@ class SheetModel:
                  ("lever_before", self._lever_before))
         for key, target in pairs:
             if key not in data or data[key].shape != target.shape:
-                raise InputError("resume", f"the checkpoint's {key!r} does not fit this model (another mesh, "
-                                           "effects or number of ranks)")
+                raise InputError("resume", f"the checkpoint's {key!r} does not fit this model (another mesh "
+                                           "or effects)")
         for key, target in pairs:
             target[...] = data[key]
         self.ep[...], self.p[...], self.stretch[...], self.lever[...] = self.ep_n, self.p_n, self.stretch_n, self.stretch_n

@@ -8,8 +8,10 @@ Writes into the output folder:
     nodal.bp, cells.bp the final state for ParaView (displacement, slopes; plastic and thickness
                        strain per cell)
     deformed.png       the final shape (serial runs)
-    last_converged.*   only if the run stops (no convergence, a limit load, Ctrl-C or SIGTERM):
-                       the last converged state
+    checkpoint.npz     only if the run stops (no convergence, a limit load, Ctrl-C or SIGTERM): the
+                       last converged state (nonlinear/checkpoint.py;
+                       `--resume` continues tool scenes only)
+    run.json           the run: scene file and hash, title, code version, started
 """
 
 import time
@@ -19,12 +21,13 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from shellform.mesh import blank
+from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure, Controls
 from shellform.nonlinear.interrupt import Interrupted
 from shellform.nonlinear.loads import EdgeMoment, PointForce, SheetLoads
 from shellform.nonlinear.problem import SheetProblem
 from shellform.scene import Scene
-from shellform.results import fields
+from shellform.results import fields, run_folder
 from shellform.results.log import Progress
 from shellform.results.tables import write_csv, write_json
 
@@ -65,11 +68,14 @@ def _record(p: SheetProblem, s: Scene) -> dict:
             "max_equivalent_plastic_strain": peq, "min_thickness_strain": e33}
 
 
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD) -> dict:
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> dict:
+    """Step the scene's load path into outdir, which is this run's alone (run_folder.start);
+    scene_path: the scene's file, for run.json."""
     outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
+    run_folder.start(outdir, s, scene_path, comm=comm)
     t0 = time.perf_counter()
     p = problem(s, comm, outdir)
+    p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     setup_s = time.perf_counter() - t0
     reports, stopped, signum = [], None, 0
     p.driver.progress = Progress("load factor", max(abs(x) for x in s.process.path))

@@ -1,22 +1,63 @@
-"""Tables and summaries on disk: CSV (rows of dicts) and JSON, written by rank 0."""
+"""Tables and summaries on disk: CSV (rows of dicts) and JSON, written by rank 0.
+
+Every file is written whole or not at all (write_atomically): into a temporary file in the same
+folder, flushed and synced to the disk, then renamed over the final name, and the folder synced;
+a kill or a full disk during the write leaves the previous file as it was (docs/reliability.md).
+"""
 
 import csv
+import io
 import json
+import os
 from pathlib import Path
 
 from mpi4py import MPI
 
 
+def sync_folder(folder: Path) -> None:
+    """Make the renames in `folder` durable (fsync of the directory; a no-op where the system
+    cannot open a directory)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def write_atomically(path: Path, write, binary: bool = False) -> None:
+    """Call write(f) on a temporary file next to `path`, flush and fsync it, then os.replace it
+    onto `path` and fsync the folder: readers see the old file or the new one, never a part."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb" if binary else "w", **({} if binary else {"newline": ""})) as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    sync_folder(path.parent)
+
+
 def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
     if MPI.COMM_WORLD.rank != 0:
         return
-    with open(path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=columns, extrasaction="ignore")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+    write_atomically(path, lambda f: f.write(text.getvalue()))
 
 
 def write_json(path: Path, data: dict) -> None:
     if MPI.COMM_WORLD.rank == 0:
-        Path(path).write_text(json.dumps(data, indent=2, default=float) + "\n")
+        text = json.dumps(data, indent=2, default=float) + "\n"
+        write_atomically(path, lambda f: f.write(text))

@@ -1,0 +1,197 @@
+"""The output folder of a run (--out): checked before any computation, and owned by one run.
+
+check_writable   the folder is created (with its parents) and proven writable by creating and
+                 removing a probe file, on every rank; else InputError("--out").
+start            run.json, the manifest of the run in the folder: the scene file, the scene's
+                 hash, its title, the code version, when it started (and when it was resumed).
+                 A run without --resume starts afresh: it removes the files a shellform run
+                 writes there (OUTPUTS: summaries, tables, pictures, fields, checkpoints), so that
+                 nothing of an older run is mixed with its own, and it refuses a folder that
+                 holds another scene's run (another scene file and another content), naming that
+                 run's title and scene file.
+fingerprint      what defines a run's state (scene content but for the knobs of how to continue,
+                 the files it reads, the code version, the mesh), and how it continues.
+"""
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from dataclasses import asdict
+from fnmatch import fnmatch
+from functools import lru_cache
+from pathlib import Path
+
+from mpi4py import MPI
+
+import shellform
+from shellform.errors import InputError
+from shellform.results.tables import write_json
+
+MANIFEST = "run.json"
+# what shellform's runs write into --out (contact/run.py, nonlinear/run.py, cli.py's linear scenes)
+OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "force_stroke.csv",
+           "force_stroke.png", "thickness_*.csv", "fld.csv", "fld.png", "cup.png", "cup_margin.png",
+           "springback.csv", "springback.png", "deformed.png", "cup.bp", "cup_cells.bp", "nodal.bp", "cells.bp", "checkpoint.npz",
+           "checkpoint.previous.npz", ".checkpoint.npz.new", "last_converged.rank*.npz")
+# what may change when a run is resumed ("how to continue"; `shellform run --resume`)
+CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force", "effects.friction",
+            "process.initial_step", "process.min_step", "process.max_step", "process.max_iterations",
+            "process.rtol", "process.path", "process.report", "process.springback", "output.vtx",
+            "output.png", "output.fld")
+
+
+def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:
+    """Create outdir and prove it writable (a probe file created and removed) on every rank;
+    InputError("--out") naming the cause on all ranks where any fails."""
+    outdir = Path(outdir)
+    error = None
+    if outdir.exists() and not outdir.is_dir():
+        error = f"{outdir} is a file, not a folder"
+    else:
+        try:
+            outdir.mkdir(parents=True, exist_ok=True)
+            probe = outdir / f".shellform-probe.{os.getpid()}.rank{comm.rank}"
+            with open(probe, "w") as f:
+                f.write("probe\n")
+                f.flush()
+                os.fsync(f.fileno())
+            probe.unlink()
+        except OSError as err:
+            error = f"cannot write into {outdir} ({err.strerror or type(err).__name__})"
+    errors = [e for e in comm.allgather(error) if e]
+    if errors:
+        raise InputError("--out", errors[0])
+
+
+def _file_digest(path: str) -> str:
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+    except OSError:
+        return "unreadable"
+
+
+def scene_record(s) -> dict:
+    """The validated scene as flat fields ("tools.stroke": 30.0), each file it reads by its
+    content's hash; "effects" without friction and "effects.friction" on its own."""
+    flat = {}
+
+    def walk(prefix, value):
+        if isinstance(value, dict) and prefix.split(".")[0] != "supports":
+            for k, v in value.items():
+                walk(f"{prefix}.{k}" if prefix else k, v)
+        else:
+            flat[prefix] = value
+
+    data = asdict(s)
+    walk("", data)
+    if flat.get("geometry.file"):
+        flat["geometry.file"] = {"name": Path(flat["geometry.file"]).name,
+                                 "sha256": _file_digest(flat["geometry.file"])}
+    effects = list(s.effects)
+    flat["effects"] = sorted(e for e in effects if e != "friction")
+    flat["effects.friction"] = "friction" in effects
+    return json.loads(json.dumps(flat, default=str))
+
+
+def scene_hash(s) -> str:
+    return hashlib.sha256(json.dumps(scene_record(s), sort_keys=True).encode()).hexdigest()[:16]
+
+
+@lru_cache(maxsize=1)
+def code_version() -> str:
+    """shellform's version and a hash of its sources (the package and its forms): any change of
+    the code gives another version."""
+    root = Path(shellform.__file__).resolve().parent
+    h = hashlib.sha256()
+    folders = [root] + [f for f in (root / "forms", root.parent / "forms") if f.is_dir()]
+    for folder in folders:
+        for f in sorted(folder.rglob("*.py")):
+            h.update(str(f.relative_to(folder)).encode())
+            h.update(f.read_bytes())
+    return f"{shellform.__version__}+src.{h.hexdigest()[:12]}"
+
+
+def fingerprint(s, mesh: str) -> dict:
+    """What defines a run and its checkpoint: "state" (the scene's fields but CONTINUE, the code
+    version, the mesh's hash), which a resume must match, and "continue" (CONTINUE's fields),
+    which may differ."""
+    record = scene_record(s)
+    return {"state": {**{k: v for k, v in record.items() if k not in CONTINUE},
+                      "code_version": code_version(), "mesh": mesh},
+            "continue": {k: record[k] for k in CONTINUE if k in record}}
+
+
+def compare(saved: dict, now: dict) -> tuple[list[str], dict]:
+    """(the state fields that differ, {continue field: {"checkpoint": old, "now": new}})."""
+    old, new = saved.get("state", {}), now["state"]
+    differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+    before, after = saved.get("continue", {}), now["continue"]
+    changed = {k: {"checkpoint": before.get(k), "now": after.get(k)} for k in sorted(set(before) | set(after))
+               if before.get(k) != after.get(k)}
+    return differ, changed
+
+
+def read_manifest(outdir: Path) -> dict | None:
+    try:
+        return json.loads((Path(outdir) / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def start(outdir: Path, s, scene_path=None, resume: bool = False, comm=MPI.COMM_WORLD) -> dict | None:
+    """Check outdir (check_writable), and make it this run's: without resume, refuse another
+    scene's run or clear the older run's outputs, and write run.json (returned). With resume
+    nothing changes yet: the resume's checks come first, then resumed() updates run.json."""
+    outdir = Path(outdir)
+    check_writable(outdir, comm)
+    if resume:
+        return None
+    scene_path = str(Path(scene_path).resolve()) if scene_path else None
+    digest = scene_hash(s)
+    error, manifest = None, None
+    if comm.rank == 0:
+        old = read_manifest(outdir)
+        if old and old.get("scene") and scene_path and old["scene"] != scene_path \
+                and old.get("scene_hash") != digest:
+            error = (f"{outdir} holds the run of another scene, {old.get('title')!r} ({old['scene']}): "
+                     "choose another folder, or remove that run first")
+        else:
+            now = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+            manifest = {"scene": scene_path, "scene_hash": digest, "title": s.title,
+                        "code_version": code_version(), "started": now, "resumed": []}
+            clear(outdir)
+            write_json(outdir / MANIFEST, manifest)
+    error, manifest = comm.bcast((error, manifest), root=0)
+    if error:
+        raise InputError("--out", error)
+    return manifest
+
+
+def resumed(outdir: Path, s, scene_path=None, comm=MPI.COMM_WORLD) -> None:
+    """run.json after a resume's checks passed: this scene, the run's start, and the resume's
+    time appended to "resumed"."""
+    if comm.rank == 0:
+        old = read_manifest(outdir) or {}
+        now = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+        write_json(Path(outdir) / MANIFEST, {
+            "scene": str(Path(scene_path).resolve()) if scene_path else None, "scene_hash": scene_hash(s),
+            "title": s.title, "code_version": code_version(), "started": old.get("started", now),
+            "resumed": old.get("resumed", []) + [now]})
+
+
+def clear(outdir: Path) -> None:
+    """Remove what a shellform run writes (OUTPUTS, and the temporary files of writes that a
+    kill interrupted: .NAME.PID.tmp) from outdir; nothing else."""
+    outdir = Path(outdir)
+    for f in outdir.glob(".*.*.tmp"):
+        name = f.name[1:].rsplit(".", 2)[0]
+        if any(fnmatch(name, pattern) for pattern in OUTPUTS):
+            f.unlink(missing_ok=True)
+    for pattern in OUTPUTS:
+        for f in outdir.glob(pattern):
+            if f.is_dir():
+                shutil.rmtree(f, ignore_errors=True)
+            else:
+                f.unlink(missing_ok=True)

@@ -1,0 +1,330 @@
+"""What survives a kill, and what a resume may and may not continue (docs/reliability.md):
+checkpoints written whole or not at all, the previous one kept; --out checked before any
+computation; a run's folder its own; a resume refused for another state or a shorter stroke;
+the counts of the whole run; checkpoints that resume on another number of ranks."""
+
+import io
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from resume_cup import cup, killed_after_first_report
+
+from shellform import cli
+from shellform.contact import run as contact_run
+from shellform.contact.semi_inverse import SemiInverseDriver
+from shellform.errors import InputError
+from shellform.studies.common import mpiexec
+
+ROOT = Path(__file__).resolve().parents[1]
+COUNTS = ("increments", "newton_iterations", "contact_passes", "cutbacks")
+
+
+class Killed(Exception):
+    pass
+
+
+@pytest.fixture(scope="module")
+def whole(tmp_path_factory):
+    """The short cup run uninterrupted: (its folder, with the checkpoints at 0.5 and 1 mm, and its summary)."""
+    out = tmp_path_factory.mktemp("whole")
+    return out, contact_run.run(cup(), out)
+
+
+def assert_same_end(summary, reference, rel=1e-9):
+    a, b = summary["reports"][-1], reference["reports"][-1]
+    assert summary["stroke_mm"] == pytest.approx(reference["stroke_mm"])
+    assert a["punch_force_kN"] == pytest.approx(b["punch_force_kN"], rel=rel)
+    assert a["draw_in_mm"]["DD"] == pytest.approx(b["draw_in_mm"]["DD"], rel=rel, abs=1e-9)
+    assert a["max_thickness_strain"] == pytest.approx(b["max_thickness_strain"], rel=rel)
+
+
+@pytest.mark.timeout(300)
+def test_a_kill_while_a_checkpoint_is_written_keeps_the_one_before(tmp_path, whole, monkeypatch):
+    """The second checkpoint's write dies halfway (the first half of its bytes written, then
+    the process killed): the first checkpoint is still whole, and --resume continues from it to
+    the uninterrupted run's end (today: the half-written file had replaced it, BadZipFile)."""
+    real, calls = np.savez, []
+
+    def dies_halfway(file, *args, **kwargs):
+        calls.append(1)
+        if len(calls) < 2:
+            return real(file, *args, **kwargs)
+        buf = io.BytesIO()
+        real(buf, *args, **kwargs)
+        half = buf.getvalue()[: len(buf.getvalue()) // 2]
+        if hasattr(file, "write"):
+            file.write(half)
+        else:
+            Path(file).write_bytes(half)
+        raise Killed
+
+    monkeypatch.setattr(np, "savez", dies_halfway)
+    with pytest.raises(Killed):
+        contact_run.run(cup(), tmp_path)
+    monkeypatch.setattr(np, "savez", real)
+    assert len(calls) == 2
+    summary = contact_run.run(cup(), tmp_path, resume=True)
+    assert summary["resumed_from_stroke_mm"] == pytest.approx(0.5)
+    assert_same_end(summary, whole[1])
+
+
+@pytest.mark.timeout(300)
+def test_a_damaged_checkpoint_is_named_and_the_previous_one_used(tmp_path, whole, capsys):
+    """checkpoint.npz cut to half its length (what an in-place write leaves): the resume says
+    that file is damaged, takes checkpoint.previous.npz (0.5 mm) and ends where the
+    uninterrupted run ends."""
+    shutil.copytree(whole[0], tmp_path / "out")
+    out = tmp_path / "out"
+    data = (out / "checkpoint.npz").read_bytes()
+    (out / "checkpoint.npz").write_bytes(data[: len(data) // 2])
+    summary = contact_run.run(cup(), out, resume=True)
+    assert summary["resumed"]["checkpoint"] == "checkpoint.previous.npz"
+    assert summary["resumed_from_stroke_mm"] == pytest.approx(0.5)
+    damaged = summary["resumed"]["damaged"]
+    assert len(damaged) == 1 and str(out / "checkpoint.npz") in damaged[0] and "damaged" in damaged[0]
+    assert f"{out / 'checkpoint.npz'}: damaged" in capsys.readouterr().out
+    assert_same_end(summary, whole[1])
+
+
+def test_summaries_and_tables_survive_a_full_disk(tmp_path, monkeypatch):
+    """write_json and write_csv (summary.json, reports.json, the CSVs a resume reads) that
+    fail halfway through their write (a full disk: half the bytes written, then ENOSPC) leave
+    the file before them whole, and no temporary file (today: a cut file)."""
+    import builtins
+    import errno
+
+    from shellform.results import tables
+
+    tables.write_json(tmp_path / "summary.json", {"a": 1})
+    tables.write_csv(tmp_path / "rows.csv", [{"x": 1.0}], ["x"])
+    real_open = io.open
+
+    class FullDisk:
+        def __init__(self, f):
+            self.f = f
+
+        def write(self, data):
+            self.f.write(data[: len(data) // 2])
+            self.f.flush()
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+        def __getattr__(self, name):
+            return getattr(self.f, name)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.f.close()
+
+    def full_disk_open(file, mode="r", *args, **kwargs):
+        f = real_open(file, mode, *args, **kwargs)
+        return FullDisk(f) if "w" in mode else f
+
+    with monkeypatch.context() as m:
+        m.setattr(builtins, "open", full_disk_open)
+        m.setattr(io, "open", full_disk_open)
+        with pytest.raises(OSError):
+            tables.write_json(tmp_path / "summary.json", {"b": 2, "c": list(range(100))})
+        with pytest.raises(OSError):
+            tables.write_csv(tmp_path / "rows.csv", [{"x": 2.0}] * 100, ["x"])
+    assert json.loads((tmp_path / "summary.json").read_text()) == {"a": 1}
+    assert (tmp_path / "rows.csv").read_text().splitlines() == ["x", "1"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rows.csv", "summary.json"]
+
+
+def _never_meshed(monkeypatch):
+    """Meshing or solving raises: the --out check must come first."""
+    from shellform import linear
+    from shellform.contact.problem import DrawingProblem
+
+    def computed(*args, **kwargs):
+        raise AssertionError("computed before --out was checked")
+
+    monkeypatch.setattr(DrawingProblem, "from_scene", classmethod(computed))
+    monkeypatch.setattr(linear, "solve", computed)
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("scene", ["square_plate.toml", "square_cup.toml"])
+@pytest.mark.parametrize("where", ["an existing file", "under a file", "read-only", "read-only mount"])
+def test_an_unwritable_out_is_an_input_error_before_any_computation(tmp_path, monkeypatch, capsys, scene, where):
+    """--out naming a file, or a folder under a file (what fails for root too), or a read-only
+    folder (a normal user only: root writes there), or a read-only mount (every write there
+    fails with EROFS, for root too: simulated), exits 2 with one line naming --out, before the
+    scene is meshed; nothing is written. Today: FileExistsError / NotADirectoryError
+    tracebacks, or an ADIOS2 abort after the whole computation."""
+    if where == "read-only" and os.geteuid() == 0:
+        pytest.skip("root writes into a read-only folder (chmod 555)")
+    _never_meshed(monkeypatch)
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder\n")
+    out = {"an existing file": blocker, "under a file": blocker / "sub", "read-only": tmp_path / "ro",
+           "read-only mount": tmp_path / "mount"}[where]
+    if where == "read-only":
+        out.mkdir()
+        out.chmod(0o555)
+    if where == "read-only mount":
+        import builtins
+        import errno
+
+        out.mkdir()
+        real_open = builtins.open
+
+        def read_only(file, mode="r", *args, **kwargs):
+            if any(c in mode for c in "wax+") and Path(file).resolve().is_relative_to(out):
+                raise OSError(errno.EROFS, "Read-only file system", str(file))
+            return real_open(file, mode, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", read_only)
+    try:
+        rc = cli.main(["run", str(ROOT / "demos" / scene), "--out", str(out)])
+    finally:
+        if where == "read-only":
+            out.chmod(0o755)
+    monkeypatch.undo()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2
+    assert err and err[-1].startswith("shellform: input error: --out: ") and str(out) in err[-1]
+    assert blocker.read_text() == "not a folder\n"
+    if where.startswith("read-only"):
+        assert list(out.iterdir()) == []
+
+
+@pytest.mark.timeout(120)
+def test_another_scenes_folder_is_refused_without_resume(tmp_path, capsys):
+    """Scene B (another file, other content) run into the folder of scene A's run: exit 2
+    naming --out, A's title and A's scene file; A's results stay as they were."""
+    a = tmp_path / "a.toml"
+    a.write_text((ROOT / "demos" / "square_plate.toml").read_text())
+    b = tmp_path / "b.toml"
+    b.write_text((ROOT / "demos" / "square_plate.toml").read_text().replace("pressure = 1.0", "pressure = 2.0")
+                 .replace('title = "square plate', 'title = "scene B: square plate'))
+    out = tmp_path / "out"
+    assert cli.main(["run", str(a), "--out", str(out)]) == 0
+    before = (out / "summary.json").read_text()
+    manifest = json.loads((out / "run.json").read_text())
+    assert manifest["scene"] == str(a.resolve()) and manifest["title"].startswith("square plate")
+    capsys.readouterr()
+    assert cli.main(["run", str(b), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("shellform: input error: --out: ") and str(a.resolve()) in err and "square plate a = 1" in err
+    assert (out / "summary.json").read_text() == before
+    # the same scene file again (edited or not) starts afresh in its own folder
+    assert cli.main(["run", str(a), "--out", str(out)]) == 0
+
+
+@pytest.mark.timeout(120)
+def test_scene_b_killed_in_a_finished_folder_then_resumed_reports_nothing_of_a(tmp_path, whole, monkeypatch):
+    """Scene A's finished run in the folder; scene B (another holder force and friction: what a
+    resume may change) run into it and killed before its first checkpoint; then --resume: no
+    checkpoint of B's is there, so the resume is refused, and none of A's outputs is left to be
+    taken for B's. Today: exit 0 and a summary with B's title and A's numbers."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    b = cup()
+    b.title, b.tools.blank_holder_force, b.tools.friction = "scene B", 0.5 * b.tools.blank_holder_force, 0.05
+
+    def killed(self, *args, **kwargs):
+        raise Killed
+
+    with monkeypatch.context() as m:
+        m.setattr(SemiInverseDriver, "run", killed)
+        with pytest.raises(Killed):
+            contact_run.run(b, out)
+    for name in ("summary.json", "reports.json", "force_stroke.csv", "checkpoint.npz", "checkpoint.previous.npz"):
+        assert not (out / name).exists(), name
+    with pytest.raises(InputError) as err:
+        contact_run.run(b, out, resume=True)
+    assert err.value.field == "resume" and "no usable checkpoint" in str(err.value)
+
+
+@pytest.mark.timeout(120)
+def test_a_resume_names_what_differs_and_records_what_changed(tmp_path, whole):
+    """Another material (what defines the state) is refused, naming the field; a longer stroke,
+    another holder force and friction (how to continue) are taken, and the summary records them."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    other = cup()
+    other.material.thickness *= 1.1
+    with pytest.raises(InputError) as err:
+        contact_run.run(other, out, resume=True)
+    assert err.value.field == "resume" and "material.thickness" in str(err.value)
+    longer = cup()
+    longer.tools.stroke, longer.tools.blank_holder_force = 1.1, 0.9 * longer.tools.blank_holder_force
+    summary = contact_run.run(longer, out, resume=True)
+    changed = summary["resumed"]["changed"]
+    assert set(changed) == {"tools.stroke", "tools.blank_holder_force"}
+    assert changed["tools.stroke"] == {"checkpoint": 1.0, "now": 1.1}
+    assert summary["stroke_mm"] == pytest.approx(1.1)
+
+
+@pytest.mark.timeout(120)
+def test_a_resume_with_a_shorter_stroke_says_so(tmp_path, whole):
+    """The checkpoint is at 1 mm; a resume with a stroke of 0.8 mm is refused naming
+    tools.stroke and both strokes (today: exit 0, reporting 1 mm as the new scene's)."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    shorter = cup()
+    shorter.tools.stroke = 0.8
+    with pytest.raises(InputError) as err:
+        contact_run.run(shorter, out, resume=True)
+    assert err.value.field == "tools.stroke" and "0.8 mm" in str(err.value) and "1 mm" in str(err.value)
+
+
+@pytest.mark.timeout(300)
+def test_the_counts_after_a_resume_are_the_whole_runs(tmp_path, whole):
+    """Killed after the first report and resumed: increments, Newton iterations, contact passes
+    and cut-backs count the whole run (the increments before the checkpoint from its saved
+    history), the same as the uninterrupted run's; history.json lists them all."""
+    killed_after_first_report(tmp_path)
+    summary = contact_run.run(cup(), tmp_path, resume=True)
+    for key in COUNTS:
+        assert summary[key] == whole[1][key], key
+    assert summary["resumed"]["increments_before"] > 0
+    history = json.loads((tmp_path / "history.json").read_text())
+    assert [h["number"] for h in history] == list(range(1, whole[1]["increments"] + 1))
+
+
+RANKS = """
+import json, sys
+sys.path.insert(0, "TESTS")
+import shellform
+from mpi4py import MPI
+from resume_cup import cup, killed_after_first_report
+from shellform.contact import run as contact_run
+if "MODE" == "kill":
+    killed_after_first_report("OUT")
+    out = {}
+else:
+    s = contact_run.run(cup(), "OUT", resume=True)
+    out = {k: s[k] for k in ("increments", "newton_iterations", "reports", "stroke_mm", "resumed_from_stroke_mm")}
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps(out))
+"""
+
+
+@pytest.mark.mpi
+@pytest.mark.timeout(600)
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_a_checkpoint_resumes_on_another_number_of_ranks(tmp_path, whole):
+    """The cup checkpointed on 1 rank resumes on 2, and checkpointed on 2 resumes on 1: each
+    ends where the uninterrupted serial run ends, to the solver tolerance (today: refused,
+    one file per rank)."""
+    from test_mpi import on_two_ranks
+
+    def script(mode, out):
+        return RANKS.replace("TESTS", str(Path(__file__).parent)).replace("MODE", mode).replace("OUT", str(out))
+
+    killed_after_first_report(tmp_path / "one")
+    two = on_two_ranks(tmp_path, script("resume", tmp_path / "one"))
+    on_two_ranks(tmp_path, script("kill", tmp_path / "two"))
+    one = contact_run.run(cup(), tmp_path / "two", resume=True)
+    for summary in (two, one):
+        assert summary["resumed_from_stroke_mm"] == pytest.approx(0.5)
+        assert summary["increments"] == whole[1]["increments"]
+        assert_same_end(summary, whole[1], rel=1e-6)
