@@ -95,3 +95,79 @@ def test_ctrl_c_to_mpiexec_stops_every_rank_at_the_same_increment(tmp_path):
     assert err.count("stopped by the user (SIGINT)") == 1 and "Traceback" not in err, err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["ranks"] == 2 and summary["increments"] == len(lines) >= 3
+
+
+def small_cup(every: float = 60.0) -> str:
+    """demos/square_cup.toml on 6 x 6, 1 mm of stroke in 0.05 to 0.1 mm steps, a report at
+    0.5 mm, no pictures (the cup of tests/resume_cup.py), as a scene file's text."""
+    text = (Path(__file__).resolve().parents[1] / "demos" / "square_cup.toml").read_text()
+    for old, new in (("[mesh]\nn = 16", "[mesh]\nn = 6"), ("stroke = 30.0", "stroke = 1.0"),
+                     ("initial_step = 0.002", "initial_step = 0.05"), ("max_step = 0.008", "max_step = 0.1"),
+                     ("springback = true", "springback = false")):
+        assert old in text
+        text = text.replace(old, new)
+    return text + f"\n[output]\nvtx = false\npng = false\nfld = false\ncheckpoint_every = {every}\n"
+
+
+def run_cli(*args) -> subprocess.CompletedProcess:
+    return subprocess.run([str(Path(sys.executable).parent / "shellform"), "run", *map(str, args)],
+                          capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.timeout(600)
+def test_ctrl_c_mid_stroke_then_resume_equals_the_uninterrupted_draw(tmp_path):
+    """SIGINT half-way through a cup's stroke (between two reports): exit 130, a summary marked
+    'stopped by the user (SIGINT) at S mm', and --resume from that state ends where the
+    uninterrupted run ends (the same increments, punch force, draw-in and thinning to 1e-9):
+    the checkpoint carries how the next increment starts (its step, the predictor's last state
+    and the contact's normal forces before it)."""
+    (tmp_path / "scene.toml").write_text(small_cup())
+    whole = run_cli(tmp_path / "scene.toml", "--out", tmp_path / "whole")
+    assert whole.returncode == 0, whole.stderr
+    done = json.loads((tmp_path / "whole" / "summary.json").read_text())
+    (tmp_path / "cut").mkdir()
+    code, err, lines, out = interrupted_run(tmp_path / "cut", small_cup(), signal.SIGINT,
+                                            after=done["increments"] // 2 + 1)
+    assert code == 130 and "stopped by the user (SIGINT) at" in err, err
+    stopped = json.loads((out / "summary.json").read_text())
+    assert 0.5 < stopped["stroke_mm"] < 1.0 and stopped["signal"] == signal.SIGINT
+    resumed = run_cli(tmp_path / "cut" / "scene.toml", "--out", out, "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    again = json.loads((out / "summary.json").read_text())
+    assert again["resumed"]["from_stroke_mm"] == pytest.approx(stopped["stroke_mm"], rel=1e-12)
+    assert again["increments"] == done["increments"] and again["stroke_mm"] == pytest.approx(1.0)
+    for key in ("newton_iterations", "cutbacks"):
+        assert again[key] == done[key]
+    a, b = done["reports"][-1], again["reports"][-1]
+    assert b["punch_force_kN"] == pytest.approx(a["punch_force_kN"], rel=1e-9)
+    for k in ("DX", "DD"):
+        assert b["draw_in_mm"][k] == pytest.approx(a["draw_in_mm"][k], rel=1e-9, abs=1e-12)
+    assert b["max_thickness_strain"] == pytest.approx(a["max_thickness_strain"], rel=1e-9)
+    assert len(again["reports"]) == len(done["reports"])
+
+
+@pytest.mark.timeout(600)
+def test_a_killed_run_resumes_from_its_last_timed_checkpoint(tmp_path):
+    """output.checkpoint_every writes the last converged increment between reports: a run
+    killed outright (SIGKILL, nothing handled) half-way between two reports resumes from an
+    increment past the last report, and ends where the uninterrupted run ends with the same
+    force-stroke curve."""
+    import csv
+
+    (tmp_path / "scene.toml").write_text(small_cup())
+    whole = run_cli(tmp_path / "scene.toml", "--out", tmp_path / "whole")
+    assert whole.returncode == 0, whole.stderr
+    done = json.loads((tmp_path / "whole" / "summary.json").read_text())
+    (tmp_path / "cut").mkdir()
+    code, err, lines, out = interrupted_run(tmp_path / "cut", small_cup(every=1e-9), signal.SIGKILL,
+                                            after=done["increments"] // 2 + 2)
+    assert code == -signal.SIGKILL
+    resumed = run_cli(tmp_path / "cut" / "scene.toml", "--out", out, "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    again = json.loads((out / "summary.json").read_text())
+    assert 0.5 < again["resumed"]["from_stroke_mm"] < 1.0
+    assert again["increments"] == done["increments"]
+    assert again["reports"][-1]["punch_force_kN"] == pytest.approx(done["reports"][-1]["punch_force_kN"], rel=1e-9)
+    rows = [list(csv.DictReader(open(d / "force_stroke.csv"))) for d in (tmp_path / "whole", out)]
+    assert [r["stroke_mm"] for r in rows[1]] == [r["stroke_mm"] for r in rows[0]]
+    assert float(rows[1][-1]["punch_force_kN"]) == pytest.approx(float(rows[0][-1]["punch_force_kN"]), rel=1e-9)

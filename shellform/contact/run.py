@@ -27,7 +27,8 @@ Writes into the output folder (forces and draw-in for the whole blank):
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
                              after the tools withdraw (contact/springback.py); summary.json:
                              wall angle, flange edge, re-yield, residual resultants
-    checkpoint.npz           the last converged state (at every report, at the end, at a stop),
+    checkpoint.npz           the last converged state (at every report, every output.checkpoint_every
+                             seconds, at the end, at a stop: no convergence, Ctrl-C, SIGTERM),
                              any number of ranks, and the one before (checkpoint.previous.npz):
                              `shellform run SCENE --out DIR --resume` continues from it
     history.json             every increment so far (with the checkpoint)
@@ -47,6 +48,7 @@ from shellform.contact.problem import DrawingProblem
 from shellform.errors import InputError
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
+from shellform.nonlinear.interrupt import Interrupted
 from shellform.results import cup, run_folder
 from shellform.results.log import Progress
 from shellform.results.tables import write_csv, write_json
@@ -102,13 +104,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     t0 = time.perf_counter()
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
     p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
-    curve, reports, stopped, resumed = [], [], None, None
+    curve, reports, stopped, resumed, signum = [], [], None, None, 0
     if resume:
         curve, reports, resumed = _resume(p, s, outdir, comm)
         run_folder.resumed(outdir, s, scene_path, comm)
     setup_s = time.perf_counter() - t0
     series = cup.CupSeries(p, outdir / "cup.bp") if s.output.vtx else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
+    saved_at = [time.monotonic()]  # when the last checkpoint was written
 
     def on_increment(d):
         h = d.history[-1]
@@ -121,10 +124,23 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                       "holder_held_down": p.holder_held_down(), "free_under_closed_holder": p.free_under_holder(),
                       "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
+        every = s.output.checkpoint_every  # the last converged increment on disk at least this often
+        if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
+            checkpoint_now()
+
+    def checkpoint_now():
+        """The curve so far, then the state it ends at: a resume takes the curve's rows up to the
+        checkpoint's stroke."""
+        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
+        p.driver.save_checkpoint()
+        saved_at[0] = time.monotonic()
+
+    def state() -> dict:
+        return {"stroke_mm": p.stroke, "draw_in_mm": cup.draw_in(p), "punch_force_kN": p.punch_force() / 1e3,
+                **cup.peak_thinning(p), "volume_change": p.model.volume_change()}
 
     def report():
-        reports.append({"stroke_mm": p.stroke, "draw_in_mm": cup.draw_in(p), "punch_force_kN": p.punch_force() / 1e3,
-                        **cup.peak_thinning(p), "volume_change": p.model.volume_change()})
+        reports.append(state())
         write_json(outdir / "reports.json", reports)  # what a resumed run takes over
         write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
         if series is not None:
@@ -136,11 +152,16 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                 continue  # reached before the resumed state
             p.driver.run(target, on_increment=on_increment)
             report()
-            p.driver.save_checkpoint()
+            checkpoint_now()
     except ConvergenceFailure as err:
         stopped = str(err)
         p.driver.progress.note(f"shellform: stopped: {err}")
         report()
+    except Interrupted as err:  # the driver wrote the state; the curve up to it, and no report
+        stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal
+        p.driver.progress.note(f"shellform: {stopped}")
+        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
+        reports.append(state())  # in the summary only: a resumed run reports where the scene says
     p.driver.progress.close()
     if series is not None:
         series.close()
@@ -157,8 +178,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         before = cup.profiles(p.driver, p.driver.X)
         try:
             released = springback.release(p.driver)
-        except ConvergenceFailure as err:  # the drawn state is kept and reported; springback is not
+        except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
             sprung = {"stopped": str(err)}
+            if isinstance(err, Interrupted):
+                stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
         else:
             sprung = cup.springback(outdir, p, s.title, before, released)
     summary = {
@@ -171,7 +194,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "element_evaluations": {"run": d.evaluations, "reused": d.reused, "tangents": d.tangents},
-        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped,
+        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
         "resumed_from_stroke_mm": resumed["from_stroke_mm"] if resumed else None, "resumed": resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},

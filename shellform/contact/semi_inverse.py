@@ -945,7 +945,12 @@ class SemiInverseDriver(Driver):
         own["nodes"].update({"contact_pinched": self.pinched_n, "contact_x_n": self.x_n,
                              "contact_half_thickness": self.half_thickness})
         own["global"].update({f"contact_{k}": getattr(c, k) for k in self.GLOBAL})
-        own["global"].update({"contact_lam_n": np.array(self.lam_n), "contact_travel": self.travel})
+        own["global"].update({"contact_lam_n": np.array(self.lam_n), "contact_travel": self.travel,
+                              "contact_early_step": np.array(self.contact.early_step)})  # the fallback's
+        if self._previous is not None:  # the predictor's: the committed set before the last
+            own["nodes"].update({"contact_previous_tool": self._previous["tool"],
+                                 "contact_previous_normal": self._previous["normal"]})
+            own["global"]["contact_previous_lam"] = np.array(self._previous["lam"])
         return own
 
     def restore_state(self, state: dict, lam_scale: float | None = None) -> None:
@@ -968,7 +973,13 @@ class SemiInverseDriver(Driver):
         self.x_n = nodes["contact_x_n"].copy()
         self.lam_n = float(glob["contact_lam_n"]) * lam_scale
         self.half_thickness = nodes["contact_half_thickness"].copy()
+        if "contact_early_step" in glob:
+            self.contact.early_step = float(glob["contact_early_step"])
         self._previous = None
+        if "contact_previous_lam" in glob:
+            self._previous = {"lam": float(glob["contact_previous_lam"]) * lam_scale,
+                              "tool": nodes["contact_previous_tool"].copy(),
+                              "normal": nodes["contact_previous_normal"].copy()}
 
     def _restore_converged(self):
         """The committed contact state and its forces (a stop reports the last converged state)."""

@@ -143,6 +143,8 @@ class Driver:
                                   imap.local_range[0] * V.dofmap.index_map_bs)
         self._dlam_prev = None
         self._direction = None
+        self._steps = None  # between two increments of run(): (the next dlam, the last one, q before it)
+        self._resumed_steps = None  # (dlam, dlam_prev, q_prev) a checkpoint gave the next run() to step on with
         self._floor = 0.0
         self._cause = ""  # why the last Newton attempt failed, in words
         self.searching = True  # the energy line search on; an increment that fails swaps it once
@@ -484,9 +486,13 @@ class Driver:
         direction = 1.0 if target >= self.lam else -1.0
         reversal = self._direction is not None and direction != self._direction
         self._direction = direction
-        dlam = min(c.initial_step, abs(target - self.lam))
-        x_prev = self.q.x.array.copy()
-        self._dlam_prev = None  # nothing to extrapolate from at a new target
+        resumed, self._resumed_steps = self._resumed_steps, None
+        if resumed is not None:  # a checkpoint written between two increments: step on as it would have
+            dlam, self._dlam_prev, x_prev = resumed
+        else:
+            dlam = min(c.initial_step, abs(target - self.lam))
+            x_prev = self.q.x.array.copy()
+            self._dlam_prev = None  # nothing to extrapolate from at a new target
         while abs(target - self.lam) > 1e-14:
             dlam = min(dlam, abs(target - self.lam))
             x_n = self.q.x.array.copy()
@@ -528,11 +534,13 @@ class Driver:
                     lam, inc.number, sum(h.iterations for h in self.history),
                     f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "
                     f"|R| {res[0]:.2e} -> {res[-1]:.2e}  plastic layers {ev.plastic_layers}")
+            if its <= c.easy_iterations and cutbacks == 0:
+                dlam = min(dlam * c.growth, c.max_step)
+            self._steps = (dlam, self._dlam_prev, x_n)  # the next step; this one and the state before it (the predictor's)
             if on_increment is not None:
                 on_increment(self)
             self._stop_if_requested()
-            if its <= c.easy_iterations and cutbacks == 0:
-                dlam = min(dlam * c.growth, c.max_step)
+        self._steps = None  # the next target starts its steps afresh
         return self.history
 
     # -- disk ----------------------------------------------------------------------------------
@@ -540,8 +548,13 @@ class Driver:
         """Everything the next increment starts from, as of the last converged increment, in the
         groups of shellform.nonlinear.checkpoint: per owned node the carrier, per owned cell the
         material state, and the load factor."""
-        return {"nodes": {"q": self._owned_nodes(self.q_n)}, "cells": dict(self.model.checkpoint()),
-                "global": {"lam": np.array(self.lam)}}
+        state = {"nodes": {"q": self._owned_nodes(self.q_n)}, "cells": dict(self.model.checkpoint()),
+                 "global": {"lam": np.array(self.lam), "searching": np.array(self.searching)}}
+        if self._steps is not None:  # between two increments of a target: how the next one starts
+            dlam, dlam_prev, q_prev = self._steps
+            state["nodes"]["q_prev"] = self._owned_nodes(q_prev)
+            state["global"].update({"next_dlam": np.array(dlam), "dlam_prev": np.array(dlam_prev)})
+        return state
 
     def _owned_nodes(self, values: np.ndarray) -> np.ndarray:
         """A carrier array as rows of its owned nodes (a view)."""
@@ -558,9 +571,17 @@ class Driver:
         q[...] = state["nodes"]["q"]
         self.q.x.scatter_forward()
         self.q_n = self.q.x.array.copy()
-        self.lam = float(state["global"]["lam"]) * lam_scale
+        glob = state["global"]
+        self.lam = float(glob["lam"]) * lam_scale
         self._direction = 1.0 if self.lam > 0 else None
         self._dlam_prev = None
+        self.searching = bool(glob.get("searching", True))
+        if "q_prev" in state["nodes"]:  # written between two increments: the next run() steps on from there
+            q[...] = state["nodes"]["q_prev"]
+            self.q.x.scatter_forward()
+            q_prev = self.q.x.array.copy()
+            self.q.x.array[:] = self.q_n
+            self._resumed_steps = (float(glob["next_dlam"]) * lam_scale, float(glob["dlam_prev"]) * lam_scale, q_prev)
 
     def numbering(self) -> checkpoint.Numbering:
         """The global numbers of this rank's nodes and cells in a checkpoint (made once)."""
