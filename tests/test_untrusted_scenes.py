@@ -2,7 +2,7 @@
 time: its gmsh files (docs/scenes.md, What a .geo file may do), its expressions (Reference
 surface) and its paths (Paths in a scene)."""
 
-import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -151,3 +151,53 @@ def test_a_geo_may_include_and_merge_files_of_its_folder(tmp_path):
     b = blank(MPI.COMM_SELF, s)
     assert b.mesh.topology.index_map(2).size_local > 10
     assert set(b.groups) == {"edge"}
+
+
+# -- item 2: expressions are checked in bounded time and memory -----------------------------
+CURVED = {"effects": ["bending", "membrane", "shallow_curvature"], "mesh": {"n": 2}}
+
+
+@pytest.mark.timeout(10)
+@pytest.mark.parametrize("z0, says", [
+    ("9**9**9", "cannot be evaluated"),  # an integer power of 370 million digits: overflows as floats
+    ("-" * 200_000 + "x", "longer than 1000 characters"),  # once a MemoryError from the parser
+    ("-" * 500 + "x", "nested too deeply"),
+    ("sin(x, y)", "sin takes one argument, got 2"),  # once a TypeError traceback
+    ("sin()", "sin takes one argument, got 0"),
+    ("sqrt(x=1)", "sqrt takes one argument"),
+    ("True", "is no number"),
+])
+def test_a_surface_expression_is_refused_in_bounded_time(z0, says):
+    with pytest.raises(InputError) as err:
+        scene.from_dict({**CURVED, "surface": {"z0": z0}})
+    assert err.value.field == "surface.z0"
+    assert says in err.value.message
+
+
+@pytest.mark.timeout(120)
+def test_a_surface_not_finite_on_the_blank_names_z0_and_a_point():
+    """sqrt(x) on the square [-0.5, 0.5]^2 once failed in the linear solve (PETSc reason -11)."""
+    from shellform import linear
+
+    s = scene.from_dict({**CURVED, "surface": {"z0": "0.1*sqrt(x)"}, "supports": {"left": "clamped"}})
+    with pytest.raises(InputError) as err:
+        linear.solve(s)
+    assert err.value.field == "surface.z0"
+    at = re.search(r"not finite at \((\S+), (\S+)\)", err.value.message)
+    assert at and float(at.group(1)) <= 0.0  # sqrt(x) and its slopes: not finite where x <= 0
+
+
+@pytest.mark.timeout(120)
+def test_slopes_not_finite_on_the_blank_are_named():
+    """sqrt(x + 0.5) is finite on [-0.5, 0.5]^2; its slope is not, at x = -0.5."""
+    from mpi4py import MPI
+
+    from shellform.mesh import blank
+
+    s = scene.from_dict({**CURVED, "surface": {"z0": "0.1*sqrt(x + 0.5)"}})
+    with pytest.raises(InputError) as err:
+        blank(MPI.COMM_WORLD, s)
+    assert err.value.field == "surface.z0"
+    assert "its slopes are not finite at (-0.5, " in err.value.message
+    fine = scene.from_dict({**CURVED, "surface": {"z0": "0.1*sqrt(x + 0.6)"}})
+    assert blank(MPI.COMM_WORLD, fine).mesh.topology.index_map(2).size_local == 8

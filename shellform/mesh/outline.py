@@ -274,4 +274,20 @@ def blank(comm, scene, points=()) -> BlankMesh:
     else:
         out = from_file(comm, g.file, m.n, m.refine)
     check_symmetry_lines(out, scene.supports)
+    _check_reference_surface(out.mesh, scene)
     return out
+
+
+def _check_reference_surface(msh, scene) -> None:
+    """z0 of a curved scene and its first and second derivatives are finite on its mesh, before
+    any form takes them (sqrt(x) on a blank with x < 0 would fail in the linear solve)."""
+    from shellform.forms.reference_surface import ReferenceSurface
+
+    surface = scene.curvature()
+    if not isinstance(surface, ReferenceSurface):
+        return
+    bad = surface.nonfinite_point(msh)
+    if bad is not None:
+        what, (x, y) = bad
+        raise InputError("surface.z0", f"{surface.source!r}: {what} {'is' if what == 'z0' else 'are'} not finite at ({x:.6g}, {y:.6g}) "
+                         "of the blank's mesh")
