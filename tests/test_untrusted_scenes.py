@@ -201,3 +201,48 @@ def test_slopes_not_finite_on_the_blank_are_named():
     assert "its slopes are not finite at (-0.5, " in err.value.message
     fine = scene.from_dict({**CURVED, "surface": {"z0": "0.1*sqrt(x + 0.6)"}})
     assert blank(MPI.COMM_WORLD, fine).mesh.topology.index_map(2).size_local == 8
+
+
+# -- item 3: a scene writes nothing outside --out --------------------------------------------
+def tree(root: Path) -> set[Path]:
+    return {p.relative_to(root) for p in root.rglob("*")}
+
+
+@pytest.mark.timeout(300)
+def test_a_scene_with_hostile_strings_writes_only_under_out(tmp_path, monkeypatch):
+    """Every string of the scene that could name a file is hostile: the title, the physical names
+    of its .geo (the boundary groups [supports] names), the file's own path."""
+    from shellform import cli
+
+    folder, out, cwd = tmp_path / "a" / "b", tmp_path / "a" / "b" / "out", tmp_path / "a" / "b" / "cwd"
+    (folder / "meshes").mkdir(parents=True)
+    cwd.mkdir()
+    monkeypatch.chdir(cwd)
+    hostile = ["../../x", "/tmp/../x", "..", "summary.json/../../y"]
+    (folder / "meshes" / "blank.geo").write_text(
+        SQUARE.replace('Physical Curve("edge") = {1, 2, 3, 4};', "".join(
+            f'Physical Curve("{name}") = {{{i + 1}}};' for i, name in enumerate(hostile))))
+    toml = folder / "scene.toml"
+    toml.write_text(
+        'title = "../../x/../$\\\\frac{$ %s {0} \\u0000 ..\\\\..\\\\z"\n'
+        'effects = ["bending", "membrane", "shallow_curvature"]\n'
+        '[geometry]\nshape = "file"\nfile = "../b/meshes/../meshes/blank.geo"\n'
+        '[surface]\nz0 = "0.01*x*y"\n[mesh]\nkind = "unstructured"\nn = 4\n[loads]\npressure = 1.0\n'
+        "[supports]\n" + "".join(f'"{name}" = "clamped"\n' for name in hostile))
+    before = tree(tmp_path)
+    assert cli.main(["run", str(toml), "--out", str(out)]) == 0
+    new = tree(tmp_path) - before
+    assert {p for p in new if out not in (tmp_path / p).parents and tmp_path / p != out} == set()
+    assert {"summary.json", "nodal.bp", "deformed.png"} <= {p.name for p in new}
+
+
+@pytest.mark.timeout(60)
+def test_a_title_is_text_in_the_cup_plots(tmp_path):
+    """A title in TeX's $...$ once stopped the cup's run at its force plot (before summary.json)."""
+    from shellform.results import cup, fld
+
+    title = "$\\frac{$"
+    cup.plot_force(tmp_path / "force.png", [{"stroke_mm": 0.0, "punch_force_kN": 0.0},
+                                            {"stroke_mm": 1.0, "punch_force_kN": 2.0}], title)
+    fld.plot(tmp_path / "fld.png", [0.1, 0.2], [-0.05, 0.02], lambda e2: 0.3 + 0 * e2, title, "curve")
+    assert (tmp_path / "force.png").stat().st_size > 0 and (tmp_path / "fld.png").stat().st_size > 0
