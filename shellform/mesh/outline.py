@@ -289,5 +289,6 @@ def _check_reference_surface(msh, scene) -> None:
     bad = surface.nonfinite_point(msh)
     if bad is not None:
         what, (x, y) = bad
-        raise InputError("surface.z0", f"{surface.source!r}: {what} {'is' if what == 'z0' else 'are'} not finite at ({x:.6g}, {y:.6g}) "
-                         "of the blank's mesh")
+        verb = "is" if what == "z0" else "are"
+        raise InputError("surface.z0", f"{surface.source!r}: {what} {verb} not finite at ({x:.6g}, {y:.6g}) of the "
+                         "blank's mesh")
