@@ -246,3 +246,20 @@ def test_a_title_is_text_in_the_cup_plots(tmp_path):
                                             {"stroke_mm": 1.0, "punch_force_kN": 2.0}], title)
     fld.plot(tmp_path / "fld.png", [0.1, 0.2], [-0.05, 0.02], lambda e2: 0.3 + 0 * e2, title, "curve")
     assert (tmp_path / "force.png").stat().st_size > 0 and (tmp_path / "fld.png").stat().st_size > 0
+
+
+@pytest.mark.timeout(120)
+def test_a_geo_is_read_once_per_version_of_its_files(tmp_path, monkeypatch):
+    """Checking a scene twice reads its .geo once; an edit of a file it includes reads it again."""
+    reads = []
+    read_file = gmsh_file.read_file
+    monkeypatch.setattr(gmsh_file, "read_file", lambda *a: reads.append(a) or read_file(*a))
+    (tmp_path / "part.geo").write_text(SQUARE)
+    geo = tmp_path / "blank.geo"
+    geo.write_text('Include "part.geo";\n')
+    for _ in range(2):
+        scene.from_dict(file_scene(geo, supports={"edge": "clamped"}))
+    assert len(reads) == 1
+    (tmp_path / "part.geo").write_text(SQUARE.replace('"edge"', '"outer_edge"'))
+    scene.from_dict(file_scene(geo, supports={"outer_edge": "clamped"}))
+    assert len(reads) == 2
