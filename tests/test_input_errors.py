@@ -35,6 +35,8 @@ def assert_names_field(data: dict, field: str) -> None:
     ({"effects": ["bending", "shallow_curvature"]}, "effects"),
     ({"surface": {"R1": 3.0}}, "surface.R1"),
     ({"surface": {"R2": 0.0}, "effects": ["bending", "membrane", "shallow_curvature"]}, "surface.R2"),
+    ({"surface": {"z0": "sin(x, y)"}, "effects": ["bending", "membrane", "shallow_curvature"]}, "surface.z0"),
+    ({"surface": {"z0": "sqrt()"}, "effects": ["bending", "membrane", "shallow_curvature"]}, "surface.z0"),
     ({"mesh": {"n": 0}}, "mesh.n"),
     ({"mesh": {"refine": -1}}, "mesh.refine"),
     ({"mesh": {"refine": 1.5}}, "mesh.refine"),

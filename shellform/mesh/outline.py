@@ -20,9 +20,9 @@ from mpi4py import MPI
 
 import dolfinx.mesh
 from shellform.errors import InputError
-from shellform.mesh import quality
 from shellform.mesh.blank_mesh import BlankMesh
-from shellform.mesh.gmsh_model import gmsh_session, mesh_on_root
+from shellform.mesh import gmsh_file, quality
+from shellform.mesh.gmsh_model import OPTIONS, mesh_on_root
 from shellform.mesh.rectangle import rectangle
 
 SHAPES = ("rectangle", "circle", "polygon", "file")
@@ -43,7 +43,7 @@ def group_names(g) -> tuple[str, ...]:
         return CIRCLE_GROUPS[g.region]
     if g.shape == "polygon":
         return tuple(dict.fromkeys(polygon_edge_names(g.vertices, g.edges)))
-    return _read_file(g.file, Path(g.file).stat().st_mtime)[0]
+    return _read_file(g.file, gmsh_file.check(g.file))[0]
 
 
 def symmetry_lines(g) -> tuple[str, ...]:
@@ -62,27 +62,18 @@ def file_cells(g, n: int, refine: int) -> int:
     bounding box at h = width / n (a .geo or CAD file), times 4^refine."""
     from shellform.mesh.budget import gmsh_cells
 
-    _, triangles, (width, height) = _read_file(g.file, Path(g.file).stat().st_mtime)
+    _, triangles, (width, height) = _read_file(g.file, gmsh_file.check(g.file))
     if triangles:
         return triangles * 4**refine
     return gmsh_cells(width * height, width / n, refine)
 
 
 @functools.lru_cache(maxsize=8)
-def _read_file(path, mtime) -> tuple[tuple[str, ...], int, tuple[float, float]]:
+def _read_file(path, version) -> tuple[tuple[str, ...], int, tuple[float, float]]:
     """(boundary groups, triangles in its mesh (0: none yet), bounding box width and height)
-    of a gmsh file, read once per version of it."""
-    with gmsh_session() as gmsh:
-        try:
-            gmsh.open(str(path))
-        except Exception as exc:  # noqa: BLE001  (gmsh raises plain Exceptions)
-            raise InputError("geometry.file", f"gmsh cannot read {path}: {exc}") from None
-        if not gmsh.model.getEntities():
-            raise InputError("geometry.file", f"{path} holds no geometry and no mesh (an empty file?)")
-        groups = tuple(n for _, n in _named_curves(gmsh)) or ("boundary",)
-        triangles = sum(len(tags) for t, tags in zip(*gmsh.model.mesh.getElements(2)[:2]) if t == TRIANGLE)
-        x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(-1, -1)
-        return groups, triangles, (x1 - x0, y1 - y0)
+    of a gmsh file, read once per version of the files gmsh reads for it (gmsh_file.check),
+    in a child process with a time limit."""
+    return gmsh_file.read_file(path, OPTIONS)
 
 
 def _named_curves(gmsh) -> list[tuple[int, str]]:
@@ -230,6 +221,7 @@ def from_file(comm, path, n=8, refine=0) -> BlankMesh:
     state = {}
 
     def build(gmsh):
+        gmsh_file.check(path)  # what the file may do, again just before gmsh reads it
         gmsh.open(str(path))
         if not gmsh.model.mesh.getNodes(2, includeBoundary=True)[0].size:
             xmin, _, _, xmax, _, _ = gmsh.model.getBoundingBox(-1, -1)
@@ -317,4 +309,21 @@ def blank(comm, scene, points=()) -> BlankMesh:
     else:
         out = from_file(comm, g.file, m.n, m.refine)
     check_symmetry_lines(out, scene.supports)
+    _check_reference_surface(out.mesh, scene)
     return out
+
+
+def _check_reference_surface(msh, scene) -> None:
+    """z0 of a curved scene and its first and second derivatives are finite on its mesh, before
+    any form takes them (sqrt(x) on a blank with x < 0 would fail in the linear solve)."""
+    from shellform.forms.reference_surface import ReferenceSurface
+
+    surface = scene.curvature()
+    if not isinstance(surface, ReferenceSurface):
+        return
+    bad = surface.nonfinite_point(msh)
+    if bad is not None:
+        what, (x, y) = bad
+        verb = "is" if what == "z0" else "are"
+        raise InputError("surface.z0", f"{surface.source!r}: {what} {verb} not finite at ({x:.6g}, {y:.6g}) of the "
+                         "blank's mesh")

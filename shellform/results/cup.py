@@ -141,7 +141,7 @@ def plot_force(path: Path, rows: list[dict], title: str) -> None:
     ax.plot([r["stroke_mm"] for r in rows], [r["punch_force_kN"] for r in rows], "-")
     ax.set_xlabel("punch stroke (mm)")
     ax.set_ylabel("punch force (kN)")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=10, parse_math=False)  # a scene's title is text, never TeX
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -72,7 +72,7 @@ def plot(path, major, minor, curve, title: str, label: str) -> None:
     fig.colorbar(sc, ax=ax, label="margin to the curve (true major strain)")
     ax.set_xlabel("minor true strain")
     ax.set_ylabel("major true strain")
-    ax.set_title(title, fontsize=9)
+    ax.set_title(title, fontsize=9, parse_math=False)  # a scene's title is text, never TeX
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper center")
     fig.tight_layout()
