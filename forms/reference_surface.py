@@ -60,6 +60,13 @@ class ReferenceSurface:
                 return f"{node.value!r} is no number"
         return None
 
+    def quoted(self, most: int = 60) -> str:
+        """The text as messages quote it: in full up to `most` characters, else its start and
+        its length (an error message stays one line)."""
+        if len(self.source) <= most:
+            return repr(self.source)
+        return f"{self.source[:most]!r}... ({len(self.source):,} characters)"
+
     def value(self, x, y):
         """z0 at a point in floating point, every number of the text taken as a float, so that
         no power grows an unbounded integer (for checks and plots)."""

@@ -362,15 +362,15 @@ def validate(s: Scene) -> None:
 
         surface = ReferenceSurface(s.surface.z0)
         problem = surface.problem()
-        _require(problem is None, "surface.z0", f"{s.surface.z0!r}: {problem}")
+        _require(problem is None, "surface.z0", f"{surface.quoted()}: {problem}")
         _require("shallow_curvature" in s.effects, "surface.z0",
                  "a curved reference surface needs the effect 'shallow_curvature'")
         _require(s.tools is None, "surface.z0", "tool scenes draw a flat blank")
         try:
             value = surface.value(0.123, 0.456)
         except (ArithmeticError, ValueError) as err:
-            raise InputError("surface.z0", f"{s.surface.z0!r} cannot be evaluated: {err}") from None
-        _require(math.isfinite(value), "surface.z0", f"{s.surface.z0!r} is not finite at (0.123, 0.456)")
+            raise InputError("surface.z0", f"{surface.quoted()} cannot be evaluated: {err}") from None
+        _require(math.isfinite(value), "surface.z0", f"{surface.quoted()} is not finite at (0.123, 0.456)")
     _require(m.kind in MESH_KINDS, "mesh.kind", f"must be one of {MESH_KINDS}, got {m.kind!r}")
     _require(m.n >= 1, "mesh.n", f"must be >= 1, got {m.n}")
     _require(m.refine >= 0, "mesh.refine", f"must be >= 0, got {m.refine}")

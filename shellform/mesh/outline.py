@@ -325,5 +325,5 @@ def _check_reference_surface(msh, scene) -> None:
     if bad is not None:
         what, (x, y) = bad
         verb = "is" if what == "z0" else "are"
-        raise InputError("surface.z0", f"{surface.source!r}: {what} {verb} not finite at ({x:.6g}, {y:.6g}) of the "
+        raise InputError("surface.z0", f"{surface.quoted()}: {what} {verb} not finite at ({x:.6g}, {y:.6g}) of the "
                          "blank's mesh")
