@@ -177,7 +177,7 @@ def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
         under = dr.holder.under(dr.positions())
         assert np.array_equal(dr.pinched, under)  # no free node under the closed holder
         p = dr.state.pressure + dr.state.holder_face
-        ft = np.linalg.norm(dr._friction, axis=1)
+        ft = np.linalg.norm(dr.friction.force, axis=1)
         assert np.all(ft <= mu * p * (1 + 1e-8) + 1e-9)
         assert np.all(dr.state.pressure[under] >= 0)
 
@@ -186,7 +186,7 @@ def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
     normal = comm.allreduce(float((d.state.pressure + d.state.holder_face).sum()), op=MPI.SUM)
     assert abs(pull - mu * normal) <= 1e-8 * mu * normal
     assert abs(pull - 2 * mu * F) <= 1e-4 * 2 * mu * F
-    assert np.all(d._slipping[d.state.tool == 0])  # the whole strip slides on the die
+    assert np.all(d.friction.slipping[d.state.tool == 0])  # the whole strip slides on the die
 
 
 def test_slip_reversal_converges_without_friction_flips():
@@ -204,7 +204,7 @@ def test_slip_reversal_converges_without_friction_flips():
     def record(lam):
         jump = constraints(lam)
         limit = mu * (d.state.pressure + d.state.holder_face)
-        f = d._friction[:, 0]
+        f = d.friction.force[:, 0]
         sides.append(np.sign(f) * (np.abs(f) >= 0.5 * limit) * (limit > 0))
         return jump
 
@@ -229,7 +229,7 @@ def test_slip_reversal_converges_without_friction_flips():
     assert all(e[0] == 0 for i, e in enumerate(log) if i not in (0, n_forward))
     assert pull_forward == pytest.approx(2 * mu * F, rel=1e-4)
     assert pull_back == pytest.approx(-2 * mu * F, rel=1e-4)
-    assert np.all(d._slipping[d.state.tool == 0]) and np.all(d._friction[d.state.tool == 0, 0] > 0)
+    assert np.all(d.friction.slipping[d.state.tool == 0]) and np.all(d.friction.force[d.state.tool == 0, 0] > 0)
     tol = d.controls.rtol * d._scale  # Newton's tolerance: below it, round-off
     for _, _, passes in log:  # superlinear tails: above the tolerance, the last reduction is the
         for r in passes:      # best of the pass and at least 1e-2
@@ -331,7 +331,7 @@ def test_the_open_holders_lift_step_is_exact_newton():
     p = DrawingProblem.from_scene(s, verbose=False)
     d = p.driver
     d.run(1.25 / s.tools.stroke)
-    lam, slip = d.lam, np.flatnonzero(d._slipping & (d.state.tool == HOLDER))
+    lam, slip = d.lam, np.flatnonzero(d.friction.slipping & (d.state.tool == HOLDER))
     assert not d.state.closed[0] and slip.size > 0
     rows = (BS * slip[:, None] + np.arange(2)).ravel()
     d.holder.force *= 1.01
@@ -605,7 +605,7 @@ def test_slip_tangent_carries_the_normal_force_change():
     on their tangential rows to 1e-6 of the largest entry; without the term they are off by 1e-3."""
     d, lam = _drawn_cup(2.0)
     m = d.model
-    slip = np.flatnonzero(d._slipping & (d.state.tool == 0) & ~d.pinched)
+    slip = np.flatnonzero(d.friction.slipping & (d.state.tool == 0) & ~d.pinched)
     assert slip.size > 0
     near = np.unique(m.dofs[np.isin(m.dofs, slip).any(axis=1)])
     free = [b for b in near if b < d.n_owned and d.state.tool[b] == FREE][:3]
@@ -627,7 +627,7 @@ def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
     frictionless, 1e-5 with the scene's friction (whose projection on the turning tangent plane,
     of order mu times the term, is left out); without the term they are off by 1e-4."""
     d, lam = _drawn_cup(6.0)
-    d.mu = mu
+    d.friction.mu = mu
     nose = np.flatnonzero((d.state.tool == 0) & (np.abs(d._curvature).max(axis=(1, 2)) > 0))[:3]
     assert nose.size > 0
     rows = (BS * nose[:, None] + np.arange(2)).ravel()
@@ -748,12 +748,12 @@ def test_a_full_step_that_sticks_slipping_nodes_is_kept_once_per_pass():
     slipping nodes to stick (the friction law's kink), once per pass; not where no node sticks,
     nor with stick_step off (the default)."""
     d, lam = _drawn_cup(2.0)
-    before = d._slipping.copy()
+    before = d.friction.slipping.copy()
     assert before.sum() >= 2
-    d._slipping[np.flatnonzero(before)[:2]] = False  # as if the step had stuck two slipping nodes
+    d.friction.slipping[np.flatnonzero(before)[:2]] = False  # as if the step had stuck two slipping nodes
     assert not d.contact.stick_step
     d._kept, d.contact.stick_step = False, True
-    assert not d._keep_sticking_step(d._slipping.copy())  # nothing sticks
+    assert not d._keep_sticking_step(d.friction.slipping.copy())  # nothing sticks
     assert d._keep_sticking_step(before)
     assert not d._keep_sticking_step(before)  # once per pass
     d._kept, d.contact.stick_step = False, False

@@ -62,7 +62,7 @@ class DrawingProblem:
         r = d.reactions()[on]
         r = np.where(d.sym_fixed[on], 0.0, r)  # the symmetry planes' reactions are not the tool's
         F = d.frames[: d.n_owned][on]
-        f = np.einsum("nji,nj->ni", F, r) + d._friction[on]
+        f = np.einsum("nji,nj->ni", F, r) + d.friction.force[on]
         total = d.model.mesh.comm.allreduce(f.sum(axis=0), op=MPI.SUM)
         return self.symmetry * total
 

@@ -20,24 +20,10 @@ solves it with the sheet (a bordered system, one more solve with the same factor
     dq = dq_a + dz_H dq_b,   dq_b the response to the holder's nodes lifted by 1,
     dz_H = (F - sum p_i - sum (K dq_a)_i) / sum (K dq_b)_i   (sums over the holder's normal rows)
 
-Friction (Coulomb, mu) is integrated as a return mapping, like non-associated plasticity, on
-every node on a tool and under the holder. With the node's slip increment ds relative to the
-tool (tangential part), the tangential force f_n of the last increment (history) and the stick
-stiffness k_t:
-
-    trial  f* = f_n - k_t ds,   |f*| <= mu p: stick, f = f*,   dR/ds = k_t I
-                               |f*| >  mu p: slip,  f = mu p f*/|f*|,
-                                                    dR/ds = k_t (mu p/|f*|) (I - m m^T),  m = f*/|f*|
-
-k_t = stick_stiffness E A_i / h per node, stick_stiffness = 0.01 (a hundredth of E/h per unit
-area): the elastic slip before sliding, mu p / k_t, is then 0.3 to 9 micrometres on the 16 x 16
-cup. With E/h itself (0.003 to 0.09 micrometres) a node nearly at rest on the punch's corner
-reversed its friction force (2 mu p) within every Newton step, far shorter than the steps
-(docs/contact.md, the 0.5 mm sheet).
-
-The normal force p of a node (both faces of a pinched node) is taken from the reactions of every
-Newton iterate after the first (refresh_normal), and the slipping force's dependence on it,
-d(mu p m)/dq = mu m dp/dq with dp/dq the node's row of K in its normal slot, enters the tangent
+Coulomb friction is a part of its own (friction.py: its return mapping, history and
+contributions to R and K) on every node on a tool and under the holder. The normal force p of a
+node (both faces of a pinched node) is taken from the reactions of every Newton iterate after
+the first (refresh_normal), and the slipping force's dependence on it enters the tangent
 (consistent_friction; non-symmetric). Newton then converges p with the displacements instead
 of one pass at a time. The first iterate of a pass keeps the p of the pass before, relaxed
 with Aitken's factor. Passes remain for the contact set: they repeat until it holds, and a pass
@@ -68,6 +54,7 @@ from mpi4py import MPI
 from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.errors import InputError
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
+from shellform.contact.friction import CoulombFriction
 from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver, shorten
 from shellform.results.log import say
@@ -83,7 +70,7 @@ class ContactControls:
     max_front_passes: int = 60  # ... and all passes, front ones included (a front crosses a row of nodes per pass)
     max_toggles: int = 2  # switches of one node (or of the holder) per increment before it is frozen
     gap_tol: float = 0.0  # |known corrections| at convergence (0: 1e-3 penetration)
-    stick_stiffness: float = 0.01  # k_t = stick_stiffness E A_i / h (module docstring)
+    stick_stiffness: float = 0.01  # k_t = stick_stiffness E A_i / h (friction.py)
     friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
     stick_step: bool = False  # keep a full step that turns slipping nodes to stick, once per pass (_keep_sticking_step)
@@ -100,16 +87,14 @@ class ContactControls:
 class ContactState:
     """Per owned node: the tool it lies on (or FREE), the normal force of that tool's face and
     of the holder's face, the normal force friction uses (held fixed within a pass; the faces'
-    sum, relaxed between passes), the tangential friction force of the last
-    converged increment (global x, y, z), the node's switches in this increment; and whether
-    the holder is closed and its lift."""
+    sum, relaxed between passes), the node's switches in this increment; and whether the holder
+    is closed and its lift. (Friction's history is the friction part's.)"""
 
     def __init__(self, n: int):
         self.tool = np.full(n, FREE, dtype=np.int8)
         self.pressure = np.zeros(n)
         self.holder_face = np.zeros(n)
         self.normal = np.zeros(n)  # the normal force friction uses in this pass (both faces)
-        self.friction = np.zeros((n, 3))
         self.toggles = np.zeros(n, dtype=np.int32)
         self.closed = np.zeros(1, dtype=bool)
         self.lift = np.zeros(1)  # the open holder's face above its closed position
@@ -143,7 +128,7 @@ class SemiInverseDriver(Driver):
         V = model.V
         imap = V.dofmap.index_map
         self.n_owned, self.n_local = imap.size_local, imap.size_local + imap.num_ghosts
-        self.tools, self.travel, self.mu = list(tools), np.asarray(travel, dtype=float), float(friction)
+        self.tools, self.travel = list(tools), np.asarray(travel, dtype=float)
         self.die = len(self.tools) - 1 if die is None else int(die)
         self.contact = contact or ContactControls(penetration=1e-3 * model.thickness)
         if not self.contact.gap_tol:
@@ -161,7 +146,8 @@ class SemiInverseDriver(Driver):
         self.area, e33 = self._nodal_areas_and_thickness_strain()
         self.half_thickness = 0.5 * model.thickness * np.exp(e33)
         E = model.material[0]
-        self.k_stick = self.contact.stick_stiffness * E * self.area / model.cell_size
+        self.friction = CoulombFriction(friction, self.contact.stick_stiffness * E * self.area / model.cell_size,
+                                        self.sym_fixed[:, :2])
         self.holder = None
         self.holder_tool = len(self.tools)  # the open holder's index in the contact set
         if holder is not None:
@@ -176,9 +162,6 @@ class SemiInverseDriver(Driver):
         self._under = np.zeros(n, dtype=bool)  # under the holder in this increment (_pinch)
         self._previous = None  # the committed state before the last (the predictor's)
         self._r_prev, self._omega = None, 1.0
-        self._friction = np.zeros((n, 3))  # tangential force of the current iterate (global)
-        self._rate = np.zeros((n, 2, 2))  # its stiffness in the frame's tangent slots
-        self._slipping = np.zeros(n, dtype=bool)
         self._passes = self._changes = self._frozen = 0
         self._scale = 0.0
         self._rub = (np.zeros(0, dtype=np.int64), np.zeros(0), self.X[:n].copy(), np.zeros((0, 3, 3)))
@@ -190,7 +173,6 @@ class SemiInverseDriver(Driver):
         self._dlift = 0.0  # the open holder's lift in this Newton iteration
         self._stable_rows = np.zeros(0, dtype=np.int32)  # known rows the free-row solve takes out (_constraints)
         self._lift_fn = fem.Function(V)  # the unit lift of the open holder's nodes (known rows)
-        self._slip_rows = None  # (coef, g) of the slip forces' dp/dq (_add_slip_pressure_tangent)
         self._lift_response = fem.Function(V)
         self.line_search_factors: list[float] = []  # alpha of every accepted Newton step (this increment)
         self.pass_residuals: list[list[float]] = []
@@ -411,11 +393,8 @@ class SemiInverseDriver(Driver):
     def _friction_forces(self):
         """Friction on the rubbing nodes of this iterate (set by _constraints) with the current
         normal forces."""
-        self._friction[:] = 0.0
-        self._rate[:] = 0.0
-        self._slipping[:] = False
-        if self.mu > 0:
-            self._coulomb(*self._rub)
+        idx, shift, x, F = self._rub
+        self.friction.update(idx, shift, x, self.x_n, F, self.state.normal)
 
     def _refresh_normal(self, R):
         """Within a pass: the friction's normal forces from this iterate's reactions (the rows of
@@ -430,30 +409,6 @@ class SemiInverseDriver(Driver):
             self._holder_faces(self._rub[2], net)
         s.normal = s.pressure + s.holder_face
         self._friction_forces()
-
-    def _coulomb(self, idx, shift, x, F):
-        """The return mapping of Coulomb friction on the nodes idx (tangent planes from their
-        frames F, tools moved by `shift` along z in this increment); sets their force and its
-        stiffness in the tangent slots (module docstring)."""
-        s = self.state
-        n = F[:, 2]
-        ds = x[idx] - self.x_n[idx]
-        ds[:, 2] -= shift
-        ds -= np.sum(ds * n, axis=1)[:, None] * n  # tangential slip increment
-        f_old = s.friction[idx] - np.sum(s.friction[idx] * n, axis=1)[:, None] * n
-        k = self.k_stick[idx]
-        trial = f_old - k[:, None] * ds
-        size = np.linalg.norm(trial, axis=1)
-        limit = self.mu * s.normal[idx]
-        slip = size > (1 - 1e-6) * limit  # on the cone (a node that slipped): keeps slipping, slip tangent
-        ratio = np.where(slip, limit / np.maximum(size, 1e-300), 1.0)
-        m2 = np.einsum("nij,nj->ni", F[:, :2], trial) / np.maximum(size, 1e-300)[:, None]
-        rate = (k * ratio)[:, None, None] * (np.eye(2) - slip[:, None, None] * m2[:, :, None] * m2[:, None, :])
-        held = self.sym_fixed[idx, :2]  # a symmetry plane holds that slot: no rate there
-        rate[held[:, :, None] | held[:, None, :]] = 0.0
-        self._friction[idx] = ratio[:, None] * trial
-        self._rate[idx] = rate
-        self._slipping[idx] = slip
 
     def _set_bcs(self, flag):
         V = self.model.V
@@ -534,8 +489,8 @@ class SemiInverseDriver(Driver):
         unit[rows] = -1.0  # the face up by 1: each node 1 up, -1 along its normal
         self._lift_fn.x.scatter_forward()
         extra = None
-        if self._slip_rows is not None:  # the slip forces' dp/dq on these known columns
-            coef, g = self._slip_rows
+        if self.friction.slip_rows is not None:  # the slip forces' dp/dq on these known columns
+            coef, g = self.friction.slip_rows
             Ku = self.apply_tangent(unit)[: self.n_owned * BS].reshape(-1, BS)[:, 2]
             extra = np.zeros(self.n_owned * BS)
             extra.reshape(-1, BS)[:, :2] = (coef * Ku)[:, None] * g
@@ -558,15 +513,12 @@ class SemiInverseDriver(Driver):
         F = self.frames[:n]  # identity off the tools
         R3 = R[: n * BS].reshape(-1, BS)[:, :3]
         if K is not None:
-            self._slip_rows = None
-        if self._refreshing and self.mu > 0:
+            self.friction.slip_rows = None
+        if self._refreshing and self.friction.active:
             self._refresh_normal(R)  # the reactions before friction
-        R3 -= np.einsum("nij,nj->ni", F, self._friction)
-        if K is not None and self.mu > 0:
-            b = np.flatnonzero(np.abs(self._rate).max(axis=(1, 2)) > 0)
-            if b.size:
-                rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
-                K.setValuesLocalRCV(rows, rows, self._rate[b].reshape(b.size, 4), addv=True)
+        self.friction.add_residual(R3, F)
+        if K is not None and self.friction.active:
+            self.friction.add_tangent(K)
             if self._refreshing and self.contact.consistent_friction:
                 self._add_slip_pressure_tangent(K)
         if K is not None and self.contact.tool_curvature:
@@ -587,35 +539,16 @@ class SemiInverseDriver(Driver):
         K.setValuesLocalRCV(rows, rows, blocks.reshape(b.size, 4), addv=True)
 
     def _add_slip_pressure_tangent(self, K):
-        """The slipping force's dependence on its normal force, which Newton's iterates now update
-        (refresh_normal): f = mu p m with p = R0 = K_(i,n) q (the node's normal row), so that
-
-            d(-f_i)/dq = -mu m_i (dp_i/dR0_i) K_(i,n),   dp/dR0 = 1 on a tool, sign(R0) pinched
-
-        (the closed holder's share of F through sum max(-R0, 0) is left out). Non-symmetric; added
-        on the free tangent rows of every slipping node, in the free columns."""
-        s, m, n = self.state, self.model, self.n_owned
-        coef = np.zeros(self.n_local)
-        on = self._slipping & (s.tool != FREE) & (s.normal > 0)
-        net = self._net
-        coef[:n][on] = np.where(self.pinched[on], np.sign(net[on]), (net[on] > 0).astype(float))
-        g = np.zeros((self.n_local, 2))
-        g[:n][on] = np.einsum("nij,nj->ni", self.frames[:n][on][:, :2], self._friction[on]) / s.normal[on, None]
-        self._slip_rows = (coef[:n].copy(), np.where(self.sym_fixed[:, :2], 0.0, g[:n]))  # for the holder's lift
+        """The slipping force's dependence on its normal force (friction.py), which Newton's
+        iterates now update (refresh_normal): dp/dR0 = 1 on a tool, sign(R0) on a pinched node
+        (the closed holder's share of F through sum max(-R0, 0) is left out)."""
+        s, n, net = self.state, self.n_owned, self._net
+        coef = np.zeros(n)
+        on = self.friction.slipping & (s.tool != FREE) & (s.normal > 0)
+        coef[on] = np.where(self.pinched[on], np.sign(net[on]), (net[on] > 0).astype(float))
         fixed = np.zeros(self.n_local * BS, dtype=bool)
         fixed[self.bc_dofs] = True
-        cells, local = np.nonzero(coef[m.dofs] != 0)
-        if cells.size == 0:
-            return
-        b = m.dofs[cells, local]
-        rows = BS * b[:, None] + np.arange(2)  # (pairs, 2): the node's tangent slots in this cell
-        g = np.where(fixed[rows], 0.0, g[b])  # none on a row held by symmetry
-        row = m.forms.matrices[cells, BS * local + 2]  # (pairs, cell dofs): the normal row
-        # not on the known columns, whose corrections vanish after a pass's first iterate
-        row = np.where(fixed[m.unrolled_dofs[cells]], 0.0, row)
-        values = -coef[b][:, None, None] * g[:, :, None] * row[:, None, :]
-        K.setValuesLocalRCV(rows.astype(np.int32), m.unrolled_dofs[cells].astype(np.int32),
-                            values.reshape(len(b), -1), addv=True)
+        self.friction.add_normal_force_tangent(K, self.model, coef, self.frames, s.normal, fixed, self.n_local)
 
     # -- one increment --------------------------------------------------------------------------
     def _newton(self, lam, reversal=False):
@@ -644,6 +577,7 @@ class SemiInverseDriver(Driver):
         """Contact passes: Newton on a fixed contact set (the normal forces follow the iterates),
         then the set's update; repeat until the set and the normal forces hold."""
         self.state = self.committed.copy()
+        self.friction.start()
         self._lam_trial = lam
         if self.holder is not None:
             self._pinch(self.holder.under(self.x_n), grow=False)
@@ -776,7 +710,7 @@ class SemiInverseDriver(Driver):
         if jump > max(self.contact.gap_tol, 1e-2 * move):
             s0 = None  # the step mostly moves nodes onto the tools
         x0, lift0 = self.q.x.array.copy(), float(self.state.lift[0])
-        slipping = self._slipping.copy()
+        slipping = self.friction.slipping.copy()
         norm = scale = ev = jump = None
         for _ in range(c.line_search + 1):
             self.q.x.array[:] = x0 + alpha * dq
@@ -812,7 +746,7 @@ class SemiInverseDriver(Driver):
         default: on the paper's cup it costs iterations and cut-backs (docs/contact.md)."""
         if not self.contact.stick_step or self._kept:
             return False
-        stuck = self.model.mesh.comm.allreduce(int(np.sum(slipping & ~self._slipping)), op=MPI.SUM)
+        stuck = self.model.mesh.comm.allreduce(int(np.sum(slipping & ~self.friction.slipping)), op=MPI.SUM)
         if stuck and self.contact.trace:
             say(f"      full step kept: {stuck} slipping nodes stick")
         self._kept = stuck > 0
@@ -829,7 +763,7 @@ class SemiInverseDriver(Driver):
                 f"normal {self.frames[i, 2].round(3)}, R (u, v, w) {R[i, :3].round(2)}, R (slopes) {R[i, 3:].round(1)}, "
                 f"tool face {s.pressure[i]:.1f} N, holder face {s.holder_face[i]:.1f} N, friction normal "
                 f"{s.normal[i]:.1f} N, friction "
-                f"{self._friction[i].round(2)} ({'slip' if self._slipping[i] else 'stick'})")
+                f"{self.friction.force[i].round(2)} ({'slip' if self.friction.slipping[i] else 'stick'})")
 
     def _global_slope(self, dq) -> float:
         """dq . R over all ranks, with R (free rows, nodal frames) rotated back to x, y, z, and
@@ -880,7 +814,7 @@ class SemiInverseDriver(Driver):
             self._pinch(under, grow=True)  # the nodes drawn under the closed holder
         switched = release | join
         s.pressure[switched] = 0.0
-        s.friction[switched] = 0.0  # a new contact starts without friction history
+        self.friction.forget(switched)  # a new contact starts without friction history
         s.toggles[switched] += 1
         changes += int(switched.sum())
         self._frozen = int((s.toggles >= self.contact.max_toggles).sum())
@@ -889,7 +823,8 @@ class SemiInverseDriver(Driver):
         changes = int(changes)
         dp, pn = self._relax_normal(changes)
         self.times["contact_s"] += time.perf_counter() - t0
-        return changes, self.mu * dp, self.mu * pn, bool(changes > 0 and back == 0)
+        mu = self.friction.mu
+        return changes, mu * dp, mu * pn, bool(changes > 0 and back == 0)
 
     def _relax_normal(self, changes):
         """The friction's normal force for the next pass from the faces' new sum p~: the fixed
@@ -920,7 +855,7 @@ class SemiInverseDriver(Driver):
         s = self.state
         s.toggles[:] = 0
         s.holder_toggles[:] = 0
-        s.friction = self._friction.copy()
+        self.friction.commit()
         c = self.committed
         self._previous = {"lam": self.lam_n, "tool": c.tool, "normal": c.normal}
         self.committed = s.copy()
@@ -932,7 +867,7 @@ class SemiInverseDriver(Driver):
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
 
     # -- checkpoints -------------------------------------------------------------------------
-    NODES = ("tool", "pressure", "holder_face", "normal", "friction")  # ContactState, per owned node
+    NODES = ("tool", "pressure", "holder_face", "normal")  # ContactState, per owned node
     GLOBAL = ("closed", "lift")  # ContactState, the holder's (the same on every rank)
 
     def checkpoint_state(self) -> dict:
@@ -942,6 +877,7 @@ class SemiInverseDriver(Driver):
         travel (shellform.nonlinear.checkpoint numbers the nodes globally)."""
         c, own = self.committed, super().checkpoint_state()
         own["nodes"].update({f"contact_{k}": getattr(c, k) for k in self.NODES})
+        own["nodes"].update(self.friction.checkpoint())
         own["nodes"].update({"contact_pinched": self.pinched_n, "contact_x_n": self.x_n,
                              "contact_half_thickness": self.half_thickness})
         own["global"].update({f"contact_{k}": getattr(c, k) for k in self.GLOBAL})
@@ -968,6 +904,7 @@ class SemiInverseDriver(Driver):
         for k in self.GLOBAL:
             getattr(c, k)[...] = glob[f"contact_{k}"]
         self.committed, self.state = c, c.copy()
+        self.friction.restore(nodes)
         self.pinched = nodes["contact_pinched"].copy()
         self.pinched_n = self.pinched.copy()
         self.x_n = nodes["contact_x_n"].copy()
@@ -984,6 +921,7 @@ class SemiInverseDriver(Driver):
     def _restore_converged(self):
         """The committed contact state and its forces (a stop reports the last converged state)."""
         self.state = self.committed.copy()
+        self.friction.start()
         self._lam_trial = self.lam_n
         self.model.converged_lever()
         if self.holder is not None:
