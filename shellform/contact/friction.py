@@ -8,8 +8,10 @@ increment (the history) and the stick stiffness k_t:
                                |f*| >  mu p: slip,  f = mu p f*/|f*|,
                                                     df/ds = -k_t (mu p/|f*|) (I - m m^T),  m = f*/|f*|
 
-with k_t = stick_stiffness E A_i / h per node (A_i its tributary area, h the cell size), so that
-the elastic slip before sliding, mu p / k_t, is a small fraction of a cell (docs/contact.md). The
+with k_t = STICK_STIFFNESS E A_i / h per node (A_i its tributary area, h the cell size), so that
+the elastic slip before sliding, mu p / k_t, is a small fraction of a cell, yet long against
+Newton's steps on a node nearly at rest (docs/contact.md: E A_i / h itself made such a node
+reverse its force within every step). The
 node's residual gets -f in its nodal frame, the tangent -df/ds in the frame's tangent slots.
 
 Where Newton's iterates update the normal force p (the contact driver's refresh of p from the
@@ -33,6 +35,8 @@ from shellform.assembly.sheet_element import BS
 class CoulombFriction:
     """Coulomb friction with coefficient mu on n owned nodes (k_stick: their stick stiffness;
     held: (n, 2) tangent slots a symmetry plane holds, which get no stiffness)."""
+
+    STICK_STIFFNESS = 0.01  # k_t per node over E A_i / h
 
     def __init__(self, mu: float, k_stick: np.ndarray, held: np.ndarray):
         n = len(k_stick)

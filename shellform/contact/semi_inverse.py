@@ -23,23 +23,20 @@ solves it with the sheet (a bordered system, one more solve with the same factor
 Coulomb friction is a part of its own (friction.py: its return mapping, history and
 contributions to R and K) on every node on a tool and under the holder. The normal force p of a
 node (both faces of a pinched node) is taken from the reactions of every Newton iterate after
-the first (refresh_normal), and the slipping force's dependence on it enters the tangent
-(consistent_friction; non-symmetric). Newton then converges p with the displacements instead
-of one pass at a time. The first iterate of a pass keeps the p of the pass before, relaxed
-with Aitken's factor. Passes remain for the contact set: they repeat until it holds, and a pass
-ends as soon as the set will change (early_set, once Newton's steps are below `early_step`
-penetrations). A node moving along a curved tool turns its frame; the tangent carries that too
-(tool_curvature: K_ab += -R0 W_ab, W the tool's shape operator). With the three, Newton's tails
-are quadratic again where no layer or node crosses a kink (elastic-plastic, stick-slip) along
-the step, and the NUMISHEET'93 cup needs 771 iterations where it needed 1744
-(docs/performance.md). A pass starts from the element arrays of the last iterate, turned into
-its new frames (the carrier has not moved).
+the first, and the slipping force's dependence on it enters the tangent (non-symmetric).
+Newton then converges p with the displacements instead of one pass at a time. The first
+iterate of a pass keeps the p of the pass before, relaxed with Aitken's factor. Passes remain
+for the contact set: they repeat until it holds, and a pass ends as soon as the set will change
+once Newton's steps are below `early_step` penetrations (EARLY_STEP; after a failure of such
+passes 1, for the rest of the run). A node moving along a curved tool turns its frame; the
+tangent carries that too (K_ab += -R0 W_ab, W the tool's shape operator). With the three,
+Newton's tails are quadratic again where no layer or node crosses a kink (elastic-plastic,
+stick-slip) along the step (docs/performance.md: what each saves). A pass starts from the
+element arrays of the last iterate, turned into its new frames (the carrier has not moved).
 
 Newton is globalised: each correction is first limited so that no node moves by more than
 `trust` thicknesses, then a line search on the energy slope dq . R(q + alpha dq) shortens it
-where it overshoots (with stick_step, opt-in: except once per pass where the full step turns
-slipping nodes to stick, the friction law's kink, which the slip tangent cannot see). The
-contact set is settled between passes: nodes that penetrate a tool by more than `penetration`
+where it overshoots. The contact set is settled between passes: nodes that penetrate a tool by more than `penetration`
 join it, nodes (not pinched) whose normal force turned tensile leave it;
 a node may switch at most `max_toggles` times per increment (no chattering).
 """
@@ -67,19 +64,9 @@ W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
 class ContactControls:
     penetration: float  # a free node may penetrate a tool by at most this much (length)
     max_passes: int = 12  # contact passes per increment, not counting those that only move the contact front
-    max_front_passes: int = 60  # ... and all passes, front ones included (a front crosses a row of nodes per pass)
     max_toggles: int = 2  # switches of one node (or of the holder) per increment before it is frozen
-    gap_tol: float = 0.0  # |known corrections| at convergence (0: 1e-3 penetration)
-    stick_stiffness: float = 0.01  # k_t = stick_stiffness E A_i / h (friction.py)
     friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
-    stick_step: bool = False  # keep a full step that turns slipping nodes to stick, once per pass (_keep_sticking_step)
-    early_set: bool = True  # end a pass once the set will change and the steps are below early_step penetrations
-    early_step: float = 10.0  # (1 until 2026-11-23: 19 % more iterations on the aluminium cup's 2,450 cells); 1 after
-    # the first failed increment (SemiInverseDriver._newton)
-    refresh_normal: bool = True  # friction's normal forces from every iterate after the first (not per pass)
-    tool_curvature: bool = True  # the frames' turning on curved tools in the tangent
-    consistent_friction: bool = True  # with refresh_normal: the slip force's dp/dq in the tangent
     holder_spread: str = "area"  # "area" or "rigid" (holder.py)
     trace: bool = False  # log every pass, step and iterate (the largest residuals) and each node that switches
 
@@ -117,6 +104,8 @@ class SemiInverseDriver(Driver):
     """
 
     swap_line_search = False  # its Newton (_newton) has its own line search and contact passes
+    MAX_FRONT_PASSES = 60  # all passes of an increment, front ones included (a front crosses a row of nodes per pass)
+    EARLY_STEP = 10.0  # a pass ends once the set will change and the steps are below this many penetrations
 
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
                  prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None):
@@ -124,15 +113,15 @@ class SemiInverseDriver(Driver):
                          verbose=verbose)
         self.support_dofs = self.bc_dofs.copy()  # supports and symmetry (prescribed values: lam qbar)
         # an increment of a few contact passes is still an easy one
-        self.controls.easy_iterations = max(self.controls.easy_iterations, 2 * self.controls.max_iterations // 3)
+        self.easy_iterations = max(self.easy_iterations, 2 * self.controls.max_iterations // 3)
         V = model.V
         imap = V.dofmap.index_map
         self.n_owned, self.n_local = imap.size_local, imap.size_local + imap.num_ghosts
         self.tools, self.travel = list(tools), np.asarray(travel, dtype=float)
         self.die = len(self.tools) - 1 if die is None else int(die)
         self.contact = contact or ContactControls(penetration=1e-3 * model.thickness)
-        if not self.contact.gap_tol:
-            self.contact.gap_tol = 1e-3 * self.contact.penetration
+        self.gap_tol = 1e-3 * self.contact.penetration  # |known corrections| at convergence
+        self.early_step = self.EARLY_STEP  # 1 once passes that end early have failed (_newton)
         self.X = V.tabulate_dof_coordinates()[: self.n_local].copy()
         self.symmetry_bcs = list(bcs)
         sym = np.zeros(self.n_local * BS, dtype=bool)
@@ -146,7 +135,7 @@ class SemiInverseDriver(Driver):
         self.area, e33 = self._nodal_areas_and_thickness_strain()
         self.half_thickness = 0.5 * model.thickness * np.exp(e33)
         E = model.material[0]
-        self.friction = CoulombFriction(friction, self.contact.stick_stiffness * E * self.area / model.cell_size,
+        self.friction = CoulombFriction(friction, CoulombFriction.STICK_STIFFNESS * E * self.area / model.cell_size,
                                         self.sym_fixed[:, :2])
         self.holder = None
         self.holder_tool = len(self.tools)  # the open holder's index in the contact set
@@ -165,11 +154,10 @@ class SemiInverseDriver(Driver):
         self._passes = self._changes = self._frozen = 0
         self._scale = 0.0
         self._rub = (np.zeros(0, dtype=np.int64), np.zeros(0), self.X[:n].copy(), np.zeros((0, 3, 3)))
-        self._refreshing = False  # normal forces from every iterate's reactions (refresh_normal)
+        self._refreshing = False  # normal forces from this iterate's reactions (all but a pass's first)
         self._curvature = np.zeros((n, 2, 2))  # W of each node's tool in its tangent slots
         self._net = np.zeros(n)  # the net normal forces of the last refreshed iterate
         self._early, self._step = False, np.inf  # a pass ended early; the last accepted step's largest move
-        self._kept = False  # a full step kept for sticking nodes in this pass (_keep_sticking_step)
         self._dlift = 0.0  # the open holder's lift in this Newton iteration
         self._stable_rows = np.zeros(0, dtype=np.int32)  # known rows the free-row solve takes out (_constraints)
         self._lift_fn = fem.Function(V)  # the unit lift of the open holder's nodes (known rows)
@@ -287,7 +275,7 @@ class SemiInverseDriver(Driver):
                 net[held] *= -1  # now the force of the face they lie on, along its normal
                 changes = 1
             elif (not s.closed[0] and s.holder_toggles[0] + 1 < self.contact.max_toggles
-                  and s.lift[0] < self._lift_floor(x, under) - self.contact.gap_tol):
+                  and s.lift[0] < self._lift_floor(x, under) - self.gap_tol):
                 # the face presses into the flange on the die: closed (if it may still open
                 # again in this increment: closed with its switches spent, it could be left
                 # holding more than F)
@@ -344,8 +332,7 @@ class SemiInverseDriver(Driver):
             flags[on, 2] = 1.0
             if k == self.holder_tool:
                 continue  # flat, and still in plan
-            if self.contact.tool_curvature:
-                self._curvature[on] = self._shape_operator(k, x[on], frames[on], normal, lam)
+            self._curvature[on] = self._shape_operator(k, x[on], frames[on], normal, lam)
             shift[on] = (lam - self.lam_n) * self.travel[k]
         # the holder's flat faces hold the flange flat: the slopes of w are known too on the
         # pinched nodes, and on every node under the open holder (on a face or between them)
@@ -519,9 +506,9 @@ class SemiInverseDriver(Driver):
         self.friction.add_residual(R3, F)
         if K is not None and self.friction.active:
             self.friction.add_tangent(K)
-            if self._refreshing and self.contact.consistent_friction:
+            if self._refreshing:
                 self._add_slip_pressure_tangent(K)
-        if K is not None and self.contact.tool_curvature:
+        if K is not None:
             self._add_curvature_tangent(K, R3[:, 2])
 
     def _add_curvature_tangent(self, K, net):
@@ -540,7 +527,7 @@ class SemiInverseDriver(Driver):
 
     def _add_slip_pressure_tangent(self, K):
         """The slipping force's dependence on its normal force (friction.py), which Newton's
-        iterates now update (refresh_normal): dp/dR0 = 1 on a tool, sign(R0) on a pinched node
+        iterates now update: dp/dR0 = 1 on a tool, sign(R0) on a pinched node
         (the closed holder's share of F through sum max(-R0, 0) is left out)."""
         s, n, net = self.state, self.n_owned, self._net
         coef = np.zeros(n)
@@ -562,13 +549,12 @@ class SemiInverseDriver(Driver):
         iterations count both tries."""
         start = self.q.x.array.copy()
         ok, its, res, ev = self._contact_passes(lam, reversal)
-        c = self.contact
-        if ok or not c.early_set or c.early_step <= 1.0:
+        if ok or self.early_step <= 1.0:
             return ok, its, res, ev
         if self.verbose:
             self.progress.note(f"  the contact passes failed ({self._cause}); from now on they end only near "
-                               f"convergence (early_step {c.early_step:g} -> 1), and the increment is tried again")
-        c.early_step = 1.0
+                               f"convergence (early_step {self.early_step:g} -> 1), and the increment is tried again")
+        self.early_step = 1.0
         self.q.x.array[:] = start
         ok, more, res, ev = self._contact_passes(lam, reversal)
         return ok, its + more, res, ev
@@ -589,7 +575,7 @@ class SemiInverseDriver(Driver):
         self._r_prev, self._omega = None, 1.0  # Aitken's memory of the normal-force updates
         iterations, residuals, ev = 0, [], None
         changes, dp, counted = 0, 0.0, 0
-        while counted < self.contact.max_passes and self._passes < self.contact.max_front_passes:
+        while counted < self.contact.max_passes and self._passes < self.MAX_FRONT_PASSES:
             self._passes += 1
             ok, its, res, ev = self._newton_fixed_set(lam)
             iterations += its
@@ -614,7 +600,7 @@ class SemiInverseDriver(Driver):
         """With the predictor: the friction's normal forces of the first pass extrapolated from
         the last two increments, as the carrier is (nodes on the same tool in both)."""
         prev = self._previous
-        if not (self.controls.predictor and self._dlam_prev and prev is not None):
+        if not (self._dlam_prev and prev is not None):
             return
         s, ratio = self.state, (lam - self.lam_n) / (self.lam_n - prev["lam"])
         same = s.tool == prev["tool"]
@@ -628,7 +614,6 @@ class SemiInverseDriver(Driver):
 
     def _newton_on_set(self, lam):
         c = self.controls
-        self._kept = False  # a full step kept for sticking nodes in this pass
         jump = self._constraints(lam)
         norm, scale, ev = self._trial(lam)
         residuals = [norm]
@@ -639,7 +624,7 @@ class SemiInverseDriver(Driver):
             self._scale = scale
             if self.contact.trace:
                 self._trace_iterate(norm, scale, jump)
-            if norm <= c.rtol * scale and jump <= self.contact.gap_tol:
+            if norm <= c.rtol * scale and jump <= self.gap_tol:
                 return True, it, residuals, ev
             if it == c.max_iterations:
                 break
@@ -654,12 +639,12 @@ class SemiInverseDriver(Driver):
             s0 = self.dq.x.petsc_vec.dot(R0) + self._dlift * self._holder_imbalance()
             R0.destroy()
             from_frames(self.dq.x.array, self.rotated, self.frames)
-            self._refreshing = self.contact.refresh_normal
+            self._refreshing = True
             ok, norm, scale, ev, jump = self._line_search(lam, s0, jump)
             if not ok:
                 return False, it + 1, residuals, ev
             residuals.append(norm)
-            if (self.contact.early_set and self._step <= self.contact.early_step * self.contact.penetration
+            if (self._step <= self.early_step * self.contact.penetration
                     and self._set_will_change(lam)):
                 self._early = True  # the set changes: end the pass here, not at convergence
                 return True, it + 1, residuals, ev
@@ -690,7 +675,7 @@ class SemiInverseDriver(Driver):
         deepest[enters] = self.die
         allowed = np.full(len(x), self.contact.penetration)
         if self._holder_open():  # between the open holder's faces: as tight as the pinch it opened
-            allowed[self._under] = self.contact.gap_tol
+            allowed[self._under] = self.gap_tol
         join = ~on & ((depth.min(axis=0) < -allowed) | enters) & can
         return join, release, deepest
 
@@ -707,10 +692,9 @@ class SemiInverseDriver(Driver):
         move = np.linalg.norm(dq.reshape(-1, BS)[:n, :3], axis=1).max(initial=0.0)
         move = comm.allreduce(float(move), op=MPI.MAX)
         alpha = min(1.0, self.contact.trust * self.model.thickness / max(move, 1e-300))
-        if jump > max(self.contact.gap_tol, 1e-2 * move):
+        if jump > max(self.gap_tol, 1e-2 * move):
             s0 = None  # the step mostly moves nodes onto the tools
         x0, lift0 = self.q.x.array.copy(), float(self.state.lift[0])
-        slipping = self.friction.slipping.copy()
         norm = scale = ev = jump = None
         for _ in range(c.line_search + 1):
             self.q.x.array[:] = x0 + alpha * dq
@@ -725,8 +709,6 @@ class SemiInverseDriver(Driver):
                 say(f"      step: alpha {alpha:.3g} of a largest nodal move {move:.3g}, |R| {norm:.3e}, energy slope "
                     f"{s0 or 0:.3e} -> {s1:.3e}, known corrections {jump:.2e}")
             shorter = None if s0 is None else shorten(alpha, s0, s1)
-            if shorter is not None and alpha == 1.0 and self._keep_sticking_step(slipping):
-                shorter = None
             if shorter is None:
                 self.line_search_factors.append(alpha)
                 self._step = alpha * move
@@ -734,23 +716,6 @@ class SemiInverseDriver(Driver):
             alpha = shorter
         self._cause = f"the line search found no acceptable step ({ev.cause() or 'no energy descent'})"
         return False, norm, scale, ev, jump
-
-    def _keep_sticking_step(self, slipping) -> bool:
-        """With stick_step (opt-in): whether a full step that overshoots is kept all the same, once
-        per pass, where it turns slipping nodes to stick (`slipping`: before the step). The slip
-        tangent has no stiffness along the slip, so a step that shortens a node's slip meets the
-        stick stiffness k_t that the tangent did not hold: a kink of the friction law. Cut back by
-        the line search, the step stays on the slipping side of the kink, and Newton crept there
-        by 10 % per iteration (the 2,450-cell aluminium cup restarted at 30 mm: 88 iterations in
-        0.72 mm, 47 with the full step kept). Past the kink the stick tangent is exact. Not the
-        default: on the paper's cup it costs iterations and cut-backs (docs/contact.md)."""
-        if not self.contact.stick_step or self._kept:
-            return False
-        stuck = self.model.mesh.comm.allreduce(int(np.sum(slipping & ~self.friction.slipping)), op=MPI.SUM)
-        if stuck and self.contact.trace:
-            say(f"      full step kept: {stuck} slipping nodes stick")
-        self._kept = stuck > 0
-        return self._kept
 
     def _trace_iterate(self, norm, scale, jump):
         """The three owned nodes with the largest residual of this iterate, and what holds them."""
@@ -882,7 +847,7 @@ class SemiInverseDriver(Driver):
                              "contact_half_thickness": self.half_thickness})
         own["global"].update({f"contact_{k}": getattr(c, k) for k in self.GLOBAL})
         own["global"].update({"contact_lam_n": np.array(self.lam_n), "contact_travel": self.travel,
-                              "contact_early_step": np.array(self.contact.early_step)})  # the fallback's
+                              "contact_early_step": np.array(self.early_step)})  # the fallback's
         if self._previous is not None:  # the predictor's: the committed set before the last
             own["nodes"].update({"contact_previous_tool": self._previous["tool"],
                                  "contact_previous_normal": self._previous["normal"]})
@@ -911,7 +876,7 @@ class SemiInverseDriver(Driver):
         self.lam_n = float(glob["contact_lam_n"]) * lam_scale
         self.half_thickness = nodes["contact_half_thickness"].copy()
         if "contact_early_step" in glob:
-            self.contact.early_step = float(glob["contact_early_step"])
+            self.early_step = float(glob["contact_early_step"])
         self._previous = None
         if "contact_previous_lam" in glob:
             self._previous = {"lam": float(glob["contact_previous_lam"]) * lam_scale,

@@ -70,9 +70,6 @@ class Controls:
     growth: float = 1.5
     cut: float = 0.25
     line_search: int = 6  # halvings
-    predictor: bool = True
-    lazy_tangent: bool = True  # Newton's trial states assemble K only when a solve asks for it
-    free_rows: bool = True  # factorise the free rows only (free_rows.py); False: the whole assembled matrix
 
     def check(self):
         for name in ("initial_step", "min_step", "max_step", "rtol"):
@@ -111,6 +108,7 @@ class Driver:
         self.model, self.bcs, self.nodal, self.edge_frames = model, bcs, nodal, frames
         self.controls = controls or Controls()
         self.controls.check()
+        self.easy_iterations = self.controls.easy_iterations  # an increment this easy lets the next grow
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
         self.verbose = verbose
         self.progress = Progress()  # a run sets its own (label, total, unit)
@@ -237,13 +235,10 @@ class Driver:
 
     def _trial(self, lam, elastic_tangent: bool = False):
         """residual(lam, tangent=True) for Newton's iterates and line-search trials, the tangent
-        left for later (Controls.lazy_tangent): the element tangents, K's assembly and its nodal
-        terms are computed only when a solve needs them (_tangent_now), so that neither the
-        iterate that converges nor a rejected trial pays for a K that is never factorised (about
-        a sixth of the cup's evaluations). The round-off floor of the scale is then the last
-        assembled tangent's."""
-        if not self.controls.lazy_tangent:
-            return self.residual(lam, tangent=True, elastic_tangent=elastic_tangent)
+        left for later: the element tangents, K's assembly and its nodal terms are computed only
+        when a solve needs them (_tangent_now), so that neither the iterate that converges nor a
+        rejected trial pays for a K that is never factorised (docs/performance.md). The round-off
+        floor of the scale is then the last assembled tangent's."""
         out = self.residual(lam, tangent=False, elastic_tangent=elastic_tangent)
         self._later = (lam, elastic_tangent)
         return out
@@ -342,7 +337,7 @@ class Driver:
 
     def _linear_solve(self, out, t0) -> bool:
         eliminable = self._eliminable()
-        if self.controls.free_rows and self.free_lu.pays(eliminable):
+        if self.free_lu.pays(eliminable):
             ok = self.free_lu.solve(self.A, self.b, out.x.petsc_vec, self._known_rows(), eliminable)
         else:
             self.ksp.solve(self.b, out.x.petsc_vec)
@@ -445,7 +440,7 @@ class Driver:
         return self.model.mesh.comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
 
     def _predict(self, dlam, x_n, x_prev):
-        if self.controls.predictor and self._dlam_prev:
+        if self._dlam_prev:
             self.q.x.array[:] = x_n + (dlam / self._dlam_prev) * (x_n - x_prev)
         else:
             self.q.x.array[:] = x_n
@@ -534,7 +529,7 @@ class Driver:
                     lam, inc.number, sum(h.iterations for h in self.history),
                     f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "
                     f"|R| {res[0]:.2e} -> {res[-1]:.2e}  plastic layers {ev.plastic_layers}")
-            if its <= c.easy_iterations and cutbacks == 0:
+            if its <= self.easy_iterations and cutbacks == 0:
                 dlam = min(dlam * c.growth, c.max_step)
             self._steps = (dlam, self._dlam_prev, x_n)  # the next step; this one and the state before it (the predictor's)
             if on_increment is not None:
