@@ -648,7 +648,7 @@ def test_a_pass_starts_from_the_last_evaluation_turned_into_its_frames():
     d.residual(lam, tangent=True)
     s, x = d.state, d.positions()
     released = np.flatnonzero((s.tool == 0) & ~d.sym_fixed.any(axis=1))[:5]
-    die_gap = d._gaps(x, lam)[d.die][0]
+    die_gap = d.gaps(x, lam)[d.die][0]
     joined = np.flatnonzero((s.tool == FREE) & np.isfinite(die_gap))[:5]
     assert released.size == 5 and joined.size == 5
     s.tool[released], s.tool[joined] = FREE, d.die

@@ -135,7 +135,7 @@ class DrawingProblem:
         d = self.driver
         x = d.positions()
         worst = 0.0
-        for gap, _ in d._gaps(x, d.lam):
+        for gap, _ in d.gaps(x, d.lam):
             worst = max(worst, float(-gap.min(initial=0.0)))
         return d.model.mesh.comm.allreduce(worst, op=MPI.MAX)
 

@@ -174,7 +174,7 @@ class SemiInverseDriver(Driver):
         d = self.q.x.array.reshape(-1, BS)[: self.n_owned, :3]
         return self.X[: self.n_owned] + d
 
-    def _gaps(self, x, lam):
+    def gaps(self, x, lam):
         """Gap and normal of every owned node to every tool at load factor lam, the open
         holder last (an infinite gap when it is closed or has no force)."""
         h = self.half_thickness
@@ -200,7 +200,7 @@ class SemiInverseDriver(Driver):
         closes on the flange when it has a force."""
         x = self.positions()
         s = self.state
-        for k, (gap, _) in enumerate(self._gaps(x, 0.0)):
+        for k, (gap, _) in enumerate(self.gaps(x, 0.0)):
             touch = (gap <= self.contact.penetration) & (s.tool == FREE)
             s.tool[touch] = k
         if self.holder is not None:
@@ -285,7 +285,7 @@ class SemiInverseDriver(Driver):
                 net[held] *= -1  # die minus holder
                 changes = 1
             elif not s.closed[0] and self._on_holder()[1] == 0:
-                gap = self._gaps(x, self._lam_trial)[self.holder_tool][0]
+                gap = self.gaps(x, self._lam_trial)[self.holder_tool][0]
                 nearest = comm.allreduce(float(gap[under].min(initial=np.inf)), op=MPI.MIN)
                 if np.isfinite(nearest) and s.lift[0] - nearest <= self._lift_floor(x, under):
                     s.closed[0] = True  # down to the sheet on the die: closed
@@ -313,7 +313,7 @@ class SemiInverseDriver(Driver):
         forces at the current iterate."""
         t0 = time.perf_counter()
         s, x = self.state, self.positions()
-        gaps = self._gaps(x, lam)
+        gaps = self.gaps(x, lam)
         n_own = self.n_owned
         frames = np.tile(np.eye(3), (n_own, 1, 1))
         known = np.zeros((n_own, BS))
@@ -669,7 +669,7 @@ class SemiInverseDriver(Driver):
         on, can = s.tool != FREE, s.toggles < self.contact.max_toggles
         scale = max(self._largest(net), 1e-300)
         release = on & ~self.pinched & (net < -tensile * scale) & can
-        depth = np.stack([g for g, _ in self._gaps(x, lam)])  # (tools, nodes)
+        depth = np.stack([g for g, _ in self.gaps(x, lam)])  # (tools, nodes)
         deepest = np.argmin(depth, axis=0)
         enters = under & ~on & s.closed[0]  # the closed holder pinches what comes under it
         deepest[enters] = self.die

@@ -57,7 +57,7 @@ def release(contact_driver, controls: Controls | None = None, verbose=False) -> 
     sb.q.x.array[:] = cd.q.x.array
     sb.held = sb.q.x.array.copy()
     sb.held[cd.support_dofs] = 0.0  # symmetry planes
-    sb.lam, sb._direction = 1.0, 1.0  # run(0) is a load reversal: elastic first tangent
+    sb.continue_from(1.0)  # run(0) is a load reversal: elastic first tangent
     sb.residual(0.0, tangent=False)
     f = sb.residual_full[: V.dofmap.index_map.size_local * BS].copy()  # f_int(q): the tools' forces
     f[sb.bc_dofs[sb.bc_dofs < f.size]] = 0.0

@@ -461,6 +461,14 @@ class Driver:
             self._cause = f"{cause}; with the line search {'on' if self.searching else 'off'}: {self._cause}"
         return ok, its + its2, res, ev
 
+    def continue_from(self, lam: float) -> None:
+        """q holds a converged state at load factor lam, reached from 0 (another driver's, or a
+        state set by hand): the next run() steps on from there, a load reversal where it goes
+        back towards 0 (its first tangent the elastic one)."""
+        self.lam = float(lam)
+        self._direction = float(np.sign(lam)) or None
+        self._dlam_prev = None
+
     def run(self, target: float = 1.0, on_increment=None):
         """Step lambda from its current value to `target` (up or down). A SIGINT or SIGTERM
         meanwhile stops it after the increment under way: the last converged state is written
