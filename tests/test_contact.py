@@ -140,9 +140,9 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
     assert abs(forces[-1]) < 1e-6 * max(abs(f) for f in forces)
 
 
-def _strip(mu=0.15, F=1000.0, t=1.0, friction_rtol=1e-10, **controls):
+def _strip(mu=0.15, F=1000.0, t=1.0, friction_rtol=1e-10, drawbeads=(), **controls):
     """A 100 x 20 strip pinched over |x| <= 40 between a flat die and a flat holder pressing with
-    F; its right end is pulled by lambda * 2 mm along x."""
+    F (and over drawbeads); its right end is pulled by lambda * 2 mm along x."""
     from shellform.contact.semi_inverse import ContactControls
 
     rect = rectangle(MPI.COMM_WORLD, 100.0, 20.0, region="full", n=10)
@@ -158,7 +158,7 @@ def _strip(mu=0.15, F=1000.0, t=1.0, friction_rtol=1e-10, **controls):
         bcs.append(fem.dirichletbc(np.float64(0), dofs, V.sub(k)))
     contact = ContactControls(penetration=1e-3 * t, friction_rtol=friction_rtol)
     d = SemiInverseDriver(model, bcs, [die], [0.0], friction=mu, holder=holder, holder_force=F, prescribed=qbar,
-                          contact=contact, controls=Controls(**{"initial_step": 0.1, "rtol": 1e-10,
+                          contact=contact, drawbeads=drawbeads, controls=Controls(**{"initial_step": 0.1, "rtol": 1e-10,
                                                                 "max_iterations": 25, **controls}), verbose=False)
     return rect, d
 

@@ -51,6 +51,7 @@ from mpi4py import MPI
 from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.errors import InputError
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
+from shellform.contact.drawbead import Drawbeads
 from shellform.contact.friction import CoulombFriction
 from shellform.contact.holder import PinchingHolder
 from shellform.nonlinear.driver import Driver, shorten
@@ -100,7 +101,7 @@ class SemiInverseDriver(Driver):
     tools: list of rigid tools with ``gap(x, offset, dz) -> (gap, normal)`` in contact order
     (e.g. punch, die); ``travel[k]`` is tool k's z-travel at lambda = 1 (punch: -stroke);
     holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool `die`
-    (default: the last tool); friction: mu.
+    (default: the last tool); friction: mu; drawbeads: DrawbeadLine's (drawbead.py).
     """
 
     swap_line_search = False  # its Newton (_newton) has its own line search and contact passes
@@ -108,7 +109,8 @@ class SemiInverseDriver(Driver):
     EARLY_STEP = 10.0  # a pass ends once the set will change and the steps are below this many penetrations
 
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
-                 prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None):
+                 prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None,
+                 drawbeads=()):
         super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,
                          verbose=verbose)
         self.support_dofs = self.bc_dofs.copy()  # supports and symmetry (prescribed values: lam qbar)
@@ -137,6 +139,8 @@ class SemiInverseDriver(Driver):
         E = model.material[0]
         self.friction = CoulombFriction(friction, CoulombFriction.STICK_STIFFNESS * E * self.area / model.cell_size,
                                         self.sym_fixed[:, :2])
+        self.drawbeads = Drawbeads(drawbeads, V, model.dofs, E, model.thickness, model.cell_size,
+                                   self.sym_fixed[:, :2]) if drawbeads else None
         self.holder = None
         self.holder_tool = len(self.tools)  # the open holder's index in the contact set
         if holder is not None:
@@ -363,6 +367,9 @@ class SemiInverseDriver(Driver):
         flag = self._flag_fn.x.array.reshape(-1, BS)
         self.rotated = flag[:, :3].any(axis=1) | np.any(np.abs(self.frames - np.eye(3)) > 0, axis=(1, 2))
         self._set_bcs(flag)
+        if self.drawbeads is not None:
+            x_local = self.X + self.q.x.array.reshape(-1, BS)[: self.n_local, :3]
+            self.drawbeads.update(x_local, self.x_n, self.frames[:n_own])
         self.times["contact_s"] += time.perf_counter() - t0
         return max(self._largest(known), self._set_dirichlet(lam, self.support_dofs))  # supports: g = lam qbar
 
@@ -492,15 +499,19 @@ class SemiInverseDriver(Driver):
         return float(dz)
 
     def add(self, lam, x, R, K=None):
-        """Driver's nodal hook: R -= friction forces (in the nodal frames), the
-        friction's normal forces first taken from R where Newton's iterates update them;
-        K += the friction's stiffness in the tangent slots, the slip force's dp/dq and the
-        frames' turning on curved tools."""
+        """Driver's nodal hook: R -= the drawbeads' forces and friction forces (in the nodal
+        frames), the friction's normal forces taken from R between the two where Newton's
+        iterates update them; K += the beads' and the friction's stiffness in the tangent slots,
+        the slip force's dp/dq and the frames' turning on curved tools."""
         n = self.n_owned
         F = self.frames[:n]  # identity off the tools
         R3 = R[: n * BS].reshape(-1, BS)[:, :3]
         if K is not None:
             self.friction.slip_rows = None
+        if self.drawbeads is not None:  # before the reactions are read: the tools take what the beads do not
+            self.drawbeads.add_residual(R3, F)
+            if K is not None:
+                self.drawbeads.add_tangent(K)
         if self._refreshing and self.friction.active:
             self._refresh_normal(R)  # the reactions before friction
         self.friction.add_residual(R3, F)
@@ -564,6 +575,8 @@ class SemiInverseDriver(Driver):
         then the set's update; repeat until the set and the normal forces hold."""
         self.state = self.committed.copy()
         self.friction.start()
+        if self.drawbeads is not None:
+            self.drawbeads.start()
         self._lam_trial = lam
         if self.holder is not None:
             self._pinch(self.holder.under(self.x_n), grow=False)
@@ -821,6 +834,8 @@ class SemiInverseDriver(Driver):
         s.toggles[:] = 0
         s.holder_toggles[:] = 0
         self.friction.commit()
+        if self.drawbeads is not None:
+            self.drawbeads.commit()
         c = self.committed
         self._previous = {"lam": self.lam_n, "tool": c.tool, "normal": c.normal}
         self.committed = s.copy()
@@ -843,6 +858,8 @@ class SemiInverseDriver(Driver):
         c, own = self.committed, super().checkpoint_state()
         own["nodes"].update({f"contact_{k}": getattr(c, k) for k in self.NODES})
         own["nodes"].update(self.friction.checkpoint())
+        if self.drawbeads is not None:
+            own["nodes"].update(self.drawbeads.checkpoint())
         own["nodes"].update({"contact_pinched": self.pinched_n, "contact_x_n": self.x_n,
                              "contact_half_thickness": self.half_thickness})
         own["global"].update({f"contact_{k}": getattr(c, k) for k in self.GLOBAL})
@@ -870,6 +887,8 @@ class SemiInverseDriver(Driver):
             getattr(c, k)[...] = glob[f"contact_{k}"]
         self.committed, self.state = c, c.copy()
         self.friction.restore(nodes)
+        if self.drawbeads is not None:
+            self.drawbeads.restore(nodes)
         self.pinched = nodes["contact_pinched"].copy()
         self.pinched_n = self.pinched.copy()
         self.x_n = nodes["contact_x_n"].copy()
@@ -887,6 +906,8 @@ class SemiInverseDriver(Driver):
         """The committed contact state and its forces (a stop reports the last converged state)."""
         self.state = self.committed.copy()
         self.friction.start()
+        if self.drawbeads is not None:
+            self.drawbeads.start()
         self._lam_trial = self.lam_n
         self.model.converged_lever()
         if self.holder is not None:

@@ -1,0 +1,186 @@
+"""Drawbeads: a part of the contact that restrains the flange's flow across a line.
+
+The equivalent drawbead model (Stoughton 1988; Carleer, Meinders and Huetink 1996, "Equivalent
+drawbead model in finite element simulations", Computers & Structures 58): the bead is not
+meshed; a line on the flange (fixed in space, in the tools' plane) resists the sheet's motion
+across it with a restraining force per unit length F_r, and pushes the binder open with an
+uplift force per unit length F_u, both measured or computed for the bead's geometry, material
+and friction once and given to the model.
+
+On the sheet, a line load along the bead, spread to the nodes by the shell's own linear
+interpolation: a node's share of the line is
+
+    l_i = integral over the bead line of N_i dl
+
+(the line clipped to each cell at the sheet's current positions; sum_i l_i is the length of
+the line on the sheet, exactly). Across the line, in the sheet's plane, the bead's normal d_i
+(the segments' normals weighted by l_i), the restraint is a rigid-plastic law integrated like
+Coulomb friction, with the node's slip across the line ds = (x - x_n) . d_i in the increment,
+its force of the last increment f_n and a stiffness k_i = E t l_i / h before the bead yields:
+
+    trial  f* = f_n - k_i ds,   |f*| <= F_r l_i: f = f*,   df/ds = -k_i
+                                |f*| >  F_r l_i: f = F_r l_i f*/|f*|,   df/ds = 0
+
+acting along d_i; the uplift F_u l_i acts along +z on the sheet, which the holder takes. Sliding
+across the line the restraint is F_r times the line's length to round-off. (The shares' change
+with the positions is left out of the tangent: a node's share moves as it crosses the line.)
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem, la
+
+from shellform.assembly.sheet_element import BS
+
+
+@dataclass(frozen=True)
+class DrawbeadLine:
+    """A drawbead: a polyline in the plane (x, y; at least two points), its restraining force
+    and uplift force per unit length."""
+
+    points: tuple
+    restraint: float
+    uplift: float = 0.0
+
+
+def _clip(P0, P1, tri):
+    """The parameters [t0, t1] of the segment P0 -> P1 inside each triangle of tri (cells, 3,
+    2), and whether the piece lies on one of its edges (shared with a neighbour). t0 >= t1:
+    none."""
+    d = P1 - P0
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    orient = np.sign((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    t0, t1 = np.zeros(len(tri)), np.ones(len(tri))
+    on_edge = np.zeros(len(tri), dtype=bool)
+    scale = np.abs(tri).max(initial=1.0) + np.abs(P0).max() + np.abs(P1).max()
+    for p, q in ((a, b), (b, c), (c, a)):
+        e = q - p
+        n = orient[:, None] * np.stack([-e[:, 1], e[:, 0]], axis=1)  # inward normal
+        f0 = np.einsum("ij,ij->i", n, P0 - p)  # n . (P0 + t d - p) >= 0
+        slope = n @ d
+        tol = 1e-12 * scale * np.linalg.norm(n, axis=1)
+        along = np.abs(slope) <= tol  # parallel to this edge
+        on_edge |= along & (np.abs(f0) <= tol * max(1.0, np.linalg.norm(d)))
+        outside = along & (f0 < -tol)
+        t0[outside], t1[outside] = 1.0, 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = -f0 / slope
+        enter, leave = ~along & (slope > 0), ~along & (slope < 0)
+        t0[enter] = np.maximum(t0[enter], t[enter])
+        t1[leave] = np.minimum(t1[leave], t[leave])
+    return t0, t1, on_edge
+
+
+class Drawbeads:
+    """The drawbeads of a blank on n_owned nodes (V: the carrier's space, dofs: the owned
+    cells' nodes, E and t: the sheet's modulus and thickness, h: its cell size, held: (n, 2)
+    in-plane slots a symmetry plane holds)."""
+
+    def __init__(self, lines, V, dofs, E: float, t: float, h: float, held: np.ndarray):
+        self.lines = tuple(lines)
+        self.V, self.dofs, self.held = V, dofs, held
+        n = held.shape[0]
+        self.n = n
+        self.k_per_length = E * t / h
+        self._shares = fem.Function(V)  # l_i and l_i d_i per node (3 of the carrier's slots)
+        self.length = np.zeros(n)  # l_i
+        self.across = np.zeros((n, 2))  # d_i
+        self.uplift = np.zeros(n)  # F_u l_i
+        self.limit = np.zeros(n)  # F_r l_i
+        self.committed = np.zeros(n)  # the restraint of the last converged increment (along d_i)
+        self.history = np.zeros(n)
+        self.force = np.zeros((n, 3))  # of the current iterate, on the sheet (x, y, z)
+        self.rate = np.zeros((n, 2, 2))  # -df/dx in the nodes' tangent slots
+
+    def shares(self, x_local: np.ndarray) -> None:
+        """l_i, d_i, F_r l_i and F_u l_i at the current positions of the local nodes."""
+        arr = self._shares.x.array.reshape(-1, BS)
+        arr[:] = 0.0
+        tri = x_local[self.dofs][:, :, :2]  # (cells, 3, 2)
+        for line in self.lines:
+            pts = np.asarray(line.points, dtype=float)
+            for P0, P1 in zip(pts[:-1], pts[1:]):
+                d = P1 - P0
+                length = float(np.hypot(*d))
+                normal = np.array([-d[1], d[0]]) / length
+                t0, t1, on_edge = _clip(P0, P1, tri)
+                cells = np.flatnonzero(t1 > t0)
+                if cells.size == 0:
+                    continue
+                piece = (t1[cells] - t0[cells]) * length * np.where(on_edge[cells], 0.5, 1.0)
+                mid = P0 + 0.5 * (t0[cells] + t1[cells])[:, None] * d
+                N = _barycentric(tri[cells], mid)  # the shape functions at the piece's middle
+                w = piece[:, None] * N  # (cells, 3): integral of N_i along the piece
+                nodes = self.dofs[cells]
+                for col, values in ((0, w), (1, w * normal[0]), (2, w * normal[1]),
+                                    (3, w * line.restraint), (4, w * line.uplift)):
+                    np.add.at(arr[:, col], nodes.ravel(), values.ravel())
+        self._shares.x.scatter_reverse(la.InsertMode.add)
+        own = arr[: self.n]
+        self.length = own[:, 0].copy()
+        size = np.hypot(own[:, 1], own[:, 2])
+        self.across = np.where(size[:, None] > 0, own[:, 1:3] / np.maximum(size, 1e-300)[:, None], 0.0)
+        self.limit, self.uplift = own[:, 3].copy(), own[:, 4].copy()
+
+    # -- the increment's history ----------------------------------------------------------------
+    def start(self) -> None:
+        self.history = self.committed.copy()
+
+    def commit(self) -> None:
+        self.committed = np.einsum("ni,ni->n", self.force[:, :2], self.across)
+        self.history = self.committed.copy()
+
+    def checkpoint(self) -> dict:
+        return {"drawbead_restraint": self.committed}
+
+    def restore(self, nodes: dict) -> None:
+        self.committed = nodes["drawbead_restraint"].copy()
+        self.history = self.committed.copy()
+
+    # -- one iterate ---------------------------------------------------------------------------
+    def update(self, x_local: np.ndarray, x_n: np.ndarray, frames: np.ndarray) -> None:
+        """The restraint and uplift at the current positions (x_local: every local node; x_n:
+        the owned nodes' at the start of the increment; frames: the owned nodes' frames)."""
+        self.shares(x_local)
+        n = self.n
+        d = self.across
+        ds = np.einsum("ni,ni->n", x_local[:n, :2] - x_n[:, :2], d)
+        k = self.k_per_length * self.length
+        trial = self.history - k * ds
+        slip = np.abs(trial) > self.limit
+        f = np.where(slip, self.limit * np.sign(trial), trial)
+        self.force[:] = 0.0
+        self.force[:, :2] = f[:, None] * d
+        self.force[:, 2] = self.uplift
+        d3 = np.zeros((n, 3))
+        d3[:, :2] = d
+        d2 = np.einsum("nij,nj->ni", frames[:n, :2], d3)  # d in the frames' tangent slots
+        self.rate = np.where(slip, 0.0, k)[:, None, None] * d2[:, :, None] * d2[:, None, :]
+        held = self.held
+        self.rate[held[:, :, None] | held[:, None, :]] = 0.0
+
+    def add_residual(self, R3: np.ndarray, frames: np.ndarray) -> None:
+        """R -= f on the owned nodes' u, v, w rows (R3), in their nodal frames."""
+        R3 -= np.einsum("nij,nj->ni", frames, self.force)
+
+    def add_tangent(self, K) -> None:
+        b = np.flatnonzero(np.abs(self.rate).max(axis=(1, 2)) > 0)
+        if b.size:
+            rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
+            K.setValuesLocalRCV(rows, rows, self.rate[b].reshape(b.size, 4), addv=True)
+
+    def total(self, comm) -> np.ndarray:
+        """The beads' force on the sheet (x, y, z), all ranks (of this model: not mirrored)."""
+        from mpi4py import MPI
+
+        return comm.allreduce(self.force.sum(axis=0), op=MPI.SUM)
+
+
+def _barycentric(tri, p):
+    """The linear shape functions of triangles tri (cells, 3, 2) at points p (cells, 2)."""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    l1 = ((p[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (p[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])) / det
+    l2 = ((b[:, 0] - a[:, 0]) * (p[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (p[:, 0] - a[:, 0])) / det
+    return np.stack([1.0 - l1 - l2, l1, l2], axis=1)
