@@ -124,11 +124,19 @@ class DrawingProblem:
         return 0.0 if d.holder is None or d.state.closed[0] else float(d.state.lift[0])
 
     def force_balance(self) -> float:
-        """|sum of the tools' z-forces on the sheet| / punch force: the sheet's equilibrium
-        along z (the symmetry planes carry no z-force)."""
+        """|sum of the tools' and the drawbeads' z-forces on the sheet| / punch force: the
+        sheet's equilibrium along z (the symmetry planes carry no z-force)."""
         d = self.driver
         fz = sum(float(self.tool_force(k)[2]) for k in range(len(d.tools) + (d.holder is not None)))
+        fz += float(self.drawbead_force()[2])
         return abs(fz) / max(abs(self.punch_force()), 1e-300)
+
+    def drawbead_force(self) -> np.ndarray:
+        """The drawbeads' force on the sheet (x, y, z), whole blank: their restraint and uplift."""
+        d = self.driver
+        if d.drawbeads is None:
+            return np.zeros(3)
+        return self.symmetry * d.drawbeads.total(d.model.mesh.comm)
 
     def max_penetration(self) -> float:
         """The deepest penetration of any node into any tool (>= 0), all ranks."""
