@@ -23,7 +23,7 @@ import signal
 import sys
 from pathlib import Path
 
-from shellform import __version__
+from shellform import __version__  # the package first: the DOLFINx runtime before any solver module
 from shellform.errors import InputError
 
 
@@ -56,7 +56,6 @@ def main(argv=None) -> int:
     p_study.add_argument("--quick", action="store_true", help="coarse levels only (for tests)")
     args = parser.parse_args(argv)
 
-    import shellform  # noqa: F401  (DOLFINx runtime first)
     from shellform.nonlinear.interrupt import Interrupted
     from shellform.results.log import say  # every line below once per run, on rank 0
 
