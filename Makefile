@@ -1,4 +1,5 @@
-# shellform: `make demo` runs the main job, `make test` the test suite.
+# shellform: `make demo` runs the main job, `make test` the fast lane of the test suite (all but the
+# tests marked slow), `make test-slow` the slow lane; CI (.ci/run) runs both.
 # Both create .venv with a Python >= 3.12 and install the project on first use.
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -6,7 +7,7 @@ STAMP  := $(VENV)/.installed
 OUT    ?= results/square_cup
 NPROC  ?= 2
 
-.PHONY: demo test venv clean bench docs
+.PHONY: demo test test-slow venv clean bench docs
 
 venv: $(STAMP)
 
@@ -24,7 +25,10 @@ demo: $(STAMP)
 	@echo "shellform: summary.json, force_stroke.csv/.png, thickness_diagonal.csv, thickness_transverse.csv, cup.png in $(OUT)"
 
 test: $(STAMP)
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -m "not slow" tests
+
+test-slow: $(STAMP)
+	$(PY) -m pytest -q -m slow tests
 
 clean:
 	rm -rf $(VENV) results

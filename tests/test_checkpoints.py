@@ -308,6 +308,7 @@ if MPI.COMM_WORLD.rank == 0:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.timeout(600)
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")

@@ -512,7 +512,7 @@ def test_drawn_cup_springback_outputs(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["numisheet93_aluminium.toml", "numisheet93_steel.toml",
-                                  "numisheet93_aluminium_graded.toml"])
+                                  pytest.param("numisheet93_aluminium_graded.toml", marks=pytest.mark.slow)])
 def test_numisheet_scenes_draw_their_first_millimetres(name):
     """The NUMISHEET'93 scenes (the numisheet study's, on 6 x 6; the graded one on its gmsh mesh
     from demos/meshes/square_cup_graded.geo) draw 2 mm: the holder's forces sum to F, the tools
@@ -616,7 +616,7 @@ def test_slip_tangent_carries_the_normal_force_change():
     assert error <= 1e-6, error
 
 
-@pytest.mark.parametrize("mu", [0.0, 0.1])
+@pytest.mark.parametrize("mu", [0.0, pytest.param(0.1, marks=pytest.mark.slow)])
 def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
     """A node moving along the punch's nose turns its frame: its tangential rows t_a . R change
     by -R0 W_ab dx_b (W the nose's shape operator). On the cup drawn 6 mm, for nodes on the nose,

@@ -30,6 +30,7 @@ def test_picks_take_the_cheapest_run_within_each_tolerance():
     assert none["case"] == "none coarser than fine" and none["wall_s"] == ""
 
 
+@pytest.mark.slow
 def test_numisheet_cost_short(tmp_path):
     rows = numisheet_cost.run(tmp_path, levels=(4, 6), steps=(1, 2), stroke=1.5)
     assert [r["case"] for r in rows] == ["n 4, 2x step", "n 6, 2x step", "n 4", "n 6"]
@@ -51,6 +52,7 @@ def test_numisheet_cost_short(tmp_path):
     assert (tmp_path / "numisheet_cost_error_time.png").stat().st_size > 0
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 def test_cup_benchmark_short(tmp_path):
     """cup-benchmark on a 6 x 6 quarter mesh, 1 mm, on 1 and 2 ranks, with Newton's tolerance at

@@ -75,6 +75,7 @@ def test_rollup_demo():
     assert out.rstrip().endswith("OK"), out
 
 
+@pytest.mark.slow
 def test_membrane_locking_demo():
     out = run_demo("demo_membrane_locking.py", "--n", "16")
     assert re.search(r"^\s*16\s+64\s+7\.96e-01\s+7\.5\de-03", out, re.M), out  # locked, then not
@@ -136,6 +137,7 @@ def test_curved_beam_scene(tmp_path):
     assert v["at"][0] == pytest.approx(0.0, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_round_cup_scene_is_axisymmetric(tmp_path):
     """The round cup (demos/round_cup.toml, its 279 cells) to 15 mm: on a planar isotropic sheet
     the draw-in along x, along y and along the diagonal agree, and so do the thickness strains

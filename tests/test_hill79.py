@@ -415,6 +415,7 @@ def test_pack_layout():
     np.testing.assert_array_equal(power(2.0, 1.0, 4.0)[4:7], [1.0, SY, 4.0])
 
 
+@pytest.mark.slow
 def test_strain_guard_counts_and_skips_unphysical_points():
     """section_update leaves a point whose strain is not finite or past 1000 % untouched (its
     resultants those of zero strain, its layers' state as it was) and counts it."""

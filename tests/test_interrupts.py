@@ -114,6 +114,7 @@ def run_cli(*args) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(600)
 def test_ctrl_c_mid_stroke_then_resume_equals_the_uninterrupted_draw(tmp_path):
     """SIGINT half-way through a cup's stroke (between two reports): exit 130, a summary marked
@@ -146,6 +147,7 @@ def test_ctrl_c_mid_stroke_then_resume_equals_the_uninterrupted_draw(tmp_path):
     assert len(again["reports"]) == len(done["reports"])
 
 
+@pytest.mark.slow
 @pytest.mark.timeout(600)
 def test_a_killed_run_resumes_from_its_last_timed_checkpoint(tmp_path):
     """output.checkpoint_every writes the last converged increment between reports: a run

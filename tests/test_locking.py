@@ -15,6 +15,7 @@ from shellform.studies import locking, rollup
 ROOF_LINEAR, ROOF_SHEET = 0.34871, 0.32699
 
 
+@pytest.mark.slow
 def test_thin_rollup_with_64_elements_is_within_1e_3_of_the_arc():
     """t/L = 1e-4 (membrane stiffness 1.2e9 times the bending stiffness): the tip stays within
     1e-3 L of the exact arc all the way round with 64 elements (4.7e-4 measured), where the
@@ -24,6 +25,7 @@ def test_thin_rollup_with_64_elements_is_within_1e_3_of_the_arc():
     assert r["max_tip_error"] < 1e-3
 
 
+@pytest.mark.slow
 def test_assumed_membrane_unlocks_a_coarse_thin_strip():
     """16 elements at t/L = 1e-3: 0.80 L off with the compatible membrane strain, 7.5e-3 L with
     the assumed one (which converges at O(h^2): 1.9e-3 with 32 elements, 4.6e-4 with 64)."""

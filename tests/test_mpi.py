@@ -59,6 +59,7 @@ if MPI.COMM_WORLD.rank == 0:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 def test_nonlinear_two_ranks_match_serial(tmp_path):
@@ -96,6 +97,7 @@ if MPI.COMM_WORLD.rank == 0:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 @pytest.mark.parametrize("bhf", [19600.0, 400.0])
@@ -143,6 +145,7 @@ if MPI.COMM_WORLD.rank == 0:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 def test_resumed_cup_on_two_ranks_matches_serial(tmp_path):
@@ -173,6 +176,7 @@ if MPI.COMM_WORLD.rank == 0:
 """
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 def test_curved_and_oblique_supports_on_two_ranks_match_serial(tmp_path, monkeypatch):
@@ -192,6 +196,7 @@ def test_curved_and_oblique_supports_on_two_ranks_match_serial(tmp_path, monkeyp
         assert w == pytest.approx(serial, rel=1e-10), name
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 def test_two_ranks_say_each_line_once(tmp_path):

@@ -15,6 +15,7 @@ from shellform.material import Hill79Material
 from shellform.studies import levy, plastic, rollup
 
 
+@pytest.mark.slow
 def test_levy_clamped_plate():
     """w_c/h within 2 % of Levy's table up to P = 318 and 2.1 % at P = 402 (16 x 16 quarter).
 

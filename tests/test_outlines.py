@@ -233,7 +233,7 @@ def test_z0_of_a_paraboloid_equals_its_radii():
     import tomllib
 
     data = tomllib.loads((Path(__file__).resolve().parents[1] / "demos" / "shallow_shell.toml").read_text())
-    from shellform.nonlinear.run import problem
+    from shellform.nonlinear.problem import SheetProblem
 
     data["mesh"]["n"] = 6
     w, sheet = [], []
@@ -241,7 +241,7 @@ def test_z0_of_a_paraboloid_equals_its_radii():
         w.append(linear.solve(scene.from_dict({**data, "surface": surface})).value("w"))
         nonlinear = {**data, "surface": surface, "effects": data["effects"] + ["geometric_nonlinearity"],
                      "loads": {"pressure": 1e-3}}
-        p = problem(scene.from_dict(nonlinear))
+        p = SheetProblem.from_scene(scene.from_dict(nonlinear))
         p.driver.run(1.0)
         sheet.append(p.value("w", 0.0, 0.0))
     assert w[1] == pytest.approx(w[0], rel=1e-12)

@@ -40,3 +40,19 @@ def test_one_blas_thread_unless_the_user_sets_it():
             env["OPENBLAS_NUM_THREADS"] = given
         out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
         assert out.stdout.strip() == expected
+
+
+def test_the_fast_lane_the_slow_lane_and_a_timeout():
+    """`make test` runs all but the tests marked slow, `make test-slow` those, CI (.ci/run) both
+    in turn; every test fails after pyproject's timeout instead of hanging."""
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]
+    assert 0 < config["timeout"] <= 900
+    assert any(m.startswith("slow:") for m in config["markers"])
+    lanes = {}
+    for target in ("test", "test-slow"):
+        out = subprocess.run(["make", "-n", target], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+        lanes[target] = [line for line in out.splitlines() if "-m pytest" in line]
+    assert len(lanes["test"]) == 1 and '-m "not slow"' in lanes["test"][0]
+    assert len(lanes["test-slow"]) == 1 and "-m slow" in lanes["test-slow"][0]
+    steps = [line for line in (ROOT / ".ci" / "run").read_text().splitlines() if line.startswith("make")]
+    assert steps == ["make test", "make test-slow"]

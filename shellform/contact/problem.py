@@ -14,8 +14,8 @@ from shellform import supports as named_supports
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import blank
-from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.model import SheetModel
+from shellform.nonlinear.problem import scene_controls
 from shellform.scene import Scene
 
 PUNCH, DIE, HOLDER = 0, 1, 2  # the open holder is the third tool of the contact set
@@ -38,8 +38,7 @@ class DrawingProblem:
                                                  fixed=named_supports.sheet_fixed_components)
         tools = square_cup_tools(t, s.material.thickness)
         symmetry = s.symmetry_copies
-        controls = Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
-                            max_iterations=pr.max_iterations, rtol=pr.rtol)
+        controls = scene_controls(s)
         mu = t.friction if "friction" in s.effects else 0.0
         driver = SemiInverseDriver(
             model, bcs, [tools["punch"], tools["die"]], [-t.stroke, 0.0], friction=mu, holder=tools["holder"],

@@ -51,6 +51,7 @@ from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
 from shellform.results import cup, run_folder
 from shellform.results.log import Progress
+from shellform.results.summary import DrawingSummary
 from shellform.results.tables import write_csv, write_json
 from shellform.scene import Scene
 
@@ -93,7 +94,7 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     return curve, reports, info
 
 
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> dict:
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> DrawingSummary:
     """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
     continue from the last converged state in outdir (written at every report, at the end and
     at a stop), with this scene's stroke, steps, friction and holder force (the summary's
@@ -184,7 +185,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                 stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
         else:
             sprung = cup.springback(outdir, p, s.title, before, released)
-    summary = {
+    summary = DrawingSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
@@ -198,6 +199,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "resumed_from_stroke_mm": resumed["from_stroke_mm"] if resumed else None, "resumed": resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
-    }
+    }, outdir)
     write_json(outdir / "summary.json", summary)
     return summary

@@ -3,6 +3,7 @@
     p = SheetProblem.on_rectangle(comm, lx, ly, region, n, material, thickness, effects,
                                   supports, loads, prescribed, controls)
     p = SheetProblem.on_blank(blank_mesh, material, thickness, effects, supports, ...)  # any outline
+    p = SheetProblem.from_scene(scene)  # a nonlinear scene (`shellform run`)
     p.driver.run(1.0)
     p.value("w", x, y), p.reaction(side, "w")
 
@@ -22,10 +23,20 @@ from mpi4py import MPI
 from shellform import supports as named_supports
 from shellform.edge_frames import SheetEdgeFrames
 from shellform.loads import value_at
-from shellform.mesh import rectangle
+from shellform.mesh import blank, rectangle
 from shellform.nonlinear.driver import Controls, Driver
-from shellform.nonlinear.loads import NodalLoads, SheetLoads
+from shellform.nonlinear.loads import EdgeMoment, NodalLoads, PointForce, SheetLoads
 from shellform.nonlinear.model import SheetModel
+
+
+def scene_controls(s) -> Controls:
+    """The Newton driver's controls from a scene's [process]: the load-factor steps (initial,
+    min, max), the iterations per increment and the residual tolerance; the rest at their
+    defaults. The one place a scene sets them, for the nonlinear sheet (SheetProblem.from_scene)
+    and the tools (contact.problem.DrawingProblem.from_scene)."""
+    pr = s.process
+    return Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
+                    max_iterations=pr.max_iterations, rtol=pr.rtol)
 
 
 @dataclass
@@ -34,6 +45,21 @@ class SheetProblem:
     model: SheetModel
     driver: Driver
     prescribed_dofs: dict
+
+    @classmethod
+    def from_scene(cls, s, comm=MPI.COMM_WORLD, checkpoint_dir=None, verbose=True):
+        """A nonlinear scene's problem: its blank (with vertices at the point loads), Hill 1979
+        material, supports, pressure, point forces and edge moments, initial curvature, and
+        the controls of its [process] (scene_controls)."""
+        loads = SheetLoads(
+            pressure=s.loads.pressure,
+            points=[PointForce(p.x, p.y, (p.fx, p.fy, p.fz)) for p in s.loads.point],
+            moments=[EdgeMoment(mo.side, mo.m) for mo in s.loads.moment])
+        controls, kappa0 = scene_controls(s), s.curvature()
+        return cls.on_blank(blank(comm, s, [(p.x, p.y) for p in s.loads.point]), s.hill79(), s.material.thickness,
+                            s.effects, s.supports, loads, controls=controls,
+                            thickness_points=s.process.thickness_points, kappa0=kappa0,
+                            checkpoint_dir=checkpoint_dir, verbose=verbose)
 
     @classmethod
     def on_rectangle(cls, comm, lx, ly, n, material, thickness, effects, supports, loads=None,

@@ -20,31 +20,15 @@ from pathlib import Path
 from dolfinx import fem
 from mpi4py import MPI
 
-from shellform.mesh import blank
 from shellform.nonlinear import checkpoint
-from shellform.nonlinear.driver import ConvergenceFailure, Controls
+from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
-from shellform.nonlinear.loads import EdgeMoment, PointForce, SheetLoads
 from shellform.nonlinear.problem import SheetProblem
 from shellform.scene import Scene
 from shellform.results import fields, run_folder
 from shellform.results.log import Progress
+from shellform.results.summary import SheetSummary
 from shellform.results.tables import write_csv, write_json
-
-
-def problem(s: Scene, comm=MPI.COMM_WORLD, outdir=None) -> SheetProblem:
-    pr = s.process
-    loads = SheetLoads(
-        pressure=s.loads.pressure,
-        points=[PointForce(p.x, p.y, (p.fx, p.fy, p.fz)) for p in s.loads.point],
-        moments=[EdgeMoment(mo.side, mo.m) for mo in s.loads.moment])
-    controls = Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
-                        max_iterations=pr.max_iterations, rtol=pr.rtol)
-    kappa0 = s.curvature()
-    return SheetProblem.on_blank(
-        blank(comm, s, [(p.x, p.y) for p in s.loads.point]), s.hill79(), s.material.thickness, s.effects,
-        s.supports, loads, controls=controls, thickness_points=pr.thickness_points, kappa0=kappa0,
-        checkpoint_dir=outdir, verbose=True)
 
 
 def cell_functions(p: SheetProblem) -> dict:
@@ -68,13 +52,13 @@ def _record(p: SheetProblem, s: Scene) -> dict:
             "max_equivalent_plastic_strain": peq, "min_thickness_strain": e33}
 
 
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> dict:
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSummary:
     """Step the scene's load path into outdir, which is this run's alone (run_folder.start);
     scene_path: the scene's file, for run.json."""
     outdir = Path(outdir)
     run_folder.start(outdir, s, scene_path, comm=comm)
     t0 = time.perf_counter()
-    p = problem(s, comm, outdir)
+    p = SheetProblem.from_scene(s, comm, checkpoint_dir=outdir)
     p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     setup_s = time.perf_counter() - t0
     reports, stopped, signum = [], None, 0
@@ -97,14 +81,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> dict:
         reports.append(_record(p, s))  # the last converged state, which the driver restored
     p.driver.progress.close()
     d = p.driver
-    summary = {
+    summary = SheetSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global,
         "dofs": p.model.V.dofmap.index_map.size_global * 9, "reports": reports,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
-    }
+    }, outdir)
     rows = [{"increment": h.number, "load_factor": h.lam, "step": h.dlam, "iterations": h.iterations,
              "first_residual": h.residuals[0], "last_residual": h.residuals[-1],
              "plastic_layers": h.plastic_layers, "cutbacks": h.cutbacks} for h in d.history]

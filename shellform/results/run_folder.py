@@ -30,7 +30,7 @@ from shellform.errors import InputError
 from shellform.results.tables import write_json
 
 MANIFEST = "run.json"
-# what shellform's runs write into --out (contact/run.py, nonlinear/run.py, cli.py's linear scenes)
+# what shellform's runs write into --out (shellform/run.py's routes: results/shell.py, nonlinear/run.py, contact/run.py)
 OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "force_stroke.csv",
            "force_stroke.png", "thickness_*.csv", "fld.csv", "fld.png", "cup.png", "cup_margin.png",
            "springback.csv", "springback.png", "deformed.png", "cup.bp", "cup_cells.bp", "nodal.bp", "cells.bp", "checkpoint.npz",

@@ -1,0 +1,63 @@
+"""A run's summary: the content of summary.json, and how the run ends.
+
+Every route (shellform.run: the linear shell, the nonlinear sheet, the tools) returns a
+Summary: a dict holding exactly what summary.json holds, which also knows
+
+    closing_line()   the one line `shellform run` prints on stdout at the end: the title, the
+                     cells, the route's result in a few numbers, the time, the output folder
+    stop_line()      where the run stopped early (no convergence, a limit load, Ctrl-C,
+                     SIGTERM), the line for stderr; None when it ran to its end
+    exit_status()    0 when it ran to its end, 128 + the signal when a signal stopped it, 3
+                     when it stopped otherwise (docs/reliability.md)
+
+so that the command line prints and returns without asking which route ran.
+"""
+
+from pathlib import Path
+
+
+class Summary(dict):
+    """summary.json's content (the dict) and the output folder it was written to."""
+
+    def __init__(self, content: dict, outdir):
+        super().__init__(content)
+        self.outdir = Path(outdir)
+
+    def closing_line(self) -> str:
+        return f"shellform: {self['title']}: {self['cells']} cells; results in {self.outdir}"
+
+    def stop_line(self) -> str | None:
+        return f"shellform: the run stopped early: {self['stopped']}" if self.get("stopped") else None
+
+    def exit_status(self) -> int:
+        if not self.get("stopped"):
+            return 0
+        return 128 + self["signal"] if self.get("signal") else 3
+
+
+class ShellSummary(Summary):
+    """The linear shell: w at the centre."""
+
+    def closing_line(self) -> str:
+        return (f"shellform: {self['title']}: {self['cells']} cells, w_center = {self['w_center']}, "
+                f"{self['wall_time_s']:.2f} s; results in {self.outdir}")
+
+
+class SheetSummary(Summary):
+    """The nonlinear sheet: the last reported load factor and w there."""
+
+    def closing_line(self) -> str:
+        last = self["reports"][-1] if self["reports"] else {}
+        return (f"shellform: {self['title']}: {self['cells']} cells, {self['increments']} increments, "
+                f"load factor {last.get('load_factor')}, w = {last.get('w')}, {self['wall_time_s']:.2f} s; "
+                f"results in {self.outdir}")
+
+
+class DrawingSummary(Summary):
+    """The tools: the stroke reached, the last draw-in, the peak thickness strain."""
+
+    def closing_line(self) -> str:
+        last = self["draw_in_mm"][-1] if self["draw_in_mm"] else {}
+        return (f"shellform: {self['title']}: {self['cells']} cells, stroke {self['stroke_mm']:.2f} mm, "
+                f"draw-in {last}, max thickness strain {self['max_thickness_strain']:.4f}, "
+                f"{self['wall_time_s']['total']:.1f} s; results in {self.outdir}")

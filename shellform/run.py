@@ -1,0 +1,67 @@
+"""One run of a scene: scene -> problem -> driver -> results, whatever its effects.
+
+    summary = run(scene, outdir, scene_path=path, trace=False, resume=False)
+    print(summary.closing_line()); sys.exit(summary.exit_status())
+
+The output folder is checked first (results.run_folder.check_writable, before any
+computation); the scene's route then solves it and writes its files and summary.json:
+
+    "shell"   the linear shell: one solve of K q = f (shellform.linear, results.shell)
+    "sheet"   the nonlinear elastic-plastic sheet stepped along its load path
+              (shellform.nonlinear.run)
+    "tools"   deep drawing between rigid tools, the sheet's route with contact
+              (shellform.contact.run)
+
+The two nonlinear routes take the Newton driver's controls from the scene's [process] in one
+place (nonlinear.problem.scene_controls). Each returns a results.summary.Summary: the content
+of summary.json, its closing line and the exit status. Only the tools resume from a checkpoint.
+"""
+
+import time
+from pathlib import Path
+
+from mpi4py import MPI
+
+from shellform.errors import InputError
+from shellform.results import run_folder
+from shellform.results.summary import Summary
+from shellform.scene import Scene
+
+def route(s: Scene) -> str:
+    """The route a scene takes: "tools" with a [tools] section, else "sheet" with any effect of
+    the nonlinear sheet (Scene.nonlinear), else "shell"."""
+    if s.tools is not None:
+        return "tools"
+    return "sheet" if s.nonlinear else "shell"
+
+
+def _shell(s: Scene, outdir: Path, comm, scene_path) -> Summary:
+    from shellform import linear
+    from shellform.results import shell
+
+    run_folder.start(outdir, s, scene_path, comm=comm)
+    t0 = time.perf_counter()
+    res = linear.solve(s, comm)
+    return shell.write(outdir, s, res, time.perf_counter() - t0)
+
+
+def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool = False,
+        comm=MPI.COMM_WORLD) -> Summary:
+    """Solve the scene into outdir (a folder this run owns: run_folder.start); scene_path: its
+    file, for run.json; trace: the tools log every contact pass, Newton step and iterate;
+    resume: the tools continue from the last converged state in outdir (InputError("resume")
+    for the other routes)."""
+    outdir = Path(outdir)
+    run_folder.check_writable(outdir, comm)  # before any computation: InputError("--out")
+    way = route(s)
+    if resume and way != "tools":
+        raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
+    if way == "tools":
+        from shellform.contact import run as tools
+
+        return tools.run(s, outdir, comm, trace=trace, resume=resume, scene_path=scene_path)
+    if way == "sheet":
+        from shellform.nonlinear import run as sheet
+
+        return sheet.run(s, outdir, comm, scene_path=scene_path)
+    return _shell(s, outdir, comm, scene_path)

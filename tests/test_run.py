@@ -1,0 +1,132 @@
+"""One run stack (shellform.run): the route a scene takes, the controls its [process] sets on
+both nonlinear routes, and the summary each route returns, which knows its closing line and
+exit status; the command line's --version."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+import shellform
+from shellform import cli, run, scene
+from shellform.contact.problem import DrawingProblem
+from shellform.errors import InputError
+from shellform.nonlinear.driver import Controls
+from shellform.nonlinear.problem import SheetProblem, scene_controls
+from shellform.results.summary import DrawingSummary, SheetSummary, ShellSummary
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMOS = ROOT / "demos"
+
+
+def small_levy():
+    s = scene.load(DEMOS / "levy_plate.toml")
+    s.mesh.n, s.process.report = 4, [0.5]
+    s.output.vtx = s.output.png = False
+    return s
+
+
+def small_cup():
+    """The paper's cup on 4 x 4, 0.2 mm of stroke in two steps."""
+    s = scene.load(DEMOS / "square_cup.toml")
+    s.mesh.n, s.tools.stroke, s.process.report = 4, 0.2, [0.5]
+    s.process.initial_step = s.process.max_step = 0.5
+    s.output.vtx = s.output.png = s.output.fld = s.process.springback = False
+    return s
+
+
+def test_route_by_scene():
+    assert run.route(scene.load(DEMOS / "square_plate.toml")) == "shell"
+    assert run.route(scene.load(DEMOS / "levy_plate.toml")) == "sheet"
+    assert run.route(scene.load(DEMOS / "square_cup.toml")) == "tools"
+
+
+def test_process_sets_the_controls_of_both_nonlinear_routes():
+    """The scene's [process] values reach the driver's controls on the sheet's route and the
+    tools' route, through one function."""
+    values = {"initial_step": 0.03, "min_step": 0.001, "max_step": 0.07, "max_iterations": 9, "rtol": 1e-7}
+    expected = Controls(**values)
+    sheet, tools = small_levy(), small_cup()
+    for s in (sheet, tools):
+        for k, v in values.items():
+            setattr(s.process, k, v)
+        assert scene_controls(s) == expected
+    assert SheetProblem.from_scene(sheet, verbose=False).driver.controls == expected
+    drawing = DrawingProblem.from_scene(tools, verbose=False).driver.controls  # its own easy_iterations
+    assert {k: getattr(drawing, k) for k in values} == values
+
+
+@pytest.mark.timeout(120)
+def test_shell_route_summary_and_closing_line(tmp_path, capsys):
+    """The linear shell: the line `shellform run` prints is the summary's closing line (w at the
+    centre), and the exit status 0."""
+    assert cli.main(["run", str(DEMOS / "square_plate.toml"), "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out.strip().splitlines()
+    saved = json.loads((tmp_path / "summary.json").read_text())
+    summary = ShellSummary(saved, tmp_path)
+    assert out[-1] == summary.closing_line()
+    assert out[-1] == (f"shellform: {saved['title']}: 288 cells, w_center = {saved['w_center']}, "
+                       f"{saved['wall_time_s']:.2f} s; results in {tmp_path}")
+    assert summary.stop_line() is None and summary.exit_status() == 0
+
+
+@pytest.mark.timeout(120)
+def test_sheet_route_summary(tmp_path):
+    s = small_levy()
+    summary = run.run(s, tmp_path)
+    assert isinstance(summary, SheetSummary)
+    assert json.loads((tmp_path / "summary.json").read_text()) == json.loads(json.dumps(summary))
+    last = summary["reports"][-1]
+    assert last["load_factor"] == pytest.approx(1.0)
+    assert summary.closing_line() == (
+        f"shellform: {s.title}: {summary['cells']} cells, {summary['increments']} increments, load factor "
+        f"{last['load_factor']}, w = {last['w']}, {summary['wall_time_s']:.2f} s; results in {tmp_path}")
+    assert summary.stop_line() is None and summary.exit_status() == 0
+
+
+@pytest.mark.timeout(120)
+def test_sheet_route_stopped_exits_3(tmp_path):
+    """No convergence at the smallest step: the run stops, its summary says so, exit status 3."""
+    s = small_levy()
+    s.process.initial_step = s.process.min_step = s.process.max_step = 1.0
+    s.process.max_iterations = 1
+    summary = run.run(s, tmp_path)
+    assert summary["stopped"] and summary["signal"] == 0
+    assert summary.stop_line() == f"shellform: the run stopped early: {summary['stopped']}"
+    assert summary.exit_status() == 3
+
+
+@pytest.mark.timeout(300)
+def test_tools_route_summary(tmp_path):
+    s = small_cup()
+    summary = run.run(s, tmp_path)
+    assert isinstance(summary, DrawingSummary)
+    assert summary["stroke_mm"] == pytest.approx(0.2)
+    last = summary["draw_in_mm"][-1]
+    assert summary.closing_line() == (
+        f"shellform: {s.title}: {summary['cells']} cells, stroke 0.20 mm, draw-in {last}, max thickness strain "
+        f"{summary['max_thickness_strain']:.4f}, {summary['wall_time_s']['total']:.1f} s; results in {tmp_path}")
+    assert summary.exit_status() == 0
+
+
+def test_exit_status_of_a_stop_by_signal(tmp_path):
+    """Stopped by SIGTERM (15) or Ctrl-C (2): 128 + the signal; stopped otherwise: 3."""
+    base = {"title": "t", "cells": 1, "reports": [], "increments": 0, "wall_time_s": 0.0}
+    assert SheetSummary({**base, "stopped": "SIGTERM", "signal": 15}, tmp_path).exit_status() == 143
+    assert SheetSummary({**base, "stopped": "Ctrl-C", "signal": 2}, tmp_path).exit_status() == 130
+    assert SheetSummary({**base, "stopped": "no convergence", "signal": 0}, tmp_path).exit_status() == 3
+    assert SheetSummary({**base, "stopped": None, "signal": 0}, tmp_path).exit_status() == 0
+
+
+def test_resume_only_on_the_tools_route(tmp_path):
+    with pytest.raises(InputError) as err:
+        run.run(small_levy(), tmp_path / "out", resume=True)
+    assert err.value.field == "resume"
+    assert not (tmp_path / "out" / "summary.json").exists()
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["--version"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"shellform {shellform.__version__}"
