@@ -147,10 +147,11 @@ def form_terms(effects) -> list:
 
 def markdown_table() -> str:
     """The effects table of docs/scenes.md, one row per registry entry."""
-    rows = ["| effect | switches on | needs | solved by | keys | what it does |", "|---|---|---|---|---|---|"]
+    rows = ["| effect | switches on | needs | solvers that know it | keys it gives a meaning | what it does |",
+            "|---|---|---|---|---|---|"]
     for e in EFFECTS.values():
         rows.append(f"| `{e.name}` | {e.kind} `{e.part}` | {', '.join(e.needs) or '-'} | "
-                    f"{' or '.join(e.routes) if e.routes != ANY else 'any'} | "
+                    f"{' or '.join(e.routes) if e.routes != ANY else 'all'} | "
                     f"{', '.join(f'`{k}`' for k in e.keys) or '-'} | {e.doc} |")
     return "\n".join(rows)
 

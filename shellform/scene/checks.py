@@ -23,6 +23,20 @@ def _sheet_effects() -> tuple[str, ...]:
     return tuple(n for n, e in registry.EFFECTS.items() if e.route == registry.SHEET)
 
 
+def _keys_of_effects(s: Scene, section: str) -> None:
+    """The keys of `section` that take a meaning only with an effect (shellform.effects, Effect.keys)
+    keep their defaults unless that effect is on. (A whole table, as [tools] of 'contact', is
+    checked with its table.)"""
+    for e in registry.EFFECTS.values():
+        for key in e.keys:
+            table, _, name = key.partition(".")
+            if e.name in s.effects or table != section or not name or getattr(s, table) is None:
+                continue
+            value, default = getattr(getattr(s, table), name), getattr(type(getattr(s, table))(), name)
+            require(value == default, key, f"{value!r} takes a meaning only with the effect {e.name!r}: switch it "
+                    f"on, or leave the default {default!r}")
+
+
 def require(cond, name, message):
     """Raise InputError(name, message) unless cond."""
     if not cond:
@@ -38,9 +52,9 @@ def validate(s: Scene) -> None:
     for name in ("R1", "R2"):
         v = getattr(s.surface, name)
         require(v != 0 and not math.isnan(v), f"surface.{name}", f"must be non-zero (inf for flat), got {v}")
-        if math.isfinite(v):
-            require("shallow_curvature" in s.effects, f"surface.{name}",
-                    "a curved reference surface needs the effect 'shallow_curvature'")
+    _keys_of_effects(s, "surface")
+    for name in ("R1", "R2"):
+        if math.isfinite(getattr(s.surface, name)):
             require(not s.surface.z0, f"surface.{name}", "give either z0 or the radii R1, R2, not both")
     if s.surface.z0:
         from shellform.forms.reference_surface import ReferenceSurface
@@ -48,8 +62,6 @@ def validate(s: Scene) -> None:
         surface = ReferenceSurface(s.surface.z0)
         problem = surface.problem()
         require(problem is None, "surface.z0", f"{surface.quoted()}: {problem}")
-        require("shallow_curvature" in s.effects, "surface.z0",
-                "a curved reference surface needs the effect 'shallow_curvature'")
         require(s.tools is None, "surface.z0", "tool scenes draw a flat blank")
         try:
             value = surface.value(0.123, 0.456)
@@ -147,23 +159,17 @@ def _validate_material(s: Scene) -> None:
     require(math.isfinite(mat.r) and mat.r > 0, "material.r", f"must be > 0, got {mat.r}")
     require(math.isfinite(mat.m) and mat.m >= 1, "material.m",
             f"must be >= 1 (convex yield function), got {mat.m}")
-    if "anisotropy" not in s.effects:
-        require(mat.r == 1.0, "material.r", f"r = {mat.r} (isotropic: 1) needs the effect 'anisotropy'")
-        require(mat.m == 2.0, "material.m", f"m = {mat.m} (von Mises: 2) needs the effect 'anisotropy'")
+    _keys_of_effects(s, "material")
     require(mat.hardening in HARDENING, "material.hardening",
             f"must be one of {', '.join(HARDENING)}, got {mat.hardening!r}")
     plastic = "plasticity" in s.effects
-    if not plastic:
-        require(mat.hardening == "none", "material.hardening",
-                "set, but the scene's effects do not include 'plasticity'")
-    elif mat.hardening == "none":
+    if plastic and mat.hardening == "none":
         raise InputError("material.hardening",
                          "plasticity needs a hardening curve: 'power' (yield_stress, n) or 'swift' (K, eps0, n)")
     for name in ("yield_stress", "n", "K", "eps0"):
         v = getattr(mat, name)
         require(math.isfinite(v), f"material.{name}", f"must be finite, got {v}")
         if v != 0.0:
-            require(plastic, f"material.{name}", "set, but the scene's effects do not include 'plasticity'")
             require(name in CURVE_PARAMETERS[mat.hardening], f"material.{name}",
                     f"is no parameter of hardening = {mat.hardening!r} "
                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")
@@ -228,6 +234,7 @@ def _validate_tools(s: Scene) -> None:
         require("contact" not in s.effects, "tools", "the effect 'contact' needs a [tools] table")
         return
     require("contact" in s.effects, "effects", "a [tools] table needs the effect 'contact'")
+    _keys_of_effects(s, "tools")
     require(t.shape in TOOL_SHAPES, "tools.shape", f"must be one of {TOOL_SHAPES}, got {t.shape!r}")
     if t.shape == "round":
         for name in ("punch_radius", "die_radius"):
@@ -272,10 +279,7 @@ def _validate_tools(s: Scene) -> None:
         require(g.radius > flat, "geometry.radius",
                 f"the blank does not reach the blank holder and the die's flat top: its radius {g.radius} "
                 f"must exceed die_half_width + die_profile_radius = {flat}")
-    if t.friction > 0:
-        require("friction" in s.effects, "tools.friction", f"friction = {t.friction} needs the effect 'friction'")
-    else:
-        require("friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
+    require(t.friction > 0 or "friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
     if g.shape == "rectangle":
         outer = ("right", "top") if g.region == "quarter" else SIDES
     else:  # an outline's edges are free or symmetry lines
