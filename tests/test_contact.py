@@ -239,12 +239,10 @@ def test_slip_reversal_converges_without_friction_flips():
             assert ratios.size < 2 or ratios[-1] < ratios[-2], r
 
 
-def _cup(n=8, **tools):
-    s = scene.load(ROOT / "demos" / "square_cup.toml")
-    s.mesh.n = n
-    for k, v in tools.items():
-        setattr(s.tools, k, v)
-    return s
+def _cup(n=8, changes=None, **tools):
+    """The paper's cup on n x n with tools keys and other changes {"section.key": value}."""
+    return scene.load(ROOT / "demos" / "square_cup.toml").changed(
+        {"mesh.n": n, **{f"tools.{k}": v for k, v in tools.items()}, **(changes or {})})
 
 
 def test_short_square_cup_draw():
@@ -478,10 +476,10 @@ def test_an_elastic_sheet_springs_back_flat():
     rigid lift of the held centre to 1e-8 mm."""
     from shellform.contact import springback
 
-    s = _cup(n=6, stroke=1.0)
-    s.effects = ("bending", "membrane", "geometric_nonlinearity", "contact")
-    s.material.hardening, s.material.r = "none", 1.0
-    s.process.initial_step, s.process.max_step = 0.1, 0.25
+    s = _cup(n=6, stroke=1.0, friction=0.0, changes={
+        "effects": ["bending", "membrane", "geometric_nonlinearity", "contact"], "material.hardening": "none",
+        "material.r": 1.0, "material.K": 0.0, "material.eps0": 0.0, "material.n": 0.0,
+        "process.initial_step": 0.1, "process.max_step": 0.25})
     p = DrawingProblem.from_scene(s, verbose=False)
     p.driver.run(1.0)
     drawn = p.driver.q.x.array.reshape(-1, 9)
@@ -542,10 +540,9 @@ def test_friction_raises_the_punch_force():
     force at 3 mm than without friction, and draws in less."""
     out = {}
     for mu in (0.0, 0.2):
-        s = _cup(n=6, friction=mu)
-        if mu == 0.0:
-            s.effects = tuple(e for e in s.effects if e != "friction")
-        s.process.initial_step, s.process.max_step = 0.02, 0.05
+        effects = [e for e in scene.load(ROOT / "demos" / "square_cup.toml").effects if e != "friction" or mu > 0]
+        s = _cup(n=6, friction=mu, changes={"effects": effects, "process.initial_step": 0.02,
+                                            "process.max_step": 0.05})
         p = DrawingProblem.from_scene(s, verbose=False)
         p.driver.run(3.0 / s.tools.stroke)
         X, x, _ = p.nodal_values()

@@ -38,10 +38,11 @@ from dataclasses import dataclass, field
 import basix.ufl
 import numpy as np
 
+from shellform import effects as registry
 from shellform.assembly import slope_map
 from shellform.elements import reduced_cubic
 
-GROUPS = ("membrane", "bending")  # order of the element-local fields
+GROUPS = tuple(e.name for e in registry.EFFECTS.values() if e.kind == "form term")  # order of the local fields
 STRAIN_COMPONENTS = ("xx", "yy", "xy")
 
 
@@ -54,9 +55,7 @@ class HybridElement:
     offsets: dict[str, slice] = field(init=False)
 
     def __post_init__(self):
-        from shellform.forms.functional import EFFECTS
-
-        self.effects = tuple(e for e in EFFECTS if e in self.effects)  # canonical order
+        self.effects = registry.canonical(self.effects)
         has_m, has_b = "membrane" in self.effects, "bending" in self.effects
         if not (has_m or has_b):
             raise ValueError("a hybrid element needs the membrane or the bending effect")
@@ -79,7 +78,7 @@ class HybridElement:
         if has_b:
             subs += [("w", reduced_cubic.element()), ("g", p1v)]
             comps += ["w", "w_x", "w_y"]
-        self.groups = tuple(gr for gr in GROUPS if gr in self.effects)
+        self.groups = tuple(gr for gr in GROUPS if gr in self.effects)  # the form-term effects, in order
         strain_name = {"membrane": "eps_p", "bending": "eps_b"}
         mult_name = {"membrane": "N", "bending": "M"}
         subs += [(strain_name[gr], space[gr]) for gr in self.groups]

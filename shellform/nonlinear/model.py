@@ -16,6 +16,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from shellform.assembly.kernels import check_mesh
+from shellform import effects as effects_registry
 from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly import assumed_membrane
@@ -82,8 +83,8 @@ class SheetModel:
         self.nonlinear = "geometric_nonlinearity" in self.effects
         self.plastic = "plasticity" in self.effects
         self.finite = "finite_strain" in self.effects
-        if self.finite and not (self.plastic and self.nonlinear):
-            raise InputError("effects", "'finite_strain' needs 'plasticity' and 'geometric_nonlinearity'")
+        if self.finite:
+            effects_registry.require("finite_strain", self.effects)  # its layers need these parts
         self.shallow = kappa0 is not None
         surface = kappa0 if hasattr(kappa0, "slopes") else self.shallow  # z0(x, y) or a constant kappa0
         self.kernels = SheetKernels.get(self.nonlinear, surface, mesh.comm, quadrature_degree)

@@ -59,17 +59,16 @@ def scene_for(n: int, stroke: float | None = None, rtol: float | None = None):
     """The aluminium cup on an n x n quarter mesh, drawn `stroke` mm (None: the scene's 40) with
     the scene's increments in mm, and Newton's tolerance rtol (None: the scene's)."""
     s = variant(n, SCENE)
+    changes = {"output.png": False, "output.fld": False}
     if rtol is not None:
-        s.process.rtol = rtol
-    s.output.png = False
-    s.output.fld = False
+        changes["process.rtol"] = rtol
     if stroke is not None and stroke != s.tools.stroke:
         scale = s.tools.stroke / stroke
-        s.process.max_step *= scale
-        s.process.initial_step *= scale
-        s.process.report = [f * scale for f in s.process.report if f * scale <= 1.0]
-        s.tools.stroke = stroke
-    return s
+        changes.update({"process.max_step": s.process.max_step * scale,
+                        "process.initial_step": s.process.initial_step * scale,
+                        "process.report": [f * scale for f in s.process.report if f * scale <= 1.0],
+                        "tools.stroke": stroke})
+    return s.changed(changes)
 
 
 def draw_one(n: int, out: Path, stroke: float | None = None, rtol: float | None = None, trace: bool = False) -> None:

@@ -27,16 +27,12 @@ COLUMNS = ["case", "n", "stroke_mm", "target_mm", "finished", "increments", "new
 
 
 def variant(n: int, name: str = "square_cup.toml", **changes) -> scene.Scene:
-    """A demo scene on an n x n quarter mesh with changes section__key=value (no VTX output, no
-    springback: the studies compare the drawn state)."""
-    s = scene.load(ROOT / "demos" / name)
-    s.mesh.n = n
-    for key, value in changes.items():
-        section, field = key.split("__")
-        setattr(getattr(s, section), field, value)
-    s.output.vtx = False
-    s.process.springback = False
-    return s
+    """A demo scene on an n x n quarter mesh with changes section__key=value or effects=[...]
+    (no VTX output, no springback: the studies compare the drawn state), checked as a scene
+    file is (Scene.changed)."""
+    return scene.load(ROOT / "demos" / name).changed({
+        "mesh.n": n, "output.vtx": False, "process.springback": False,
+        **{key.replace("__", "."): value for key, value in changes.items()}})
 
 
 def draw(name: str, s: scene.Scene, out: Path) -> dict:

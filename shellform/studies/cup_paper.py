@@ -33,15 +33,10 @@ COLUMNS = ["friction", "stroke_mm", "max_thickness_strain", "where_initial_xy_mm
 
 def friction_runs() -> dict:
     """(name, scene) of Fig. 7's runs other than the demo's mu 0.1."""
-    runs = {}
-    for mu in FRICTION:
-        if mu == 0.1:
-            continue
-        s = variant(16, tools__friction=mu)
-        if mu == 0.0:
-            s.effects = tuple(e for e in s.effects if e != "friction")
-        runs[f"mu {mu:g}"] = s
-    return runs
+    demo = variant(16)
+    without = [e for e in demo.effects if e != "friction"]  # mu 0: no friction, nor its effect
+    return {f"mu {mu:g}": variant(16, tools__friction=mu, **({"effects": without} if mu == 0.0 else {}))
+            for mu in FRICTION if mu != 0.1}
 
 
 def run(out: Path, meshes: Path = ROOT / "docs/results/cup_mesh", hard: Path = ROOT / "docs/results/cup_hard"):

@@ -31,12 +31,12 @@ def runs(levels=LEVELS, steps=STEPS, stroke=None) -> list:
     for k in steps[::-1]:
         for n in levels:
             s = variant(n, SCENE)
-            s.process.max_step *= k
-            s.process.initial_step *= k
+            max_step, initial_step = s.process.max_step * k, s.process.initial_step * k
+            changes = {}
             if stroke is not None:  # the same increments in mm
-                s.process.max_step *= s.tools.stroke / stroke
-                s.process.initial_step *= s.tools.stroke / stroke
-                s.tools.stroke = stroke
+                max_step, initial_step = max_step * (s.tools.stroke / stroke), initial_step * (s.tools.stroke / stroke)
+                changes["tools.stroke"] = stroke
+            s = s.changed({"process.max_step": max_step, "process.initial_step": initial_step, **changes})
             out.append((f"n {n}" + (f", {k}x step" if k != 1 else ""), s))
     return out
 

@@ -1,0 +1,14 @@
+"""Scenes: what to simulate, read from TOML and checked before any computation.
+
+    schema   the sections as dataclasses: keys, defaults, allowed names; Scene and its queries
+    read     TOML and parsed documents to a Scene, each key's type checked; a changed Scene
+    checks   the values across fields (``validate``), run whenever a Scene is made
+    machine  what depends on the machine: the blank's file, the mesh's memory
+
+Every bad value raises shellform.errors.InputError naming its field. A scene is changed only by
+``Scene.changed``, which checks the new scene again. See docs/scenes.md for every key.
+"""
+
+from shellform.scene.checks import validate
+from shellform.scene.read import changed, from_dict, load, to_dict
+from shellform.scene.schema import *  # noqa: F403  (the sections and their allowed names)

@@ -1,0 +1,44 @@
+"""The checks of a scene that depend on the machine it is read on: its blank's file exists
+(``check_file``) and its mesh fits this machine's memory (``check_size``, by the estimates of
+shellform/mesh/budget.py). They raise shellform.errors.InputError naming the field.
+"""
+
+from pathlib import Path
+
+from shellform.errors import InputError
+from shellform.mesh import outline
+
+
+def require(cond, name, message):
+    """Raise InputError(name, message) unless cond."""
+    if not cond:
+        raise InputError(name, message)
+
+
+def check_file(s) -> None:
+    """A file blank's file exists (its name and suffix are checked with the geometry)."""
+    require(Path(s.geometry.file).is_file(), "geometry.file", f"no such file: {s.geometry.file}")
+
+
+def check_size(s) -> None:
+    """A mesh whose estimated memory exceeds what the machine allows is refused before it is built."""
+    from shellform.mesh import budget
+    from shellform.scene.schema import Process
+
+    g, m = s.geometry, s.mesh
+    if g.shape == "file":
+        cells = outline.file_cells(g, m.n, m.refine)
+    elif g.shape == "rectangle":
+        cells = budget.estimated_cells(g.lx, g.ly, g.region, m.kind, m.n, m.refine)
+    else:
+        x0, x1, _, _ = outline.region_bounds(g)
+        cells = budget.gmsh_cells(outline.region_area(g), (x1 - x0) / m.n, m.refine)
+    nonlinear = s.nonlinear or s.tools is not None
+    layers = s.process.thickness_points if "plasticity" in s.effects else 0  # a plastic section's points
+    need, have = budget.estimated_bytes(cells, nonlinear, layers=layers), budget.available_bytes()
+    usual = min(layers, Process().thickness_points)
+    require(need <= have or budget.estimated_bytes(cells, nonlinear, layers=usual) > have, "process.thickness_points",
+            f"{layers:,} points through the thickness on {cells:,} cells need about {need / 1e9:.3g} GB; "
+            f"this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
+    require(need <= have, "mesh.n", f"n = {m.n} (refine {m.refine}) makes about {cells:,} cells, which need about "
+            f"{need / 1e9:.3g} GB; this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")

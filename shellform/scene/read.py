@@ -1,0 +1,166 @@
+"""Reading a scene: TOML (``load``), a parsed TOML document (``from_dict``) and a changed scene
+(``changed``: the scene as a document, ``to_dict``, with the changes applied, read again). Each
+key's type is checked here against its default in the schema, naming the field; the values
+are checked when the Scene is made (shellform.scene.checks).
+"""
+
+import copy
+import tomllib
+from dataclasses import asdict, fields
+from pathlib import Path
+
+from shellform.errors import InputError
+from shellform.scene.schema import (SQUARE_TOOL_KEYS, EdgeMoment, Geometry, Loads, Material, MeshSpec, Output,
+                                    PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
+
+_SECTIONS = {
+    "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
+    "solver": Solver, "process": Process, "output": Output, "tools": ToolsSpec,
+}
+
+
+def _number(value, name, integer=False):
+    ok = isinstance(value, int) if integer else isinstance(value, int | float)
+    if isinstance(value, bool) or not ok:
+        raise InputError(name, f"must be {'an integer' if integer else 'a number'}, got {value!r}")
+    return value if integer else float(value)
+
+
+def _numbers(value, name) -> list[float]:
+    if not isinstance(value, list):
+        raise InputError(name, f"must be a list of numbers, got {value!r}")
+    return [_number(v, name) for v in value]
+
+
+def _points(value, name) -> list[list[float]]:
+    if not isinstance(value, list) or not all(isinstance(p, list) and len(p) == 2 for p in value):
+        raise InputError(name, f"must be a list of points [x, y], got {value!r}")
+    return [_numbers(p, name) for p in value]
+
+
+def _names(value, name) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+        raise InputError(name, f"must be a list of names, got {value!r}")
+    return list(value)
+
+
+_LIST_ITEMS = {"numbers": _numbers, "points": _points, "names": _names}
+
+
+def _supports(data) -> dict[str, str]:
+    if not isinstance(data, dict):
+        raise InputError("supports", "must be a table of boundary group = support")
+    for key, value in data.items():
+        if not isinstance(value, str):
+            raise InputError(f"supports.{key}", f"must be a support name (a string), got {value!r}")
+    return dict(data)
+
+
+def _records(cls, tables, name) -> list:
+    if not isinstance(tables, list):
+        raise InputError(name, f"must be an array of tables [[{name}]]")
+    return [_record(cls, t, f"{name}[{i}]") for i, t in enumerate(tables)]
+
+
+def _record(cls, data, name):
+    if not isinstance(data, dict):
+        raise InputError(name, f"must be a table, got {data!r}")
+    known = {f.name: f for f in fields(cls)}
+    values = {}
+    for key, value in data.items():
+        if key not in known:
+            raise InputError(f"{name}.{key}", f"unknown key; known keys: {', '.join(known)}")
+        default = getattr(cls(), key)
+        if isinstance(default, bool):
+            if not isinstance(value, bool):
+                raise InputError(f"{name}.{key}", f"must be true or false, got {value!r}")
+        elif isinstance(default, int | float):
+            value = _number(value, f"{name}.{key}", integer=isinstance(default, int))
+        elif isinstance(default, str) and not isinstance(value, str):
+            raise InputError(f"{name}.{key}", f"must be a string, got {value!r}")
+        elif isinstance(default, list):
+            value = _LIST_ITEMS[known[key].metadata.get("items", "numbers")](value, f"{name}.{key}")
+        values[key] = value
+    return cls(**values)
+
+
+def from_dict(data: dict) -> Scene:
+    """A validated Scene from a parsed TOML document."""
+    known = {f.name for f in fields(Scene)}
+    for key in data:
+        if key not in known:
+            raise InputError(key, f"unknown key; known keys: {', '.join(sorted(known))}")
+    kwargs = {name: _record(cls, data[name], name) for name, cls in _SECTIONS.items() if name in data}
+    if "supports" in data:
+        kwargs["supports"] = _supports(data["supports"])
+    tools = data.get("tools")
+    if isinstance(tools, dict) and tools.get("shape") == "round":
+        for key in SQUARE_TOOL_KEYS:
+            if key in tools:
+                raise InputError(f"tools.{key}", "is a key of square tools: round tools take punch_radius and "
+                                 "die_radius")
+    if "loads" in data:
+        loads = dict(data["loads"]) if isinstance(data["loads"], dict) else data["loads"]
+        if not isinstance(loads, dict):
+            raise InputError("loads", "must be a table")
+        points = _records(PointLoad, loads.pop("point", []), "loads.point")
+        moments = _records(EdgeMoment, loads.pop("moment", []), "loads.moment")
+        kwargs["loads"] = _record(Loads, loads, "loads")
+        kwargs["loads"].point, kwargs["loads"].moment = points, moments
+    if "effects" in data:
+        effects = data["effects"]
+        if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+            raise InputError("effects", f"must be a list of effect names, got {effects!r}")
+        kwargs["effects"] = tuple(effects)
+    if "title" in data:
+        kwargs["title"] = str(data["title"])
+    return Scene(**kwargs)
+
+
+def load(path: str | Path) -> Scene:
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("scene", f"no such file: {path}")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise InputError("scene", f"{path} is not valid TOML: {err}") from None
+    geometry = data.get("geometry")
+    if isinstance(geometry, dict) and isinstance(geometry.get("file"), str) and geometry["file"]:
+        data["geometry"] = {**geometry, "file": str(path.parent / geometry["file"])}  # relative to the scene
+    return from_dict(data)
+
+
+
+
+def to_dict(s: Scene) -> dict:
+    """The scene as a parsed TOML document: from_dict(to_dict(s)) equals s."""
+    data = {"title": s.title, "effects": list(s.effects), "supports": dict(s.supports),
+            "loads": copy.deepcopy(asdict(s.loads))}
+    for name in _SECTIONS:
+        section = getattr(s, name)
+        if section is not None:
+            data[name] = {f.name: copy.deepcopy(getattr(section, f.name)) for f in fields(section)}
+    if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
+        for key in SQUARE_TOOL_KEYS:
+            del data["tools"][key]
+    return data
+
+
+def changed(s: Scene, changes: dict) -> Scene:
+    """A new Scene: `s` with `changes` applied, checked as a scene file is. Keys name a field as
+    its errors do: "effects", "title", "mesh.n", "tools.friction", "supports.left" (a [tools]
+    table is added if the scene has none). Every change is applied before any check, so that
+    changes that hold only together (friction 0 without the effect 'friction') may be made."""
+    data = to_dict(s)
+    for key, value in changes.items():
+        value = list(value) if isinstance(value, tuple) else copy.deepcopy(value)
+        section, dot, name = key.partition(".")
+        if not dot:
+            data[key] = value
+            continue
+        table = data.setdefault(section, {})
+        if not isinstance(table, dict) or not name:
+            raise InputError(key, f"is no key of a scene's tables, got the change {key!r}")
+        table[name] = value
+    return from_dict(data)

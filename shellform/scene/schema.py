@@ -1,0 +1,245 @@
+"""The schema of a scene: its sections as dataclasses, their keys, defaults and allowed names.
+
+A scene states the geometry of the blank, its reference surface, the mesh, the material, the
+supports, the loads and the physical effects to simulate (shellform.effects: what each effect
+switches on and needs). Its effects select the solver (``Scene.route``): the linear shell, the
+nonlinear elastic-plastic sheet stepped through the load factors of [process]
+(``Scene.nonlinear``; ``Scene.hill79()`` is its material), or the sheet drawn by the rigid tools
+of [tools] (``Scene.tools``, shellform.contact.tools).
+
+A Scene is checked when it is made (shellform.scene.checks, shellform.scene.machine); a changed
+scene is a new one, made by ``Scene.changed`` and checked again. See docs/scenes.md for every key.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+from shellform import effects as registry
+from shellform.mesh import outline
+
+__all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "SPREADS", "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
+           "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
+           "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
+           "ToolsSpec", "Output", "Scene", "bounds"]
+
+TOOL_SHAPES = ("square", "round")
+SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
+SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
+
+SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
+NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
+SIDES = ("left", "right", "bottom", "top")
+# what a mirror line needs (u_n = 0, w,n = 0; shellform/supports.py): symmetry, or a support holding more
+MIRROR_SUPPORTS = ("symmetry", "clamped", "clamped_sliding")
+MAY_BE_INFINITE = ("surface.R1", "surface.R2")  # inf: flat along that direction
+REGIONS = ("full", "quarter")  # rectangle
+CIRCLE_REGIONS = ("full", "half", "quarter")
+MESH_KINDS = ("structured", "unstructured")
+DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
+HARDENING = ("none", "power", "swift")
+CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n")}
+
+
+@dataclass
+class Geometry:
+    shape: str = "rectangle"  # rectangle, circle, polygon or file (shellform/mesh/outline.py)
+    lx: float = 1.0  # rectangle: blank size along x
+    ly: float = 1.0  # rectangle: blank size along y
+    region: str = "full"  # rectangle, circle: "quarter" x, y >= 0; circle: "half" y >= 0
+    radius: float = 0.0  # circle (0: unset)
+    vertices: list[list[float]] = field(default_factory=list, metadata={"items": "points"})  # polygon
+    edges: list[str] = field(default_factory=list, metadata={"items": "names"})  # polygon: a name per edge
+    file: str = ""  # file: a gmsh .msh, .geo (or CAD) file, relative to the scene's folder
+
+
+@dataclass
+class Surface:
+    R1: float = math.inf  # principal radius along x of z0 = -(x^2/R1 + y^2/R2)/2
+    R2: float = math.inf
+    z0: str = ""  # or any z0(x, y) as text, e.g. "0.1*sin(pi*x)*sin(pi*y)" (forms/reference_surface.py)
+
+
+@dataclass
+class MeshSpec:
+    kind: str = "structured"
+    n: int = 8  # elements along x of the region (structured: n x n x 2 triangles)
+    diagonal: str = "right"
+    refine: int = 0  # uniform refinements of that mesh (nested meshes for convergence studies)
+
+
+@dataclass
+class Material:
+    E: float = 1.0
+    nu: float = 0.3
+    thickness: float = 0.01
+    hardening: str = "none"  # "none" (elastic), "power" (yield_stress, n) or "swift" (K, eps0, n)
+    yield_stress: float = 0.0  # power law: sigma_y (0: unset)
+    n: float = 0.0  # power law: n >= 1; Swift: n >= 0
+    K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset)
+    eps0: float = 0.0  # Swift (0: unset)
+    r: float = 1.0  # Lankford coefficient of Hill 1979 (> 0; != 1 needs 'anisotropy')
+    m: float = 2.0  # Hill 1979 exponent (>= 1; != 2 needs 'anisotropy')
+
+
+@dataclass
+class PointLoad:
+    x: float = 0.0
+    y: float = 0.0
+    fz: float = 0.0  # force along +w
+    fx: float = 0.0  # in-plane forces along +x, +y (need 'membrane')
+    fy: float = 0.0
+
+
+@dataclass
+class EdgeMoment:
+    side: str = ""  # left, right, bottom or top
+    m: float = 0.0  # per unit length about the side's tangent; > 0 turns the outward fibre towards +z
+
+
+@dataclass
+class Loads:
+    pressure: float = 0.0  # uniform, along +w
+    point: list[PointLoad] = field(default_factory=list)
+    moment: list[EdgeMoment] = field(default_factory=list)  # nonlinear scenes only
+
+
+@dataclass
+class Solver:
+    mapped: bool = True  # False: no Jacobian map of the slopes (plain DOLFINx); for studies only
+
+
+@dataclass
+class Process:
+    """Load stepping of the nonlinear sheet (shellform.nonlinear.driver); ignored by linear scenes."""
+
+    thickness_points: int = 5  # Gauss points through the thickness (>= 2 with plasticity)
+    initial_step: float = 0.1  # first load-factor increment
+    min_step: float = 1e-4  # 0 < min_step <= initial_step <= max_step <= 1
+    max_step: float = 0.25
+    max_iterations: int = 12  # Newton iterations per increment (>= 1)
+    rtol: float = 1e-9  # residual tolerance (> 0)
+    path: list[float] = field(default_factory=lambda: [1.0])  # load factors to step through, in order
+    report: list[float] = field(default_factory=list)  # load factors at which results are recorded
+    springback: bool = False  # tool scenes: after the stroke the tools withdraw (contact/springback.py)
+
+
+@dataclass
+class ToolsSpec:
+    """Rigid tools of cup deep drawing (shellform.contact.tools): square (NUMISHEET'93) or round.
+    A round punch is the square one with plan corner radius = half-width = punch_radius (its
+    plan is a circle), a round die the same with die_radius."""
+
+    shape: str = "square"  # "square" or "round"
+    punch_radius: float = 0.0  # round: the punch's radius (0: unset)
+    die_radius: float = 0.0  # round: the die opening's radius (0: unset)
+    punch_half_width: float = 35.0  # 70 mm square punch
+    punch_corner_radius: float = 10.0  # plan corner radius
+    punch_profile_radius: float = 8.0  # nose radius
+    die_half_width: float = 37.0  # 74 mm die opening
+    die_corner_radius: float = 12.0
+    die_profile_radius: float = 5.0  # die shoulder radius
+    punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
+    blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
+    friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
+    stroke: float = 30.0  # punch travel, mm
+    holder_spread: str = "area"  # how the closed holder spreads its force: "area" or "rigid" (contact/holder.py)
+
+    def __post_init__(self):
+        if self.shape == "round":  # circles: corner radius = half-width = radius
+            self.punch_half_width = self.punch_corner_radius = self.punch_radius
+            self.die_half_width = self.die_corner_radius = self.die_radius
+
+
+@dataclass
+class Output:
+    vtx: bool = True
+    png: bool = True
+    fld: bool = True  # tool scenes with plasticity: the forming-limit view (results/fld.py)
+    checkpoint_every: float = 60.0  # tool scenes: seconds of wall time between checkpoints (0: at reports only)
+
+
+@dataclass
+class Scene:
+    title: str = "shellform scene"
+    effects: tuple[str, ...] = ("bending",)
+    geometry: Geometry = field(default_factory=Geometry)
+    surface: Surface = field(default_factory=Surface)
+    mesh: MeshSpec = field(default_factory=MeshSpec)
+    material: Material = field(default_factory=Material)
+    supports: dict[str, str] = field(default_factory=dict)  # boundary group -> support; unnamed: free
+    loads: Loads = field(default_factory=Loads)
+    solver: Solver = field(default_factory=Solver)
+    process: Process = field(default_factory=Process)
+    output: Output = field(default_factory=Output)
+    tools: ToolsSpec | None = None  # None: no [tools] table, no tools
+
+    def __post_init__(self):
+        from shellform.scene.checks import validate
+
+        validate(self)
+
+    def changed(self, changes: dict) -> "Scene":
+        """A new scene with `changes` {"section.key": value, "effects": [...], ...} applied at once,
+        read and checked as a scene file is: a bad value raises InputError naming its field.
+        This scene is left as it is."""
+        from shellform.scene.read import changed
+
+        return changed(self, changes)
+
+    @property
+    def kappa0(self) -> tuple[float, float]:
+        return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
+
+    def curvature(self):
+        """What the forms take as kappa0 with 'shallow_curvature': the ReferenceSurface of
+        surface.z0, or the principal curvatures diag(1/R1, 1/R2) as an array; None if flat."""
+        import numpy as np
+
+        from shellform.forms.reference_surface import ReferenceSurface
+
+        if "shallow_curvature" not in self.effects:
+            return None
+        if self.surface.z0:
+            return ReferenceSurface(self.surface.z0)
+        return np.diag(self.kappa0).astype(np.float64)
+
+    @property
+    def symmetry_copies(self) -> int:
+        """How many copies of the meshed region make the whole blank (4 for a quarter)."""
+        g = self.geometry
+        if g.shape in ("rectangle", "circle"):
+            return {"full": 1, "half": 2, "quarter": 4}[g.region]
+        return 2 ** sum(v == "symmetry" for v in self.supports.values())
+
+    @property
+    def route(self) -> str:
+        """The solver its effects select (shellform.effects.route): linear shell, nonlinear sheet or tools."""
+        return registry.route(self.effects)
+
+    @property
+    def nonlinear(self) -> bool:
+        """Whether its effects select the nonlinear sheet (alone or drawn by the tools)."""
+        return self.route != registry.LINEAR
+
+    def hill79(self):
+        """The scene's shellform.material.Hill79Material: elastic (hardening "none") unless the
+        effect 'plasticity' is on. Its own validation names the field (material.yield_stress, ...)."""
+        from shellform.material import Hill79Material  # numba modules: imported only when needed
+
+        mat = self.material
+        if "plasticity" not in self.effects:
+            return Hill79Material(mat.E, mat.nu, mat.r, mat.m)
+        unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
+        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
+        n = unset(mat.n) if mat.hardening == "power" else mat.n
+        return Hill79Material(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
+                              unset(mat.K), unset(mat.eps0))
+
+
+def bounds(s: Scene) -> tuple[float, float, float, float]:
+    """x_min, x_max, y_min, y_max of the meshed region (a rectangle or circle is centred at the
+    origin; a polygon is where its vertices are; a file's region is known once it is read)."""
+    if s.geometry.shape in ("circle", "polygon"):
+        return outline.region_bounds(s.geometry)
+    hx, hy = s.geometry.lx / 2, s.geometry.ly / 2
+    return (0.0, hx, 0.0, hy) if s.geometry.region == "quarter" else (-hx, hx, -hy, hy)
