@@ -22,17 +22,18 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from shellform import effects
 from shellform.errors import InputError
 from shellform.results import run_folder
 from shellform.results.summary import Summary
 from shellform.scene import Scene
 
+ROUTES = {effects.LINEAR: "shell", effects.SHEET: "sheet", effects.TOOLS: "tools"}
+
+
 def route(s: Scene) -> str:
-    """The route a scene takes: "tools" with a [tools] section, else "sheet" with any effect of
-    the nonlinear sheet (Scene.nonlinear), else "shell"."""
-    if s.tools is not None:
-        return "tools"
-    return "sheet" if s.nonlinear else "shell"
+    """The route a scene takes: the solver its effects select (shellform.effects.route)."""
+    return ROUTES[s.route]
 
 
 def _shell(s: Scene, outdir: Path, comm, scene_path) -> Summary:
