@@ -87,6 +87,10 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
     Effect("friction", "contact part", "shellform.contact.semi_inverse.SemiInverseDriver", (TOOLS,), ("contact",),
            why="acts at the contact with the tools", keys=("tools.friction",),
            doc="Coulomb friction at that contact, coefficient tools.friction > 0"),
+    Effect("drawbeads", "contact part", "shellform.contact.drawbead.Drawbeads", (TOOLS,), ("contact",),
+           why="act on the flange the tools hold", keys=("tools.drawbead",),
+           doc="drawbeads on the flange, [[tools.drawbead]]: lines that restrain the flow across them and "
+               "lift the sheet, per unit length (the equivalent drawbead model)"),
 )}
 
 

@@ -11,6 +11,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform import supports as named_supports
+from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import blank
@@ -40,9 +41,11 @@ class DrawingProblem:
         symmetry = s.symmetry_copies
         controls = scene_controls(s)
         mu = t.friction if "friction" in s.effects else 0.0
+        beads = tuple(DrawbeadLine(tuple(map(tuple, b.points)), b.restraint, b.uplift) for b in t.drawbead)
         driver = SemiInverseDriver(
             model, bcs, [tools["punch"], tools["die"]], [-t.stroke, 0.0], friction=mu, holder=tools["holder"],
-            holder_force=t.blank_holder_force / symmetry, contact=ContactControls(1e-2 * s.material.thickness, holder_spread=t.holder_spread, trace=trace),
+            holder_force=t.blank_holder_force / symmetry, drawbeads=beads,
+            contact=ContactControls(1e-2 * s.material.thickness, holder_spread=t.holder_spread, trace=trace),
             controls=controls, checkpoint_dir=checkpoint_dir, verbose=verbose)
         return cls(s, rect, model, driver, symmetry)
 

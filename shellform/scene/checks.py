@@ -9,6 +9,8 @@ import math
 from dataclasses import fields
 from pathlib import Path
 
+import numpy as np
+
 from shellform import effects as registry
 from shellform.errors import InputError
 from shellform.mesh import outline
@@ -226,6 +228,31 @@ def _validate_process(s: Scene) -> None:
                 f"{v} lies outside the load factors [{lo}, {hi}] that process.path covers")
 
 
+def _validate_drawbead(bead, name: str, flat: float, t) -> None:
+    """A drawbead: a polyline of at least two distinct points, all on the die's flat top (outside
+    its opening and shoulder, where the holder pinches the flange), and forces >= 0."""
+    from shellform.contact.tools import rounded_square_sdf
+
+    pts = bead.points
+    require(len(pts) >= 2, f"{name}.points", f"needs at least two points [x, y], got {len(pts)}")
+    require(all(math.isfinite(c) for p in pts for c in p), f"{name}.points", "must be finite")
+    for a, b in zip(pts[:-1], pts[1:]):
+        require(a != b, f"{name}.points", f"two consecutive points coincide: {a}")
+    for key in ("restraint", "uplift"):
+        v = getattr(bead, key)
+        require(v >= 0, f"{name}.{key}", f"must be >= 0 (N/mm), got {v}")
+    require(bead.restraint > 0 or bead.uplift > 0, name, "a drawbead with no restraint and no uplift does nothing")
+    p = np.asarray(pts, dtype=float)
+    along = np.linspace(0.0, 1.0, 21)[:, None, None]
+    samples = (p[:-1] + along * (p[1:] - p[:-1])).reshape(-1, 2)  # 21 points on every segment
+    corner = t.die_corner_radius + t.die_profile_radius
+    distance, _, _ = rounded_square_sdf(samples[:, 0], samples[:, 1], flat, corner)
+    require(bool(np.all(distance >= 0)), f"{name}.points",
+            f"must lie on the die's flat top, outside its opening and shoulder (the rounded square of "
+            f"half-width die_half_width + die_profile_radius = {flat}); "
+            f"{samples[int(np.argmin(distance))].tolist()} lies within it")
+
+
 def _validate_tools(s: Scene) -> None:
     """The [tools] table and the effects 'contact' and 'friction' (after the material: the
     clearance is checked against the thickness)."""
@@ -246,7 +273,7 @@ def _validate_tools(s: Scene) -> None:
     require(t.holder_spread in SPREADS, "tools.holder_spread", f"must be one of {SPREADS}, got {t.holder_spread!r}")
     for f in fields(ToolsSpec):
         v = getattr(t, f.name)
-        if f.name not in ("holder_spread", "shape"):
+        if f.name not in ("holder_spread", "shape", "drawbead"):
             require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
     for name in ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "stroke"):
         v = getattr(t, name)
@@ -280,6 +307,10 @@ def _validate_tools(s: Scene) -> None:
                 f"the blank does not reach the blank holder and the die's flat top: its radius {g.radius} "
                 f"must exceed die_half_width + die_profile_radius = {flat}")
     require(t.friction > 0 or "friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
+    require(bool(t.drawbead) or "drawbeads" not in s.effects, "tools.drawbead",
+            "the effect 'drawbeads' needs at least one [[tools.drawbead]]")
+    for i, bead in enumerate(t.drawbead):
+        _validate_drawbead(bead, f"tools.drawbead[{i}]", flat, t)
     if g.shape == "rectangle":
         outer = ("right", "top") if g.region == "quarter" else SIDES
     else:  # an outline's edges are free or symmetry lines

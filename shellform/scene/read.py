@@ -10,8 +10,8 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (SQUARE_TOOL_KEYS, EdgeMoment, Geometry, Loads, Material, MeshSpec, Output,
-                                    PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
+from shellform.scene.schema import (SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Geometry, Loads, Material, MeshSpec,
+                                    Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
 
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
@@ -90,10 +90,15 @@ def from_dict(data: dict) -> Scene:
     for key in data:
         if key not in known:
             raise InputError(key, f"unknown key; known keys: {', '.join(sorted(known))}")
+    beads, tools = None, data.get("tools")
+    if isinstance(tools, dict) and "drawbead" in tools:  # [[tools.drawbead]]: an array of tables
+        beads = _records(Drawbead, tools["drawbead"], "tools.drawbead")
+        data = {**data, "tools": {k: v for k, v in tools.items() if k != "drawbead"}}
     kwargs = {name: _record(cls, data[name], name) for name, cls in _SECTIONS.items() if name in data}
+    if beads is not None:
+        kwargs["tools"].drawbead = beads
     if "supports" in data:
         kwargs["supports"] = _supports(data["supports"])
-    tools = data.get("tools")
     if isinstance(tools, dict) and tools.get("shape") == "round":
         for key in SQUARE_TOOL_KEYS:
             if key in tools:
@@ -141,6 +146,8 @@ def to_dict(s: Scene) -> dict:
         section = getattr(s, name)
         if section is not None:
             data[name] = {f.name: copy.deepcopy(getattr(section, f.name)) for f in fields(section)}
+    if s.tools is not None:
+        data["tools"]["drawbead"] = [asdict(b) for b in s.tools.drawbead]
     if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
         for key in SQUARE_TOOL_KEYS:
             del data["tools"][key]

@@ -20,7 +20,7 @@ from shellform.mesh import outline
 __all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "SPREADS", "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
-           "ToolsSpec", "Output", "Scene", "bounds"]
+           "Drawbead", "ToolsSpec", "Output", "Scene", "bounds"]
 
 TOOL_SHAPES = ("square", "round")
 SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
@@ -124,6 +124,16 @@ class Process:
 
 
 @dataclass
+class Drawbead:
+    """A drawbead on the flange (shellform.contact.drawbead, the equivalent drawbead model): a
+    polyline in the plane, its restraining force and its uplift force per unit length."""
+
+    points: list[list[float]] = field(default_factory=list, metadata={"items": "points"})  # [x, y], mm
+    restraint: float = 0.0  # N/mm, against the flow across the line
+    uplift: float = 0.0  # N/mm, lifting the sheet off the die (the holder takes it)
+
+
+@dataclass
 class ToolsSpec:
     """Rigid tools of cup deep drawing (shellform.contact.tools): square (NUMISHEET'93) or round.
     A round punch is the square one with plan corner radius = half-width = punch_radius (its
@@ -143,6 +153,7 @@ class ToolsSpec:
     friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
     stroke: float = 30.0  # punch travel, mm
     holder_spread: str = "area"  # how the closed holder spreads its force: "area" or "rigid" (contact/holder.py)
+    drawbead: list[Drawbead] = field(default_factory=list, metadata={"items": "tables"})  # [[tools.drawbead]]
 
     def __post_init__(self):
         if self.shape == "round":  # circles: corner radius = half-width = radius
