@@ -553,11 +553,9 @@ class SemiInverseDriver(Driver):
         """The contact passes (_contact_passes); where they fail with passes that end early (early_step
         above 1), they end only near convergence from then on (early_step 1), and the increment
         is tried once more at the same step before the driver cuts it back. An early end judges
-        the set on an iterate whose steps are still up to early_step penetrations long: on the
-        paper's cup on 24 x 24 such passes failed four times (the cut-backs cost 1167
-        iterations where early_step 1 takes 962; the NUMISHEET'93 cup
-        saves 19 % with the early end and never fails): docs/contact.md. The increment's
-        iterations count both tries."""
+        the set on an iterate whose steps are still up to early_step penetrations long, which
+        saves iterations where it holds and can fail where the set is delicate (docs/contact.md
+        has both measured). The increment's iterations count both tries."""
         start = self.q.x.array.copy()
         ok, its, res, ev = self._contact_passes(lam, reversal)
         if ok or self.early_step <= 1.0:

@@ -176,9 +176,8 @@ def _return_core(e0, e1, e2, q0, q1, q2, p_n, mat, w0=0.0, w1=0.0, w2=0.0, p_w=-
     (w0, w1, w2, p_w): a warm start, the plastic strain and p of this point's last solution in
     the same increment (Newton's last iterate); used where it flowed (p_w > p_n). The local
     Newton then starts from s = C (e - ep_w), dlambda = p_w - p_n, the exact solution if the
-    plastic strain did not change since (on the cup's section updates: 18 % less time than
-    from the radial start, docs/performance.md). Where it does not converge the radial start
-    is tried."""
+    plastic strain did not change since (what it saves: docs/performance.md). Where it does not
+    converge the radial start is tried."""
     E, nu, r, m = mat[E_], mat[NU_], mat[R_], mat[M_]
     ee0, ee1, ee2 = e0 - q0, e1 - q1, e2 - q2
     cE = E / (1.0 - nu * nu)

@@ -2,7 +2,7 @@
 
 Quarter plate [0, a/2]^2 with symmetry at x = 0 and y = 0; simply supported or clamped at
 x = a/2 and y = a/2; a = 1, D = 1, q = 1, nu = 0.3, so w_center is the coefficient w D/(q a^4).
-References: ../shared/reference/validation.md section 1; the simply supported value from the
+References: the project's validation notes, section 1 (docs/plate.md); the simply supported value from the
 Navier double series summed here to round-off (0.0040623526607, within the table's 8 digits).
 
 The plain DOLFINx route gives reference curves on the same error-against-time plot: the C0
