@@ -202,7 +202,7 @@ def test_consistent_tangent(plastic):
 
 def test_newton_converges_quadratically():
     """One large increment of the Levy plate: the residual ratios show order 2."""
-    p = levy.problem(4, controls=Controls(initial_step=0.25, max_step=0.25, rtol=1e-13, predictor=False))
+    p = levy.problem(4, controls=Controls(initial_step=0.25, max_step=0.25, rtol=1e-13))
     d = p.driver
     d.run(0.25)
     res = np.array(d.history[0].residuals)
