@@ -32,6 +32,7 @@ import numpy as np
 from dolfinx import fem, la
 
 from shellform.assembly.sheet_element import BS
+from shellform.contact.frames import add_tangent_slot_stiffness, subtract_nodal_forces
 
 
 @dataclass(frozen=True)
@@ -162,13 +163,10 @@ class Drawbeads:
 
     def add_residual(self, R3: np.ndarray, frames: np.ndarray) -> None:
         """R -= f on the owned nodes' u, v, w rows (R3), in their nodal frames."""
-        R3 -= np.einsum("nij,nj->ni", frames, self.force)
+        subtract_nodal_forces(R3, frames, self.force)
 
     def add_tangent(self, K) -> None:
-        b = np.flatnonzero(np.abs(self.rate).max(axis=(1, 2)) > 0)
-        if b.size:
-            rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
-            K.setValuesLocalRCV(rows, rows, self.rate[b].reshape(b.size, 4), addv=True)
+        add_tangent_slot_stiffness(K, self.rate)
 
     def total(self, comm) -> np.ndarray:
         """The beads' force on the sheet (x, y, z), all ranks (of this model: not mirrored)."""

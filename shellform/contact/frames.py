@@ -75,3 +75,16 @@ def from_frames(array: np.ndarray, rotated: np.ndarray, frames: np.ndarray) -> N
     d = array.reshape(-1, BS)
     idx = np.flatnonzero(rotated[: d.shape[0]])
     d[idx, :3] = np.einsum("nji,nj->ni", frames[idx], d[idx, :3])
+
+
+def subtract_nodal_forces(R3: np.ndarray, frames: np.ndarray, force: np.ndarray) -> None:
+    """R -= f on the owned nodes' u, v, w rows R3, f (x, y, z) seen in their frames: F f."""
+    R3 -= np.einsum("nij,nj->ni", frames, force)
+
+
+def add_tangent_slot_stiffness(K, rate: np.ndarray) -> None:
+    """K += rate, (n, 2, 2) blocks on the owned nodes' tangent slots (0, 1), where non-zero."""
+    b = np.flatnonzero(np.abs(rate).max(axis=(1, 2)) > 0)
+    if b.size:
+        rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
+        K.setValuesLocalRCV(rows, rows, rate[b].reshape(b.size, 4), addv=True)

@@ -30,6 +30,7 @@ which nodes rub, where they are and on what frames, and with which normal forces
 import numpy as np
 
 from shellform.assembly.sheet_element import BS
+from shellform.contact.frames import add_tangent_slot_stiffness, subtract_nodal_forces
 
 
 class CoulombFriction:
@@ -105,14 +106,11 @@ class CoulombFriction:
 
     def add_residual(self, R3: np.ndarray, frames: np.ndarray) -> None:
         """R -= f on the owned nodes' u, v, w rows (R3), in their nodal frames."""
-        R3 -= np.einsum("nij,nj->ni", frames, self.force)
+        subtract_nodal_forces(R3, frames, self.force)
 
     def add_tangent(self, K) -> None:
         """K += -df/ds in the tangent slots of the rubbing nodes."""
-        b = np.flatnonzero(np.abs(self.rate).max(axis=(1, 2)) > 0)
-        if b.size:
-            rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
-            K.setValuesLocalRCV(rows, rows, self.rate[b].reshape(b.size, 4), addv=True)
+        add_tangent_slot_stiffness(K, self.rate)
 
     def add_normal_force_tangent(self, K, model, coef, frames, normal, fixed, n_local) -> None:
         """K += the slipping force's dependence on its normal force (module docstring): coef,
