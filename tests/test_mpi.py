@@ -216,3 +216,38 @@ def test_two_ranks_say_each_line_once(tmp_path):
     assert runs["good"].stdout.count("shellform: once:") == 1, runs["good"].stdout
     assert runs["bad"].returncode == 2
     assert runs["bad"].stderr.count("shellform: input error: material.thickness") == 1, runs["bad"].stderr
+
+
+BEADS = """
+import json, sys
+sys.path.insert(0, "TESTS")
+import shellform
+from mpi4py import MPI
+from test_drawbead import SIDES, _cup
+from shellform.contact import run as contact_run
+r = contact_run.run(_cup(SIDES), "OUT")
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps({"force": r["reports"][-1]["punch_force_kN"], "DX": r["reports"][-1]["draw_in_mm"]["DX"],
+                                  "increments": r["increments"], "balance": r["over_the_stroke"]["force_balance"]}))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_drawbeads_on_two_ranks_match_serial(tmp_path):
+    """The drawbead cup of tests/test_drawbead.py on two ranks: the beads' line shared out
+    across the ranks' cells gives the serial punch force and draw-in to the solver tolerance."""
+    import sys
+
+    tests = str(Path(__file__).parent)
+    sys.path.insert(0, tests)
+    from test_drawbead import SIDES, _cup
+
+    from shellform.contact import run as contact_run
+
+    parallel = on_two_ranks(tmp_path, BEADS.replace("TESTS", tests).replace("OUT", str(tmp_path / "two")))
+    serial = contact_run.run(_cup(SIDES), tmp_path / "one")
+    assert parallel["increments"] == serial["increments"] and parallel["balance"] <= 1e-6
+    assert parallel["force"] == pytest.approx(serial["reports"][-1]["punch_force_kN"], rel=1e-6)
+    assert parallel["DX"] == pytest.approx(serial["reports"][-1]["draw_in_mm"]["DX"], rel=1e-6)
