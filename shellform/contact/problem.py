@@ -11,6 +11,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform import supports as named_supports
+from shellform.assembly.sheet_element import BS
 from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.tools import square_cup_tools
@@ -148,6 +149,18 @@ class DrawingProblem:
         for gap, _ in d.gaps(x, d.lam):
             worst = max(worst, float(-gap.min(initial=0.0)))
         return d.model.mesh.comm.allreduce(worst, op=MPI.MAX)
+
+    def blank_bounds(self) -> tuple[float, float, float, float]:
+        """x_min, x_max, y_min, y_max of the meshed blank (a quarter: from the symmetry lines)."""
+        return tuple(self.rect.bounds)
+
+    def blank_size(self) -> float:
+        """The meshed blank's size (its larger side), the scale of its tolerances."""
+        return float(self.rect.size)
+
+    def displacements(self) -> np.ndarray:
+        """(u, v, w) of every local node, the owned ones first (a view of the carrier)."""
+        return self.driver.q.x.array.reshape(-1, BS)[:, :3]
 
     def nodal_values(self):
         """Owned nodes: initial (x, y), current position, thickness strain."""

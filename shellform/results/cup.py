@@ -26,7 +26,7 @@ def draw_in(p) -> dict:
     """DX, DY, DD (mm) at the blank's edge on the axes and the diagonal (x, y >= 0 quadrant)."""
     X, x, _ = p.nodal_values()
     X, x = _gather(p.model.mesh.comm, X, x)
-    hx, hy = p.rect.bounds[1], p.rect.bounds[3]
+    _, hx, _, hy = p.blank_bounds()
 
     def at(px, py):
         i = int(np.argmin(np.hypot(X[:, 0] - px, X[:, 1] - py)))
@@ -49,7 +49,7 @@ def thickness_lines(p) -> dict[str, list[dict]]:
     """Thickness strain at the nodes along the cup's lines (LINES), by initial distance."""
     X, _, e33 = p.nodal_values()
     X, e33 = _gather(p.model.mesh.comm, X, e33)
-    tol = 1e-6 * p.rect.size
+    tol = 1e-6 * p.blank_size()
     lines = {}
     for name, line in LINES[p.scene.tools.shape].items():
         on = line(X, tol)
@@ -112,10 +112,10 @@ class CupSeries:
                         io.VTXWriter(mesh.comm, path.with_name(path.stem + "_cells.bp"), self.cells, engine="BP4")]
 
     def write(self, stroke):
-        d = self.p.driver
-        n = d.n_owned
-        self.disp.x.array.reshape(-1, 3)[:n] = d.q.x.array.reshape(-1, BS)[:n, :3]
-        self.e33.x.array[:n] = self.p.nodal_values()[2]
+        e33 = self.p.nodal_values()[2]
+        n = len(e33)  # the owned nodes
+        self.disp.x.array.reshape(-1, 3)[:n] = self.p.displacements()[:n]
+        self.e33.x.array[:n] = e33
         fields = self.p.model.cell_fields()
         for f in self.cells:
             f.x.array[: self.p.model.num_cells] = fields[f.name]
@@ -160,10 +160,10 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     from dolfinx import plot
 
     topology, cell_types, x = plot.vtk_mesh(mesh)
-    d = p.driver
-    grid = pyvista.UnstructuredGrid(topology, cell_types, x + d.q.x.array.reshape(-1, BS)[: x.shape[0], :3])
+    grid = pyvista.UnstructuredGrid(topology, cell_types, x + p.displacements()[: x.shape[0]])
     e33 = np.zeros(x.shape[0])
-    e33[: d.n_owned] = p.nodal_values()[2]
+    owned = p.nodal_values()[2]
+    e33[: len(owned)] = owned
     grid.point_data["thickness strain"] = e33
     name, clim, cmap = "thickness strain", None, "coolwarm"
     if cell_field is not None:
@@ -177,7 +177,7 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.add_mesh(grid, scalars=name, show_edges=True, cmap=cmap, clim=clim, edge_color="#555555",
                 line_width=0.5, scalar_bar_args={"title": name})
     pl.add_text(title, font_size=10)
-    L = 2 * p.rect.size if p.symmetry == 4 else p.rect.size
+    L = 2 * p.blank_size() if p.symmetry == 4 else p.blank_size()
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
     pl.screenshot(str(path))
     pl.close()
