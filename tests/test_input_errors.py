@@ -336,6 +336,16 @@ def test_thickness_points_are_bounded_by_the_memory_budget(thickness_points, fie
     assert "GB" in err.value.message
 
 
+@pytest.mark.timeout(20)
+def test_thickness_points_that_fit_in_memory_are_bounded_in_time():
+    """5,000 points fit the memory budget, but numpy's rule of n points costs n^3 (10,000 took
+    minutes): refused at once naming process.thickness_points; 1,000 are taken."""
+    with pytest.raises(InputError) as err:
+        scene.from_dict(square_cup(process={"thickness_points": 5000}))
+    assert err.value.field == "process.thickness_points" and "<= 1000" in err.value.message
+    assert scene.from_dict(square_cup(process={"thickness_points": 1000})).process.thickness_points == 1000
+
+
 INF, NAN = float("inf"), float("nan")
 
 

@@ -20,6 +20,8 @@ from shellform.scene.schema import (CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS,
                                     SUPPORTS, TOOL_SHAPES, Scene, ToolsSpec, bounds)
 
 
+MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
+
 def _sheet_effects() -> tuple[str, ...]:
     """The effects that select the nonlinear sheet."""
     return tuple(n for n, e in registry.EFFECTS.items() if e.route == registry.SHEET)
@@ -92,7 +94,11 @@ def validate(s: Scene) -> None:
     every = s.output.checkpoint_every
     require(math.isfinite(every) and every >= 0, "output.checkpoint_every", f"must be finite and >= 0, got {every}")
     _validate_tools(s)
-    machine.check_size(s)
+    machine.check_size(s)  # first: a count too large for memory is named with the memory it needs
+    n = s.process.thickness_points
+    require(n <= MAX_THICKNESS_POINTS, "process.thickness_points",
+            f"must be <= {MAX_THICKNESS_POINTS} (the Gauss rule costs n^3: 10,000 points take minutes before "
+            f"anything is solved), got {n}")
 
 
 def _validate_finite(s: Scene) -> None:
