@@ -264,3 +264,22 @@ def test_a_geo_is_read_once_per_version_of_its_files(tmp_path, monkeypatch):
     (tmp_path / "part.geo").write_text(SQUARE.replace('"edge"', '"outer_edge"'))
     scene.from_dict(file_scene(geo, supports={"outer_edge": "clamped"}))
     assert len(reads) == 2
+
+
+def test_links_in_out_are_removed_not_written_through(tmp_path):
+    """An --out folder that holds links with the names of shellform's outputs (to a file, to a
+    folder elsewhere): a fresh run removes the links, and nothing is written where they pointed."""
+    from shellform import cli
+
+    elsewhere = tmp_path / "elsewhere"
+    (elsewhere / "series").mkdir(parents=True)
+    (elsewhere / "keep.json").write_text("{}")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "nodal.bp").symlink_to(elsewhere / "series", target_is_directory=True)
+    (out / "summary.json").symlink_to(elsewhere / "keep.json")
+    scene_file = tmp_path / "plate.toml"
+    scene_file.write_text('[mesh]\nn = 4\n[supports]\nleft = "clamped"\n[loads]\npressure = 1.0\n')
+    assert cli.main(["run", str(scene_file), "--out", str(out)]) == 0
+    assert not (out / "nodal.bp").is_symlink() and not (out / "summary.json").is_symlink()
+    assert list((elsewhere / "series").iterdir()) == [] and (elsewhere / "keep.json").read_text() == "{}"

@@ -191,7 +191,7 @@ def clear(outdir: Path) -> None:
             f.unlink(missing_ok=True)
     for pattern in OUTPUTS:
         for f in outdir.glob(pattern):
-            if f.is_dir():
+            if f.is_dir() and not f.is_symlink():
                 shutil.rmtree(f, ignore_errors=True)
-            else:
+            else:  # a file, or a link (to a folder too: the run must not write through it)
                 f.unlink(missing_ok=True)
