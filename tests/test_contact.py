@@ -1,41 +1,23 @@
-"""The mixed semi-inverse contact: nodal frames, equilibrium with a rigid punch, release on
-unloading, the pinching holder and Coulomb friction as a return mapping between flat tools (the
-clamping force, a slip reversal), the square cup drawn a few millimetres (balances, the pinch,
-penetration; BHF 0 and 4 N; hard cases), and the report of a stopped run."""
+"""The mixed semi-inverse contact driver: nodal frames, equilibrium with a rigid punch, release
+on unloading, the square cup drawn a few millimetres (balances, the pinch, penetration; hard
+cases), its passes, tangent and fallback, the report of a stopped run, a resume, springback.
+The parts have files of their own: test_friction.py, test_holder.py, test_drawbead.py,
+test_tools.py; the cases they share are in contact_cases.py."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
 import numpy as np
 import pytest
-from dolfinx import fem
 from mpi4py import MPI
 
 from shellform import scene
-from shellform import supports as named_supports
 from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
-from shellform.contact.problem import HOLDER, DrawingProblem
+from shellform.contact.problem import DrawingProblem
 from shellform.assembly.sheet_element import BS
 from shellform.contact.semi_inverse import FREE, SemiInverseDriver
-from shellform.material import Hill79Material
-from shellform.mesh import SIDE_TAG, rectangle
 from shellform.nonlinear.driver import Controls
-from shellform.nonlinear.model import SheetModel
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
-
-
-class FlatTool:
-    """A rigid flat face at z_face over |x| <= a (and |y| <= b), pushing along `sign` z."""
-
-    def __init__(self, z_face, a, b=np.inf, sign=-1.0):
-        self.z_face, self.a, self.b, self.sign = z_face, a, b, sign
-
-    def gap(self, x, offset=0.0, dz=0.0):
-        over = (np.abs(x[:, 0]) <= self.a) & (np.abs(x[:, 1]) <= self.b)
-        gap = np.where(over, self.sign * (x[:, 2] - (self.z_face + dz)) - offset, np.inf)
-        n = np.zeros_like(x)
-        n[:, 2] = self.sign
-        return gap, n
+from contact_cases import ROOT, FlatTool, drawn_cup, plate, side_sum, square_cup, tangent_error
 
 
 def test_nodal_frames_keep_symmetry_slots():
@@ -73,28 +55,10 @@ def test_rotated_cell_arrays_are_t_k_tt():
         assert np.allclose(m2[c], T @ mat[c] @ T.T, atol=1e-12)
 
 
-def _plate(n=8, L=100.0, t=1.0):
-    rect = rectangle(MPI.COMM_WORLD, L, L, region="quarter", n=n)
-    model = SheetModel(rect.mesh, Hill79Material(E=210000.0, nu=0.3).pack(), t, ("geometric_nonlinearity",))
-    sup = {"left": "symmetry", "bottom": "symmetry", "right": "simply_supported", "top": "simply_supported"}
-    bcs = named_supports.boundary_conditions(model.V, model.components, rect, sup,
-                                             fixed=named_supports.sheet_fixed_components)
-    return rect, model, bcs
-
-
-def _side_sum(driver, rect, sides, comp):
-    """Sum of the residual (the support's force) over the dofs of a component on the sides."""
-    V = driver.model.V
-    facets = np.concatenate([rect.facet_tags.find(SIDE_TAG[side]) for side in sides])
-    dofs = fem.locate_dofs_topological(V.sub(comp), 1, np.unique(facets))
-    owned = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
-    return MPI.COMM_WORLD.allreduce(float(driver.residual_full[dofs[dofs < owned]].sum()), op=MPI.SUM)
-
-
 def test_a_support_in_a_turned_frame_is_corrected_towards_its_value():
     """On y = 0 under a face whose normal points down, nodal_frames turns slot 1 to -e_y: the
     symmetry row's known correction must move v back to 0 (global: -v), not double it."""
-    rect, model, bcs = _plate()
+    rect, model, bcs = plate()
     d = SemiInverseDriver(model, bcs, [FlatTool(0.5, 15.0, 15.0)], [-2.0], verbose=False)
     bottom = np.flatnonzero((d.state.tool == 0) & d.sym_fixed[:, 1] & ~d.sym_fixed[:, 0])
     assert bottom.size > 0
@@ -112,7 +76,7 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
     contact force equals the support reactions (to 1e-8), no node penetrates, the contact set
     settles in every increment, and when the punch is lifted every node leaves it."""
     t = 1.0
-    rect, model, bcs = _plate(t=t)
+    rect, model, bcs = plate(t=t)
     punch = FlatTool(t / 2, 15.0, 15.0)
     d = SemiInverseDriver(model, bcs, [punch], [-2.0], controls=Controls(initial_step=0.25, rtol=1e-10),
                           verbose=False)
@@ -124,7 +88,7 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
         # z of the punch's force on the sheet: F^T r on the punch nodes
         fz = np.einsum("nk,nk->n", dr.frames[: dr.n_owned][on][:, :, 2], r[on])
         punch_z = MPI.COMM_WORLD.allreduce(float(fz.sum()), op=MPI.SUM)
-        support = _side_sum(dr, rect, ("right", "top"), 2)
+        support = side_sum(dr, rect, ("right", "top"), 2)
         forces.append(punch_z)
         peak = max(abs(f) for f in forces)
         assert abs(punch_z + support) <= 1e-8 * peak, (punch_z, support)
@@ -140,118 +104,13 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
     assert abs(forces[-1]) < 1e-6 * max(abs(f) for f in forces)
 
 
-def _strip(mu=0.15, F=1000.0, t=1.0, friction_rtol=1e-10, drawbeads=(), **controls):
-    """A 100 x 20 strip pinched over |x| <= 40 between a flat die and a flat holder pressing with
-    F (and over drawbeads); its right end is pulled by lambda * 2 mm along x."""
-    from shellform.contact.semi_inverse import ContactControls
-
-    rect = rectangle(MPI.COMM_WORLD, 100.0, 20.0, region="full", n=10)
-    model = SheetModel(rect.mesh, Hill79Material(E=210000.0, nu=0.3).pack(), t, ("geometric_nonlinearity",))
-    die, holder = FlatTool(-t / 2, 40.0, sign=1.0), FlatTool(t / 2, 40.0, sign=-1.0)
-    V = model.V
-    qbar = fem.Function(V)
-    right = rect.facet_tags.find(SIDE_TAG["right"])
-    bcs = []
-    for k, value in ((0, 2.0), (1, 0.0), (2, 0.0)):
-        dofs = fem.locate_dofs_topological(V.sub(k), 1, right)
-        qbar.x.array[dofs] = value
-        bcs.append(fem.dirichletbc(np.float64(0), dofs, V.sub(k)))
-    contact = ContactControls(penetration=1e-3 * t, friction_rtol=friction_rtol)
-    d = SemiInverseDriver(model, bcs, [die], [0.0], friction=mu, holder=holder, holder_force=F, prescribed=qbar,
-                          contact=contact, drawbeads=drawbeads, controls=Controls(**{"initial_step": 0.1, "rtol": 1e-10,
-                                                                "max_iterations": 25, **controls}), verbose=False)
-    return rect, d
-
-
-def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
-    """A strip pinched between a flat die and a flat holder (F = 1 kN) is pulled 2 mm at one
-    end: once it slides, the pull equals mu times the sum of the normal forces on both faces
-    (to 1e-8) and 2 mu F (to 1e-4); the holder's nodal forces sum to F at every increment, every
-    node under it stays pinched, and no tangential force exceeds mu times its normal force."""
-    mu, F = 0.15, 1000.0
-    rect, d = _strip(mu, F)
-    comm = MPI.COMM_WORLD
-
-    def check(dr):
-        assert abs(dr.holder.total(dr.state.holder_face) - F) <= 1e-9 * F
-        under = dr.holder.under(dr.positions())
-        assert np.array_equal(dr.pinched, under)  # no free node under the closed holder
-        p = dr.state.pressure + dr.state.holder_face
-        ft = np.linalg.norm(dr.friction.force, axis=1)
-        assert np.all(ft <= mu * p * (1 + 1e-8) + 1e-9)
-        assert np.all(dr.state.pressure[under] >= 0)
-
-    d.run(1.0, on_increment=check)
-    pull = _side_sum(d, rect, ("right",), 0)
-    normal = comm.allreduce(float((d.state.pressure + d.state.holder_face).sum()), op=MPI.SUM)
-    assert abs(pull - mu * normal) <= 1e-8 * mu * normal
-    assert abs(pull - 2 * mu * F) <= 1e-4 * 2 * mu * F
-    assert np.all(d.friction.slipping[d.state.tool == 0])  # the whole strip slides on the die
-
-
-def test_slip_reversal_converges_without_friction_flips():
-    """The strip pulled 1 mm, then pushed back 0.5 mm. A node's friction force never jumps
-    from one side of the Coulomb cone to the other between Newton iterates (both at >= half the
-    limit mu p), except once, in the first correction of the increment where the slip reverses
-    (the return mapping goes through stick; and from rest, in the first increment, in the first
-    two corrections); every Newton pass ends superlinearly; after the
-    reversal the whole strip slides the other way with the pull reversed."""
-    mu, F = 0.15, 1000.0
-    rect, d = _strip(mu, F, initial_step=0.05, max_step=0.05)
-    sides, log = [], []
-    constraints = d._constraints
-
-    def record(lam):
-        jump = constraints(lam)
-        limit = mu * (d.state.pressure + d.state.holder_face)
-        f = d.friction.force[:, 0]
-        sides.append(np.sign(f) * (np.abs(f) >= 0.5 * limit) * (limit > 0))
-        return jump
-
-    d._constraints = record
-
-    def check(dr):
-        s = np.array(sides)
-        jumps = s[1:] * s[:-1] < 0  # (iterate pairs, nodes): the force crossed the cone
-        log.append((int(jumps.sum(axis=0).max()), int(jumps[1:].sum()), [list(r) for r in dr.pass_residuals]))
-        sides.clear()
-
-    d.run(0.5, on_increment=check)
-    pull_forward = _side_sum(d, rect, ("right",), 0)
-    n_forward = len(log)
-    d.run(0.25, on_increment=check)
-    pull_back = _side_sum(d, rect, ("right",), 0)
-    # from rest (the first increment) every node starts sticking with no force: one crossing
-    # is allowed there in its first two corrections
-    assert all(per_node <= 1 for per_node, _, _ in log) and log[0][1] <= 1, [e[:2] for e in log]
-    assert all(late == 0 for _, late, _ in log[1:]), [e[:2] for e in log]
-    assert log[n_forward][0] == 1  # the reversal: one crossing, in the first correction
-    assert all(e[0] == 0 for i, e in enumerate(log) if i not in (0, n_forward))
-    assert pull_forward == pytest.approx(2 * mu * F, rel=1e-4)
-    assert pull_back == pytest.approx(-2 * mu * F, rel=1e-4)
-    assert np.all(d.friction.slipping[d.state.tool == 0]) and np.all(d.friction.force[d.state.tool == 0, 0] > 0)
-    tol = d.controls.rtol * d._scale  # Newton's tolerance: below it, round-off
-    for _, _, passes in log:  # superlinear tails: above the tolerance, the last reduction is the
-        for r in passes:      # best of the pass and at least 1e-2
-            above = np.array([v for v in r[int(np.argmax(r)):] if v > tol])
-            ratios = above[1:] / above[:-1]
-            assert ratios.size == 0 or ratios[-1] <= 1e-2, r
-            assert ratios.size < 2 or ratios[-1] < ratios[-2], r
-
-
-def _cup(n=8, changes=None, **tools):
-    """The paper's cup on n x n with tools keys and other changes {"section.key": value}."""
-    return scene.load(ROOT / "demos" / "square_cup.toml").changed(
-        {"mesh.n": n, **{f"tools.{k}": v for k, v in tools.items()}, **(changes or {})})
-
-
 def test_short_square_cup_draw():
     """The square-cup scene on a coarse quarter blank, 3 mm of stroke: at every increment the
     holder's nodal forces sum to 19.6 kN and no node takes more than 10 % of it, the tools' forces
     balance (to 1e-6 of the punch force), no flange node under the closed holder is free, no node
     penetrates a tool by more than 1 % of the thickness and the contact settles; the punch force
     grows."""
-    s = _cup()
+    s = square_cup()
     p = DrawingProblem.from_scene(s, verbose=False)
     forces = []
 
@@ -274,96 +133,13 @@ def test_short_square_cup_draw():
     assert c["punch"] > 0 and c["pinched"] > 0 and c["free"] > 0
 
 
-@pytest.mark.parametrize("force", [0.0, 4.0])
-def test_cup_without_a_holder_force_draws(force):
-    """BHF = 0 (no holder) and 4 N (a holder that the flange lifts): the cup draws its first
-    millimetre, the holder open, with the tools in balance and no penetration."""
-    s = _cup(blank_holder_force=force)
-    p = DrawingProblem.from_scene(s, verbose=False)
-    p.driver.run(1.0 / s.tools.stroke)
-    d = p.driver
-    assert p.stroke == pytest.approx(1.0)
-    assert not d.state.closed[0] and p.free_under_holder() == 0
-    assert p.holder_force() == pytest.approx(force, abs=1e-9)
-    assert p.force_balance() <= 1e-6
-    assert p.max_penetration() <= 0.01 * s.material.thickness
-    assert p.punch_force() > 0
-
-
-def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
-    """A light holder (400 N) that the flange lifts below 1 mm of stroke and lets down again
-    before 4 mm. Open, it is a rigid face at its own lift (within the contact tolerance, 1 % of
-    t, of its closed position: micrometres), solved with the sheet in each Newton iteration: its
-    nodes' forces sum to F, no node under it passes its face, the tools balance, and Newton's
-    last pass converges fast (each step at least 5 times smaller, from its second iterate) in at
-    most 4 iterations. Then it closes and pinches the flange again."""
-    s = _cup(blank_holder_force=400.0)
-    p = DrawingProblem.from_scene(s, verbose=False)
-    F = s.tools.blank_holder_force
-    opened = []
-
-    def check(d):
-        assert abs(p.holder_force() - F) <= 1e-6 * F
-        assert p.force_balance() <= 1e-6
-        assert p.max_penetration() <= 0.01 * s.material.thickness  # the open face included
-        if d.state.closed[0]:
-            assert p.holder_lift() == 0.0 and p.free_under_holder() == 0
-            return
-        opened.append(p.stroke)
-        assert abs(p.holder_lift()) < 0.01 * s.material.thickness and p.in_contact()["holder"] > 0
-        last = d.pass_residuals[-1][1:]
-        assert len(last) <= 5 and all(b <= a / 5 for a, b in zip(last, last[1:]))
-
-    p.driver.run(4.0 / s.tools.stroke, on_increment=check)
-    assert len(opened) >= 3 and 0.5 < opened[0] < 1.0
-    assert p.driver.state.closed[0] and p.in_contact()["pinched"] > 0
-
-
-def test_the_open_holders_lift_step_is_exact_newton():
-    """The lift is solved with the sheet (a bordered system). From the open state at 1.25 mm
-    (400 N holder, its nodes slipping) with F raised by 1 %, central differences of the
-    residual along the Newton direction (dq, dz_H) equal -R on the slipping holder nodes'
-    tangential rows and on the holder's equation: to 2e-3 of |R| (measured; h = 1e-4 to 1e-6
-    give the same), against 6e-2 without the slip forces' dp/dq on the lifted columns."""
-    s = _cup(blank_holder_force=400.0)
-    p = DrawingProblem.from_scene(s, verbose=False)
-    d = p.driver
-    d.run(1.25 / s.tools.stroke)
-    lam, slip = d.lam, np.flatnonzero(d.friction.slipping & (d.state.tool == HOLDER))
-    assert not d.state.closed[0] and slip.size > 0
-    rows = (BS * slip[:, None] + np.arange(2)).ravel()
-    d.holder.force *= 1.01
-    q0, lift0, solve = d.q.x.array.copy(), float(d.state.lift[0]), d.solve_lifted
-
-    def residual(h=0.0, dq=0.0, dz=0.0):
-        d.q.x.array[:] = q0 + h * dq
-        d.state.lift[0] = lift0 + h * dz
-        d._constraints(lam)
-        d._refreshing = True
-        d.residual(lam, tangent=True)
-        return np.append(d.b.getArray()[rows], d._holder_imbalance())
-
-    errors = {}
-    for exact in (True, False):
-        d.solve_lifted = solve if exact else (lambda delta, out, extra=None: solve(delta, out))
-        R = residual()
-        assert d._solve(0.0)
-        dz = d._lift_step()
-        dq = d.dq.x.array.copy()
-        from_frames(dq, d.rotated, d.frames)
-        h = 1e-4
-        change = (residual(h, dq, dz) - residual(-h, dq, dz)) / (2 * h)
-        errors[exact] = np.abs(change + R).max() / np.abs(R).max()
-    assert errors[True] <= 5e-3 and errors[False] >= 3e-2, errors
-
-
 @pytest.mark.parametrize("case", ["mu 0.3", "10x increment", "die radius 2 mm"])
 def test_hard_cup_cases_draw(case):
     """Hard cases of the cup (the full-stroke table: shellform study cup-hard) on the coarse mesh
     for 3 mm: three times the friction; increments of ten times the scene's largest (2.4 mm), cut
     back by the driver where they fail; a die shoulder of 2 mm, a quarter of a cell. Each reaches
     3 mm with the tools in balance, the flange pinched and no penetration."""
-    s = _cup()
+    s = square_cup()
     big = 10 * s.process.max_step
     changes = {"mu 0.3": ("tools", "friction", 0.3), "die radius 2 mm": ("tools", "die_profile_radius", 2.0),
                "10x increment": ("process", "max_step", big)}[case]
@@ -401,7 +177,7 @@ def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
         return False, 1, [1e9], None
 
     monkeypatch.setattr(SemiInverseDriver, "_newton_fixed_set", breaks_down)
-    s = _cup()
+    s = square_cup()
     s.process.initial_step = s.process.max_step = 0.25 / 30.0
     summary = contact_run.run(s, tmp_path)
     assert "forced by the test" in summary["stopped"]
@@ -464,7 +240,7 @@ def test_a_resumed_run_equals_an_uninterrupted_one(tmp_path):
     assert len(rows[0]) == len(rows[1])
     assert float(rows[1][-1]["punch_force_kN"]) == pytest.approx(float(rows[0][-1]["punch_force_kN"]), rel=1e-9)
 
-    other = _cup(n=4, stroke=1.0)
+    other = square_cup(n=4, stroke=1.0)
     with pytest.raises(InputError) as err:
         contact_run.run(other, tmp_path / "pieces", resume=True)
     assert err.value.field == "resume" and "mesh.n" in str(err.value)
@@ -476,7 +252,7 @@ def test_an_elastic_sheet_springs_back_flat():
     rigid lift of the held centre to 1e-8 mm."""
     from shellform.contact import springback
 
-    s = _cup(n=6, stroke=1.0, friction=0.0, changes={
+    s = square_cup(n=6, stroke=1.0, friction=0.0, changes={
         "effects": ["bending", "membrane", "geometric_nonlinearity", "contact"], "material.hardening": "none",
         "material.r": 1.0, "material.K": 0.0, "material.eps0": 0.0, "material.n": 0.0,
         "process.initial_step": 0.1, "process.max_step": 0.25})
@@ -497,7 +273,7 @@ def test_drawn_cup_springback_outputs(tmp_path):
     the residual resultants and the unloading's plastic layers, and writes the profiles."""
     from shellform.contact import run as contact_run
 
-    s = _cup(n=6, stroke=3.0)
+    s = square_cup(n=6, stroke=3.0)
     s.process.initial_step, s.process.max_step = 0.02, 0.05
     s.process.springback = True
     s.output.vtx = s.output.png = s.output.fld = False
@@ -535,84 +311,6 @@ def test_numisheet_scenes_draw_their_first_millimetres(name):
     assert forces[-1] > forces[0] > 0
 
 
-def test_friction_raises_the_punch_force():
-    """The trend of Fig. 7's runs (cup-paper), short: with friction 0.2 the cup needs more punch
-    force at 3 mm than without friction, and draws in less."""
-    out = {}
-    for mu in (0.0, 0.2):
-        effects = [e for e in scene.load(ROOT / "demos" / "square_cup.toml").effects if e != "friction" or mu > 0]
-        s = _cup(n=6, friction=mu, changes={"effects": effects, "process.initial_step": 0.02,
-                                            "process.max_step": 0.05})
-        p = DrawingProblem.from_scene(s, verbose=False)
-        p.driver.run(3.0 / s.tools.stroke)
-        X, x, _ = p.nodal_values()
-        out[mu] = (p.punch_force(), np.abs(x[:, :2] - X).max())
-    assert out[0.2][0] > 1.05 * out[0.0][0]
-    assert out[0.2][1] < out[0.0][1]
-
-
-def _tangent_error(d, lam, rows, columns, h=1e-6):
-    """Largest |K e_j - (R(q + h v) - R(q - h v)) / 2h| on `rows` over the (j, v) in columns (a
-    tangent column and the perturbation of q, global coordinates, that it stands for), relative
-    to the largest entry; the frames, friction and normal forces follow q as in Newton."""
-    def residual(tangent):
-        d._constraints(lam)
-        d._refreshing = True
-        d.residual(lam, tangent=tangent)
-        return d.b.getArray()[rows].copy()
-
-    residual(True)
-    K = d.A.copy()
-    worst, size = 0.0, 0.0
-    for j, v in columns:
-        e, Ke = K.createVecs()
-        e.set(0.0)
-        e.setValue(j, 1.0)
-        e.assemble()
-        K.mult(e, Ke)
-        q0 = d.q.x.array.copy()
-        d.q.x.array[:] = q0 + h * v
-        plus = residual(False)
-        d.q.x.array[:] = q0 - h * v
-        minus = residual(False)
-        d.q.x.array[:] = q0
-        column = Ke.getArray()[rows]
-        worst = max(worst, np.abs((plus - minus) / (2 * h) - column).max())
-        size = max(size, np.abs(column).max())
-    residual(True)
-    return worst / size
-
-
-def _drawn_cup(stroke):
-    """The coarse cup drawn `stroke` mm, then the next increment (0.2 mm) converged, not committed."""
-    s = _cup()
-    p = DrawingProblem.from_scene(s, verbose=False)
-    d = p.driver
-    d.run(stroke / s.tools.stroke)
-    lam = d.lam + 0.2 / s.tools.stroke
-    assert d._newton(lam)[0]
-    return d, lam
-
-
-def test_slip_tangent_carries_the_normal_force_change():
-    """Newton updates the friction's normal forces at every iterate, so the tangent carries the
-    slipping force's dependence on them, d(mu p m)/dq = mu m K_(i,n): on the cup drawn 2 mm, in
-    the next increment's converged state (nodes slipping on the punch), the tangent's columns of
-    the free nodes next to them match central differences of the residual on their tangential
-    rows to 1e-6 of the largest entry (without the term: 1e-3, docs/contact.md)."""
-    d, lam = _drawn_cup(2.0)
-    m = d.model
-    slip = np.flatnonzero(d.friction.slipping & (d.state.tool == 0) & ~d.pinched)
-    assert slip.size > 0
-    near = np.unique(m.dofs[np.isin(m.dofs, slip).any(axis=1)])
-    free = [b for b in near if b < d.n_owned and d.state.tool[b] == FREE][:3]
-    rows = (BS * slip[:, None] + np.arange(2)).ravel()
-    columns = [(j, np.eye(d.q.x.array.size)[j]) for j in (BS * b + k for b in free for k in range(BS))
-               if j not in d.bc_dofs]
-    error = _tangent_error(d, lam, rows, columns)
-    assert error <= 1e-6, error
-
-
 @pytest.mark.parametrize("mu", [0.0, pytest.param(0.1, marks=pytest.mark.slow)])
 def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
     """A node moving along the punch's nose turns its frame: its tangential rows t_a . R change
@@ -620,7 +318,7 @@ def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
     a step along their own tangents matches the tangent's columns to 1e-6 of the largest entry
     frictionless, 1e-5 with the scene's friction (whose projection on the turning tangent plane,
     of order mu times the term, is left out); without the term: 1e-4 (docs/contact.md)."""
-    d, lam = _drawn_cup(6.0)
+    d, lam = drawn_cup(6.0)
     d.friction.mu = mu
     nose = np.flatnonzero((d.state.tool == 0) & (np.abs(d._curvature).max(axis=(1, 2)) > 0))[:3]
     assert nose.size > 0
@@ -631,7 +329,7 @@ def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
             v = np.zeros(d.q.x.array.size)
             v[BS * b:BS * b + 3] = d.frames[b, a]
             columns.append((BS * b + a, v))
-    error = _tangent_error(d, lam, rows, columns)
+    error = tangent_error(d, lam, rows, columns)
     assert error <= (1e-5 if mu else 1e-6), error
 
 
@@ -640,7 +338,7 @@ def test_a_pass_starts_from_the_last_evaluation_turned_into_its_frames():
     another contact set and so other nodal frames. The last evaluation's element arrays, turned
     from its frames F0 into the new F (T = F F0^T), give the residual and tangent of a fresh
     evaluation to round-off, without running the element loops again."""
-    d, lam = _drawn_cup(2.0)
+    d, lam = drawn_cup(2.0)
     d._constraints(lam)
     d.residual(lam, tangent=True)
     s, x = d.state, d.positions()
@@ -667,7 +365,7 @@ def test_a_trials_tangent_is_assembled_only_when_a_solve_asks_for_it():
     come from the trial's stresses and section tangents without the element loops running
     again, and R and K equal an eager evaluation's to round-off (of the element forces' scale).
     Drawn, the coarse cup computes one tangent per solve, fewer than its evaluations."""
-    d, lam = _drawn_cup(2.0)
+    d, lam = drawn_cup(2.0)
     evaluations, tangents = d.evaluations, d.tangents
     d._memo = None
     _, scale, _ = d._trial(lam)
@@ -683,7 +381,7 @@ def test_a_trials_tangent_is_assembled_only_when_a_solve_asks_for_it():
     K.axpy(-1.0, d.A)
     assert K.norm() <= 1e-12 * d.A.norm()
 
-    s = _cup()
+    s = square_cup()
     p = DrawingProblem.from_scene(s, verbose=False)
     p.driver.run(1.5 / s.tools.stroke)
     lazy = p.driver
@@ -695,7 +393,7 @@ def test_failed_early_ending_passes_end_only_near_convergence_from_then_on():
     near convergence from then on (early_step 1), and the increment is tried again from the
     same start before it is cut back; its iterations count both tries. A failure at early_step
     1 is returned to the driver (which cuts back)."""
-    s = _cup()
+    s = square_cup()
     p = DrawingProblem.from_scene(s, verbose=False)
     d = p.driver
     d.run(1.0 / s.tools.stroke)

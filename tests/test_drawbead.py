@@ -8,7 +8,7 @@ import pytest
 from mpi4py import MPI
 
 from shellform.contact.drawbead import DrawbeadLine, _barycentric, _clip
-from test_contact import _side_sum, _strip
+from contact_cases import side_sum, strip
 
 
 def test_a_line_is_shared_out_by_the_shape_functions_to_its_length():
@@ -34,10 +34,10 @@ def test_a_strip_pulled_across_a_drawbead_needs_its_restraining_force(mu, uplift
     share of the die's), to 1e-6; the holder's forces still sum to F."""
     F, Fr, width = 1000.0, 30.0, 20.0
     bead = DrawbeadLine(((5.0, -15.0), (5.0, 15.0)), restraint=Fr, uplift=uplift)
-    rect, d = _strip(mu, F, drawbeads=(bead,))
+    rect, d = strip(mu, F, drawbeads=(bead,))
     d.run(1.0)
     comm = MPI.COMM_WORLD
-    pull = _side_sum(d, rect, ("right",), 0)
+    pull = side_sum(d, rect, ("right",), 0)
     L = comm.allreduce(float(d.drawbeads.length.sum()), op=MPI.SUM)
     assert L == pytest.approx(width, rel=1e-4) and L < width
     expected = Fr * L + mu * (2 * F - uplift * L)

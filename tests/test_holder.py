@@ -1,0 +1,97 @@
+"""The pinching blank holder (shellform/contact/holder.py and the contact driver): a cup drawn
+without a holder force, the open holder as a rigid face that carries its force, and its lift
+step solved with the sheet as exact Newton."""
+
+import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
+
+import numpy as np
+import pytest
+
+from shellform.contact.frames import from_frames
+from shellform.contact.problem import HOLDER, DrawingProblem
+from shellform.assembly.sheet_element import BS
+
+from contact_cases import square_cup
+
+
+@pytest.mark.parametrize("force", [0.0, 4.0])
+def test_cup_without_a_holder_force_draws(force):
+    """BHF = 0 (no holder) and 4 N (a holder that the flange lifts): the cup draws its first
+    millimetre, the holder open, with the tools in balance and no penetration."""
+    s = square_cup(blank_holder_force=force)
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(1.0 / s.tools.stroke)
+    d = p.driver
+    assert p.stroke == pytest.approx(1.0)
+    assert not d.state.closed[0] and p.free_under_holder() == 0
+    assert p.holder_force() == pytest.approx(force, abs=1e-9)
+    assert p.force_balance() <= 1e-6
+    assert p.max_penetration() <= 0.01 * s.material.thickness
+    assert p.punch_force() > 0
+
+
+def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
+    """A light holder (400 N) that the flange lifts below 1 mm of stroke and lets down again
+    before 4 mm. Open, it is a rigid face at its own lift (within the contact tolerance, 1 % of
+    t, of its closed position: micrometres), solved with the sheet in each Newton iteration: its
+    nodes' forces sum to F, no node under it passes its face, the tools balance, and Newton's
+    last pass converges fast (each step at least 5 times smaller, from its second iterate) in at
+    most 4 iterations. Then it closes and pinches the flange again."""
+    s = square_cup(blank_holder_force=400.0)
+    p = DrawingProblem.from_scene(s, verbose=False)
+    F = s.tools.blank_holder_force
+    opened = []
+
+    def check(d):
+        assert abs(p.holder_force() - F) <= 1e-6 * F
+        assert p.force_balance() <= 1e-6
+        assert p.max_penetration() <= 0.01 * s.material.thickness  # the open face included
+        if d.state.closed[0]:
+            assert p.holder_lift() == 0.0 and p.free_under_holder() == 0
+            return
+        opened.append(p.stroke)
+        assert abs(p.holder_lift()) < 0.01 * s.material.thickness and p.in_contact()["holder"] > 0
+        last = d.pass_residuals[-1][1:]
+        assert len(last) <= 5 and all(b <= a / 5 for a, b in zip(last, last[1:]))
+
+    p.driver.run(4.0 / s.tools.stroke, on_increment=check)
+    assert len(opened) >= 3 and 0.5 < opened[0] < 1.0
+    assert p.driver.state.closed[0] and p.in_contact()["pinched"] > 0
+
+
+def test_the_open_holders_lift_step_is_exact_newton():
+    """The lift is solved with the sheet (a bordered system). From the open state at 1.25 mm
+    (400 N holder, its nodes slipping) with F raised by 1 %, central differences of the
+    residual along the Newton direction (dq, dz_H) equal -R on the slipping holder nodes'
+    tangential rows and on the holder's equation: to 2e-3 of |R| (measured; h = 1e-4 to 1e-6
+    give the same), against 6e-2 without the slip forces' dp/dq on the lifted columns."""
+    s = square_cup(blank_holder_force=400.0)
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(1.25 / s.tools.stroke)
+    lam, slip = d.lam, np.flatnonzero(d.friction.slipping & (d.state.tool == HOLDER))
+    assert not d.state.closed[0] and slip.size > 0
+    rows = (BS * slip[:, None] + np.arange(2)).ravel()
+    d.holder.force *= 1.01
+    q0, lift0, solve = d.q.x.array.copy(), float(d.state.lift[0]), d.solve_lifted
+
+    def residual(h=0.0, dq=0.0, dz=0.0):
+        d.q.x.array[:] = q0 + h * dq
+        d.state.lift[0] = lift0 + h * dz
+        d._constraints(lam)
+        d._refreshing = True
+        d.residual(lam, tangent=True)
+        return np.append(d.b.getArray()[rows], d._holder_imbalance())
+
+    errors = {}
+    for exact in (True, False):
+        d.solve_lifted = solve if exact else (lambda delta, out, extra=None: solve(delta, out))
+        R = residual()
+        assert d._solve(0.0)
+        dz = d._lift_step()
+        dq = d.dq.x.array.copy()
+        from_frames(dq, d.rotated, d.frames)
+        h = 1e-4
+        change = (residual(h, dq, dz) - residual(-h, dq, dz)) / (2 * h)
+        errors[exact] = np.abs(change + R).max() / np.abs(R).max()
+    assert errors[True] <= 5e-3 and errors[False] >= 3e-2, errors
