@@ -173,3 +173,21 @@ def test_a_killed_run_resumes_from_its_last_timed_checkpoint(tmp_path):
     rows = [list(csv.DictReader(open(d / "force_stroke.csv"))) for d in (tmp_path / "whole", out)]
     assert [r["stroke_mm"] for r in rows[1]] == [r["stroke_mm"] for r in rows[0]]
     assert float(rows[1][-1]["punch_force_kN"]) == pytest.approx(float(rows[0][-1]["punch_force_kN"]), rel=1e-9)
+
+
+@pytest.mark.timeout(600)
+def test_a_resume_with_other_steps_starts_them_afresh(tmp_path):
+    """Stopped half-way between reports and resumed with another initial_step: the first resumed
+    increment takes the new step (not the one the checkpoint had grown to), and the run ends."""
+    (tmp_path / "cut").mkdir()
+    code, err, lines, out = interrupted_run(tmp_path / "cut", small_cup(), signal.SIGINT, after=7)
+    assert code == 130, err
+    before = json.loads((out / "summary.json").read_text())["increments"]
+    other = small_cup().replace("initial_step = 0.05", "initial_step = 0.01")
+    (tmp_path / "cut" / "scene.toml").write_text(other)
+    resumed = run_cli(tmp_path / "cut" / "scene.toml", "--out", out, "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    again = json.loads((out / "summary.json").read_text())
+    history = json.loads((out / "history.json").read_text())
+    assert "process.initial_step" in again["resumed"]["changed"]
+    assert history[before]["dlam"] == pytest.approx(0.01, rel=1e-12) and again["stroke_mm"] == pytest.approx(1.0)

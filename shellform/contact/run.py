@@ -56,6 +56,8 @@ from shellform.results.tables import write_csv, write_json
 from shellform.scene import Scene
 
 
+# a resume that changes one of these starts its steps afresh (not as the checkpoint had them)
+STEPPING = {"process.initial_step", "process.min_step", "process.max_step", "process.max_iterations", "process.rtol"}
 # worst values over all increments, in summary.json: the balances and the pinch
 CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
 
@@ -82,6 +84,8 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     for line in saved.damaged:
         p.driver.progress.note(f"shellform: resume: {line}; using {saved.path}")
     p.driver.resume(saved)
+    if set(changed) & STEPPING:  # other steps asked for: they start afresh
+        p.driver.forget_steps()
     upto = p.stroke + 1e-9
     curve, reports = [], []
     if (outdir / "force_stroke.csv").exists():

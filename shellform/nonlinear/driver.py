@@ -469,6 +469,11 @@ class Driver:
         self._direction = float(np.sign(lam)) or None
         self._dlam_prev = None
 
+    def forget_steps(self) -> None:
+        """The next run() starts its steps afresh (initial_step, no predictor), not as a checkpoint
+        written between two increments had them (a resume with other steps)."""
+        self._resumed_steps = None
+
     def run(self, target: float = 1.0, on_increment=None):
         """Step lambda from its current value to `target` (up or down). A SIGINT or SIGTERM
         meanwhile stops it after the increment under way: the last converged state is written
