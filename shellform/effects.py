@@ -94,11 +94,6 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
 )}
 
 
-def names() -> tuple[str, ...]:
-    """Every effect, in the registry's (canonical) order."""
-    return tuple(EFFECTS)
-
-
 def check(effects) -> None:
     """Raise InputError('effects', ...) unless every effect is known, listed once, something is
     assembled, every effect's needs are on, and one route knows every effect."""

@@ -3,8 +3,8 @@
     summary = run(scene, outdir, scene_path=path, trace=False, resume=False)
     print(summary.closing_line()); sys.exit(summary.exit_status())
 
-The output folder is checked first (results.run_folder.check_writable, before any
-computation); the scene's route then solves it and writes its files and summary.json:
+The scene's route solves it and writes its files and summary.json; each route first claims
+the output folder (results.run_folder.start: checked writable, before any computation):
 
     "shell"   the linear shell: one solve of K q = f (shellform.linear, results.shell)
     "sheet"   the nonlinear elastic-plastic sheet stepped along its load path
@@ -53,7 +53,6 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     resume: the tools continue from the last converged state in outdir (InputError("resume")
     for the other routes)."""
     outdir = Path(outdir)
-    run_folder.check_writable(outdir, comm)  # before any computation: InputError("--out")
     way = route(s)
     if resume and way != "tools":
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")

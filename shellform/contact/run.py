@@ -133,10 +133,13 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
             checkpoint_now()
 
+    def write_curve():
+        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
+
     def checkpoint_now():
         """The curve so far, then the state it ends at: a resume takes the curve's rows up to the
         checkpoint's stroke."""
-        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
+        write_curve()
         p.driver.save_checkpoint()
         saved_at[0] = time.monotonic()
 
@@ -147,7 +150,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     def report():
         reports.append(state())
         write_json(outdir / "reports.json", reports)  # what a resumed run takes over
-        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
         if series is not None:
             series.write(p.stroke)
 
@@ -162,10 +164,11 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         stopped = str(err)
         p.driver.progress.note(f"shellform: stopped: {err}")
         report()
+        write_curve()
     except Interrupted as err:  # the driver wrote the state; the curve up to it, and no report
         stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal
         p.driver.progress.note(f"shellform: {stopped}")
-        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
+        write_curve()
         reports.append(state())  # in the summary only: a resumed run reports where the scene says
     p.driver.progress.close()
     if series is not None:
@@ -173,7 +176,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     d = p.driver
     for name, line in cup.thickness_lines(p).items():
         write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
-    write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
     cup.plot_force(outdir / "force_stroke.png", curve, s.title)
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")

@@ -141,6 +141,8 @@ class SemiInverseDriver(Driver):
                                         self.sym_fixed[:, :2])
         self.drawbeads = Drawbeads(drawbeads, V, model.dofs, E, model.thickness, model.cell_size,
                                    self.sym_fixed[:, :2]) if drawbeads else None
+        # the parts with a history of their own: started, committed and checkpointed alike
+        self.parts = [part for part in (self.friction, self.drawbeads) if part is not None]
         self.holder = None
         self.holder_tool = len(self.tools)  # the open holder's index in the contact set
         if holder is not None:
@@ -572,9 +574,8 @@ class SemiInverseDriver(Driver):
         """Contact passes: Newton on a fixed contact set (the normal forces follow the iterates),
         then the set's update; repeat until the set and the normal forces hold."""
         self.state = self.committed.copy()
-        self.friction.start()
-        if self.drawbeads is not None:
-            self.drawbeads.start()
+        for part in self.parts:
+            part.start()
         self._lam_trial = lam
         if self.holder is not None:
             self._pinch(self.holder.under(self.x_n), grow=False)
@@ -831,9 +832,8 @@ class SemiInverseDriver(Driver):
         s = self.state
         s.toggles[:] = 0
         s.holder_toggles[:] = 0
-        self.friction.commit()
-        if self.drawbeads is not None:
-            self.drawbeads.commit()
+        for part in self.parts:
+            part.commit()
         c = self.committed
         self._previous = {"lam": self.lam_n, "tool": c.tool, "normal": c.normal}
         self.committed = s.copy()
@@ -855,9 +855,8 @@ class SemiInverseDriver(Driver):
         travel (shellform.nonlinear.checkpoint numbers the nodes globally)."""
         c, own = self.committed, super().checkpoint_state()
         own["nodes"].update({f"contact_{k}": getattr(c, k) for k in self.NODES})
-        own["nodes"].update(self.friction.checkpoint())
-        if self.drawbeads is not None:
-            own["nodes"].update(self.drawbeads.checkpoint())
+        for part in self.parts:
+            own["nodes"].update(part.checkpoint())
         own["nodes"].update({"contact_pinched": self.pinched_n, "contact_x_n": self.x_n,
                              "contact_half_thickness": self.half_thickness})
         own["global"].update({f"contact_{k}": getattr(c, k) for k in self.GLOBAL})
@@ -884,9 +883,8 @@ class SemiInverseDriver(Driver):
         for k in self.GLOBAL:
             getattr(c, k)[...] = glob[f"contact_{k}"]
         self.committed, self.state = c, c.copy()
-        self.friction.restore(nodes)
-        if self.drawbeads is not None:
-            self.drawbeads.restore(nodes)
+        for part in self.parts:
+            part.restore(nodes)
         self.pinched = nodes["contact_pinched"].copy()
         self.pinched_n = self.pinched.copy()
         self.x_n = nodes["contact_x_n"].copy()
@@ -903,9 +901,8 @@ class SemiInverseDriver(Driver):
     def _restore_converged(self):
         """The committed contact state and its forces (a stop reports the last converged state)."""
         self.state = self.committed.copy()
-        self.friction.start()
-        if self.drawbeads is not None:
-            self.drawbeads.start()
+        for part in self.parts:
+            part.start()
         self._lam_trial = self.lam_n
         self.model.converged_lever()
         if self.holder is not None:

@@ -175,11 +175,3 @@ def read(folder: Path, comm=MPI.COMM_WORLD) -> Checkpoint:
         raise InputError("resume", found)
     return found
 
-
-def discard(folder: Path) -> None:
-    """Remove the folder's checkpoints (both generations, a partial one, an older format's)."""
-    folder = Path(folder)
-    for name in (CURRENT, PREVIOUS, f".{CURRENT}.new"):
-        (folder / name).unlink(missing_ok=True)
-    for old in folder.glob("last_converged.rank*.npz"):
-        old.unlink(missing_ok=True)
