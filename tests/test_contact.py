@@ -60,13 +60,14 @@ def test_a_support_in_a_turned_frame_is_corrected_towards_its_value():
     symmetry row's known correction must move v back to 0 (global: -v), not double it."""
     rect, model, bcs = plate()
     d = SemiInverseDriver(model, bcs, [FlatTool(0.5, 15.0, 15.0)], [-2.0], verbose=False)
-    bottom = np.flatnonzero((d.state.tool == 0) & d.sym_fixed[:, 1] & ~d.sym_fixed[:, 0])
+    held = d.nodes.held
+    bottom = np.flatnonzero(d.contact.on(0) & held[:, 1] & ~held[:, 0])
     assert bottom.size > 0
     q = d.q.x.array.reshape(-1, BS)
     q[bottom, 1] = 1e-3  # off the symmetry plane
-    assert d._constraints(0.0) >= 1e-3
+    d.constrain(0.0)
     assert np.all(d.frames[bottom, 1] == [0.0, -1.0, 0.0])
-    delta = d._correction()
+    delta = d.correction()
     from_frames(delta, d.rotated, d.frames)  # the correction in x, y, z
     assert np.allclose(delta.reshape(-1, BS)[bottom, 1], -1e-3, rtol=1e-12)
 
@@ -84,7 +85,7 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
 
     def check(dr):
         r = dr.reactions()
-        on = dr.state.tool == 0
+        on = dr.contact.on(0)
         # z of the punch's force on the sheet: F^T r on the punch nodes
         fz = np.einsum("nk,nk->n", dr.frames[: dr.n_owned][on][:, :, 2], r[on])
         punch_z = MPI.COMM_WORLD.allreduce(float(fz.sum()), op=MPI.SUM)
@@ -93,14 +94,14 @@ def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading()
         peak = max(abs(f) for f in forces)
         assert abs(punch_z + support) <= 1e-8 * peak, (punch_z, support)
         gap, _ = punch.gap(dr.positions(), 0.5 * t, dr.lam * -2.0)
-        assert -gap.min() <= dr.contact.penetration
-        assert dr.history[-1].contact["passes"] < dr.contact.max_passes
+        assert -gap.min() <= dr.contact.controls.penetration
+        assert dr.history[-1].contact["passes"] < dr.controls.max_passes
 
     d.run(1.0, on_increment=check)
     assert forces[-1] < 0 and abs(forces[-1]) > 10.0  # the punch pushes down with a real force
-    assert MPI.COMM_WORLD.allreduce(int((d.state.tool == 0).sum()), op=MPI.SUM) > 0
+    assert MPI.COMM_WORLD.allreduce(int(d.contact.on(0).sum()), op=MPI.SUM) > 0
     d.run(-0.1, on_increment=check)  # unload and lift the punch 0.2 mm: the plate springs back off it
-    assert MPI.COMM_WORLD.allreduce(int((d.state.tool == 0).sum()), op=MPI.SUM) == 0
+    assert MPI.COMM_WORLD.allreduce(int(d.contact.on(0).sum()), op=MPI.SUM) == 0
     assert abs(forces[-1]) < 1e-6 * max(abs(f) for f in forces)
 
 
@@ -121,9 +122,9 @@ def test_short_square_cup_draw():
         x, y = p.holder_largest_at()
         assert 0 <= x <= s.geometry.lx / 2 and 0 <= y <= s.geometry.ly / 2
         assert p.force_balance() <= 1e-6
-        assert p.free_under_holder() == 0 and d.state.closed[0]
+        assert p.free_under_holder() == 0 and d.holder.closed
         assert p.max_penetration() <= 0.01 * s.material.thickness
-        assert d.history[-1].contact["passes"] < d.contact.max_passes
+        assert d.history[-1].contact["passes"] < d.controls.max_passes
         forces.append(p.punch_force())
 
     p.driver.run(3.0 / s.tools.stroke, on_increment=check)
@@ -165,18 +166,17 @@ def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
 
     from shellform.contact import run as contact_run
 
-    original = SemiInverseDriver._newton_fixed_set
+    original = SemiInverseDriver.settle
 
-    def breaks_down(self, lam):
+    def breaks_down(self, lam, reversal=False):
         if lam * 30.0 <= 0.5 + 1e-9:
-            return original(self, lam)
+            return original(self, lam, reversal)
         self.q.x.array[:] += 5.0  # a diverged iterate: its reactions must not be reported
-        self._constraints(lam)
-        self.residual(lam, tangent=False)
-        self._cause = "forced by the test"
+        self.linearize(lam, tangent=False)
+        self.cause = "forced by the test"
         return False, 1, [1e9], None
 
-    monkeypatch.setattr(SemiInverseDriver, "_newton_fixed_set", breaks_down)
+    monkeypatch.setattr(SemiInverseDriver, "settle", breaks_down)
     s = square_cup()
     s.process.initial_step = s.process.max_step = 0.25 / 30.0
     summary = contact_run.run(s, tmp_path)
@@ -262,7 +262,7 @@ def test_an_elastic_sheet_springs_back_flat():
     assert np.abs(drawn[:, 2]).max() > 0.5  # pressed well into the die opening
     sb = springback.release(p.driver)
     q = sb.q.x.array.reshape(-1, 9)
-    centre = q[np.argmin(np.hypot(*p.driver.X[:, :2].T)), 2]
+    centre = q[np.argmin(np.hypot(*p.driver.nodes.X[:, :2].T)), 2]
     assert np.abs(q[:, [0, 1, 3, 4, 5, 6, 7, 8]]).max() < 1e-8
     assert np.abs(q[:, 2] - centre).max() < 1e-8
     assert sum(h.plastic_layers for h in sb.history) == 0
@@ -320,12 +320,12 @@ def test_tangent_follows_the_frames_turning_on_curved_tools(mu):
     of order mu times the term, is left out); without the term: 1e-4 (docs/contact.md)."""
     d, lam = drawn_cup(6.0)
     d.friction.mu = mu
-    nose = np.flatnonzero((d.state.tool == 0) & (np.abs(d._curvature).max(axis=(1, 2)) > 0))[:3]
+    nose = np.flatnonzero(d.contact.on(0) & (np.abs(d.contact.curvature).max(axis=(1, 2)) > 0))[:3]
     assert nose.size > 0
     rows = (BS * nose[:, None] + np.arange(2)).ravel()
     columns = []
     for b in nose:
-        for a in np.flatnonzero(~d.sym_fixed[b, :2]):
+        for a in np.flatnonzero(~d.nodes.held[b, :2]):
             v = np.zeros(d.q.x.array.size)
             v[BS * b:BS * b + 3] = d.frames[b, a]
             columns.append((BS * b + a, v))
@@ -339,20 +339,21 @@ def test_a_pass_starts_from_the_last_evaluation_turned_into_its_frames():
     from its frames F0 into the new F (T = F F0^T), give the residual and tangent of a fresh
     evaluation to round-off, without running the element loops again."""
     d, lam = drawn_cup(2.0)
-    d._constraints(lam)
+    d.constrain(lam)
     d.residual(lam, tangent=True)
-    s, x = d.state, d.positions()
-    released = np.flatnonzero((s.tool == 0) & ~d.sym_fixed.any(axis=1))[:5]
-    die_gap = d.gaps(x, lam)[d.die][0]
-    joined = np.flatnonzero((s.tool == FREE) & np.isfinite(die_gap))[:5]
+    s, x = d.contact, d.positions()
+    released = np.flatnonzero(s.on(0) & ~d.nodes.held[:, :3].any(axis=1))[:5]
+    die_gap = s.gaps(x, lam)[s.die][0]
+    joined = np.flatnonzero(s.on(FREE) & np.isfinite(die_gap))[:5]
     assert released.size == 5 and joined.size == 5
-    s.tool[released], s.tool[joined] = FREE, d.die
-    d._constraints(lam)
+    s.assign(released, FREE)
+    s.assign(joined, s.die)
+    d.constrain(lam)
     reused = d.reused
     d.residual(lam, tangent=True)
     assert d.reused == reused + 1
     R, K = d.b.copy(), d.A.copy()
-    d._memo = None  # a fresh evaluation
+    d.forget_evaluation()  # a fresh evaluation
     d.residual(lam, tangent=True)
     assert d.reused == reused + 1
     assert (R - d.b).norm() <= 1e-12 * d.b.norm()
@@ -367,15 +368,15 @@ def test_a_trials_tangent_is_assembled_only_when_a_solve_asks_for_it():
     Drawn, the coarse cup computes one tangent per solve, fewer than its evaluations."""
     d, lam = drawn_cup(2.0)
     evaluations, tangents = d.evaluations, d.tangents
-    d._memo = None
-    _, scale, _ = d._trial(lam)
+    d.forget_evaluation()
+    _, scale, _ = d.trial(lam)
     R = d.b.copy()
-    assert d._later is not None and d.tangents == tangents and d.evaluations == evaluations + 1
-    d._tangent_now()
-    assert d._later is None and d.tangents == tangents + 1 and d.evaluations == evaluations + 1
+    assert d.tangent_pending and d.tangents == tangents and d.evaluations == evaluations + 1
+    d.assemble_tangent()
+    assert not d.tangent_pending and d.tangents == tangents + 1 and d.evaluations == evaluations + 1
     K = d.A.copy()
     assert (R - d.b).norm() <= 1e-15 * scale  # the same R (converged: small against the element forces)
-    d._memo = None
+    d.forget_evaluation()
     d.residual(lam, tangent=True)
     assert (R - d.b).norm() <= 1e-14 * scale
     K.axpy(-1.0, d.A)
@@ -397,30 +398,30 @@ def test_failed_early_ending_passes_end_only_near_convergence_from_then_on():
     p = DrawingProblem.from_scene(s, verbose=False)
     d = p.driver
     d.run(1.0 / s.tools.stroke)
-    assert d.early_step == 10.0
-    starts, real = [], d._contact_passes
+    assert d.contact.early_step == 10.0
+    starts, real = [], d.settle
 
     def first_fails(lam, reversal=False):
-        starts.append((d.early_step, d.q.x.array.copy()))
+        starts.append((d.contact.early_step, d.q.x.array.copy()))
         if len(starts) == 1:
             d.q.x.array[:] += 1e-3  # a failed try leaves its last iterate behind
-            d._cause = "a failure for the test"
+            d.cause = "a failure for the test"
             return False, 7, [1.0], None
         return real(lam, reversal)
 
-    d._contact_passes = first_fails
+    d.settle = first_fails
     lam = d.lam + 0.2 / s.tools.stroke
-    ok, its, _, _ = d._newton(lam)
-    assert ok and [e for e, _ in starts] == [10.0, 1.0] and d.early_step == 1.0
+    ok, its, _, _ = d.newton(lam)
+    assert ok and [e for e, _ in starts] == [10.0, 1.0] and d.contact.early_step == 1.0
     assert np.array_equal(starts[0][1], starts[1][1])
     assert its > 7
 
     def fails(lam, reversal=False):
-        starts.append((d.early_step, None))
+        starts.append((d.contact.early_step, None))
         return False, 3, [1.0], None
 
-    d._contact_passes = fails
-    assert d._newton(lam)[:2] == (False, 3) and len(starts) == 3
+    d.settle = fails
+    assert d.newton(lam)[:2] == (False, 3) and len(starts) == 3
 
 
 def test_passes_that_only_move_the_contact_front_are_not_counted():
@@ -433,7 +434,7 @@ def test_passes_that_only_move_the_contact_front_are_not_counted():
     states = []
     for max_passes in (12, 2):
         p = DrawingProblem.from_scene(s, verbose=False)
-        p.driver.contact.max_passes = max_passes
+        p.driver.controls.max_passes = max_passes
         p.driver.run(s.process.initial_step)
         h = p.driver.history
         assert len(h) == 1 and h[0].cutbacks == 0

@@ -26,20 +26,20 @@ def test_strip_dragged_between_flat_tools_carries_mu_times_the_clamping_force():
     comm = MPI.COMM_WORLD
 
     def check(dr):
-        assert abs(dr.holder.total(dr.state.holder_face) - F) <= 1e-9 * F
+        assert abs(dr.holder.total() - F) <= 1e-9 * F
         under = dr.holder.under(dr.positions())
-        assert np.array_equal(dr.pinched, under)  # no free node under the closed holder
-        p = dr.state.pressure + dr.state.holder_face
+        assert np.array_equal(dr.holder.pinched, under)  # no free node under the closed holder
+        p = dr.contact.face_forces()
         ft = np.linalg.norm(dr.friction.force, axis=1)
         assert np.all(ft <= mu * p * (1 + 1e-8) + 1e-9)
-        assert np.all(dr.state.pressure[under] >= 0)
+        assert np.all(dr.contact.pressure[under] >= 0)
 
     d.run(1.0, on_increment=check)
     pull = side_sum(d, rect, ("right",), 0)
-    normal = comm.allreduce(float((d.state.pressure + d.state.holder_face).sum()), op=MPI.SUM)
+    normal = comm.allreduce(float(d.contact.face_forces().sum()), op=MPI.SUM)
     assert abs(pull - mu * normal) <= 1e-8 * mu * normal
     assert abs(pull - 2 * mu * F) <= 1e-4 * 2 * mu * F
-    assert np.all(d.friction.slipping[d.state.tool == 0])  # the whole strip slides on the die
+    assert np.all(d.friction.slipping[d.contact.on(0)])  # the whole strip slides on the die
 
 
 def test_slip_reversal_converges_without_friction_flips():
@@ -52,16 +52,16 @@ def test_slip_reversal_converges_without_friction_flips():
     mu, F = 0.15, 1000.0
     rect, d = strip(mu, F, initial_step=0.05, max_step=0.05)
     sides, log = [], []
-    constraints = d._constraints
+    constraints = d.constrain
 
     def record(lam):
         jump = constraints(lam)
-        limit = mu * (d.state.pressure + d.state.holder_face)
+        limit = mu * d.contact.face_forces()
         f = d.friction.force[:, 0]
         sides.append(np.sign(f) * (np.abs(f) >= 0.5 * limit) * (limit > 0))
         return jump
 
-    d._constraints = record
+    d.constrain = record
 
     def check(dr):
         s = np.array(sides)
@@ -82,8 +82,9 @@ def test_slip_reversal_converges_without_friction_flips():
     assert all(e[0] == 0 for i, e in enumerate(log) if i not in (0, n_forward))
     assert pull_forward == pytest.approx(2 * mu * F, rel=1e-4)
     assert pull_back == pytest.approx(-2 * mu * F, rel=1e-4)
-    assert np.all(d.friction.slipping[d.state.tool == 0]) and np.all(d.friction.force[d.state.tool == 0, 0] > 0)
-    tol = d.controls.rtol * d._scale  # Newton's tolerance: below it, round-off
+    on = d.contact.on(0)
+    assert np.all(d.friction.slipping[on]) and np.all(d.friction.force[on, 0] > 0)
+    tol = d.controls.rtol * d.scale  # Newton's tolerance: below it, round-off
     for _, _, passes in log:  # superlinear tails: above the tolerance, the last reduction is the
         for r in passes:      # best of the pass and at least 1e-2
             above = np.array([v for v in r[int(np.argmax(r)):] if v > tol])
@@ -116,10 +117,10 @@ def test_slip_tangent_carries_the_normal_force_change():
     rows to 1e-6 of the largest entry (without the term: 1e-3, docs/contact.md)."""
     d, lam = drawn_cup(2.0)
     m = d.model
-    slip = np.flatnonzero(d.friction.slipping & (d.state.tool == 0) & ~d.pinched)
+    slip = np.flatnonzero(d.friction.slipping & d.contact.on(0) & ~d.holder.pinched)
     assert slip.size > 0
     near = np.unique(m.dofs[np.isin(m.dofs, slip).any(axis=1)])
-    free = [b for b in near if b < d.n_owned and d.state.tool[b] == FREE][:3]
+    free = [b for b in near if b < d.n_owned and d.contact.tool[b] == FREE][:3]
     rows = (BS * slip[:, None] + np.arange(2)).ravel()
     columns = [(j, np.eye(d.q.x.array.size)[j]) for j in (BS * b + k for b in free for k in range(BS))
                if j not in d.bc_dofs]

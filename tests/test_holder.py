@@ -23,7 +23,7 @@ def test_cup_without_a_holder_force_draws(force):
     p.driver.run(1.0 / s.tools.stroke)
     d = p.driver
     assert p.stroke == pytest.approx(1.0)
-    assert not d.state.closed[0] and p.free_under_holder() == 0
+    assert not d.holder.closed and p.free_under_holder() == 0
     assert p.holder_force() == pytest.approx(force, abs=1e-9)
     assert p.force_balance() <= 1e-6
     assert p.max_penetration() <= 0.01 * s.material.thickness
@@ -46,7 +46,7 @@ def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
         assert abs(p.holder_force() - F) <= 1e-6 * F
         assert p.force_balance() <= 1e-6
         assert p.max_penetration() <= 0.01 * s.material.thickness  # the open face included
-        if d.state.closed[0]:
+        if d.holder.closed:
             assert p.holder_lift() == 0.0 and p.free_under_holder() == 0
             return
         opened.append(p.stroke)
@@ -56,7 +56,7 @@ def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
 
     p.driver.run(4.0 / s.tools.stroke, on_increment=check)
     assert len(opened) >= 3 and 0.5 < opened[0] < 1.0
-    assert p.driver.state.closed[0] and p.in_contact()["pinched"] > 0
+    assert p.driver.holder.closed and p.in_contact()["pinched"] > 0
 
 
 def test_the_open_holders_lift_step_is_exact_newton():
@@ -69,26 +69,24 @@ def test_the_open_holders_lift_step_is_exact_newton():
     p = DrawingProblem.from_scene(s, verbose=False)
     d = p.driver
     d.run(1.25 / s.tools.stroke)
-    lam, slip = d.lam, np.flatnonzero(d.friction.slipping & (d.state.tool == HOLDER))
-    assert not d.state.closed[0] and slip.size > 0
+    lam, slip = d.lam, np.flatnonzero(d.friction.slipping & d.contact.on(HOLDER))
+    assert not d.holder.closed and slip.size > 0
     rows = (BS * slip[:, None] + np.arange(2)).ravel()
     d.holder.force *= 1.01
-    q0, lift0, solve = d.q.x.array.copy(), float(d.state.lift[0]), d.solve_lifted
+    q0, lift0, solve = d.q.x.array.copy(), d.holder.lift, d.solve_lifted
 
     def residual(h=0.0, dq=0.0, dz=0.0):
         d.q.x.array[:] = q0 + h * dq
-        d.state.lift[0] = lift0 + h * dz
-        d._constraints(lam)
-        d._refreshing = True
-        d.residual(lam, tangent=True)
-        return np.append(d.b.getArray()[rows], d._holder_imbalance())
+        d.holder.lift = lift0 + h * dz
+        d.linearize(lam)
+        return np.append(d.b.getArray()[rows], d.holder.imbalance())
 
     errors = {}
     for exact in (True, False):
         d.solve_lifted = solve if exact else (lambda delta, out, extra=None: solve(delta, out))
         R = residual()
-        assert d._solve(0.0)
-        dz = d._lift_step()
+        assert d.solve(0.0)
+        dz = d.holder.border(d)
         dq = d.dq.x.array.copy()
         from_frames(dq, d.rotated, d.frames)
         h = 1e-4

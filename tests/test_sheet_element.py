@@ -176,7 +176,7 @@ def test_consistent_tangent(plastic):
     # a converged state inside the next increment, not committed: the return mapping is smooth
     # there (at a committed state a central difference would straddle loading and unloading)
     lam = 95.0 / max(levy.TABLE)
-    converged, _, _, ev = d._newton(lam)
+    converged, _, _, ev = d.newton(lam)
     assert converged
     if plastic:
         assert ev.plastic_layers > 0

@@ -33,6 +33,7 @@ from dolfinx import fem, la
 
 from shellform.assembly.sheet_element import BS
 from shellform.contact.frames import add_tangent_slot_stiffness, subtract_nodal_forces
+from shellform.nonlinear.parts import Part
 
 
 @dataclass(frozen=True)
@@ -73,13 +74,13 @@ def _clip(P0, P1, tri):
     return t0, t1, on_edge
 
 
-class Drawbeads:
+class Drawbeads(Part):
     """The drawbeads of a blank on n_owned nodes (V: the carrier's space, dofs: the owned
     cells' nodes, E and t: the sheet's modulus and thickness, h: its cell size, held: (n, 2)
     in-plane slots a symmetry plane holds)."""
 
-    def __init__(self, lines, V, dofs, E: float, t: float, h: float, held: np.ndarray):
-        self.lines = tuple(lines)
+    def __init__(self, lines, V, dofs, E: float, t: float, h: float, held: np.ndarray, nodes=None):
+        self.lines, self.nodes = tuple(lines), nodes
         self.V, self.dofs, self.held = V, dofs, held
         n = held.shape[0]
         self.n = n
@@ -125,19 +126,31 @@ class Drawbeads:
         self.limit, self.uplift = own[:, 3].copy(), own[:, 4].copy()
 
     # -- the increment's history ----------------------------------------------------------------
-    def start(self) -> None:
+    def start(self, lam: float = 0.0, predicting: bool = False) -> None:
         self.history = self.committed.copy()
 
-    def commit(self) -> None:
+    def commit(self, lam: float = 0.0) -> None:
         self.committed = np.einsum("ni,ni->n", self.force[:, :2], self.across)
         self.history = self.committed.copy()
 
     def checkpoint(self) -> dict:
-        return {"drawbead_restraint": self.committed}
+        return {"nodes": {"drawbead_restraint": self.committed}}
 
-    def restore(self, nodes: dict) -> None:
-        self.committed = nodes["drawbead_restraint"].copy()
+    def restore(self, state: dict, lam_scale: float = 1.0) -> None:
+        self.committed = state["nodes"]["drawbead_restraint"].copy()
         self.history = self.committed.copy()
+
+    # -- the part's protocol: one iterate --------------------------------------------------------
+    def follow(self, frames: np.ndarray, lam: float) -> None:
+        self.frames = frames[: self.n]
+        self.update(self.nodes.local_positions(), self.nodes.x_n, self.frames)
+
+    def add_residual(self, R: np.ndarray) -> None:
+        """R -= f on the owned nodes' u, v, w rows, in their nodal frames."""
+        subtract_nodal_forces(R[: self.n * BS].reshape(-1, BS)[:, :3], self.frames, self.force)
+
+    def add_tangent(self, K, R: np.ndarray, fixed: np.ndarray) -> None:
+        add_tangent_slot_stiffness(K, self.rate)
 
     # -- one iterate ---------------------------------------------------------------------------
     def update(self, x_local: np.ndarray, x_n: np.ndarray, frames: np.ndarray) -> None:
@@ -160,13 +173,6 @@ class Drawbeads:
         self.rate = np.where(slip, 0.0, k)[:, None, None] * d2[:, :, None] * d2[:, None, :]
         held = self.held
         self.rate[held[:, :, None] | held[:, None, :]] = 0.0
-
-    def add_residual(self, R3: np.ndarray, frames: np.ndarray) -> None:
-        """R -= f on the owned nodes' u, v, w rows (R3), in their nodal frames."""
-        subtract_nodal_forces(R3, frames, self.force)
-
-    def add_tangent(self, K) -> None:
-        add_tangent_slot_stiffness(K, self.rate)
 
     def total(self, comm) -> np.ndarray:
         """The beads' force on the sheet (x, y, z), all ranks (of this model: not mirrored)."""

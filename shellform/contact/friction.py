@@ -22,26 +22,51 @@ reactions), the slipping force's dependence on it enters the tangent too:
 (K_(i,n) the node's normal row of the sheet's tangent, R0 its net normal force; non-symmetric),
 on the free tangent rows of every slipping node, in the free columns.
 
-The part owns its history (committed with an increment, forgotten where a node switches tools)
-and the forces, stiffness and slip state of the current iterate; the contact driver tells it
-which nodes rub, where they are and on what frames, and with which normal forces.
+The normal force p (both faces of a pinched node) is the part's too. Within a Newton pass it is
+taken from the reactions of every iterate after the first (the contact set's faces), so that
+Newton converges p with the displacements; the first iterate of a pass keeps the p of the pass
+before. Between passes p is the fixed point p = p~(p) of the faces' new sum p~, relaxed with
+Aitken's factor (Irons and Tuck), r = p~ - p,
+
+    omega_k = -omega_k-1 r_k-1 . (r_k - r_k-1) / |r_k - r_k-1|^2   in [0.2, 1.5],
+
+which damps a cycling p (a node whose faces swap) and speeds a slow one; the passes go on until
+|mu r| <= friction_rtol |mu p~|. With the driver's predictor, an increment's first p is
+extrapolated from the last two increments, as the carrier is (nodes on the same tool in both).
+
+The part owns its history (committed with an increment, forgotten where a node switches tools),
+its normal forces and the forces, stiffness and slip state of the current iterate; the contact
+set (contact_set.py) tells it which nodes rub on which tool and with which face forces.
 """
 
 import numpy as np
+from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
 from shellform.contact.frames import add_tangent_slot_stiffness, subtract_nodal_forces
+from shellform.nonlinear.parts import Change, Part
+from shellform.results.log import say
 
 
-class CoulombFriction:
+class CoulombFriction(Part):
     """Coulomb friction with coefficient mu on n owned nodes (k_stick: their stick stiffness;
-    held: (n, 2) tangent slots a symmetry plane holds, which get no stiffness)."""
+    held: (n, 2) tangent slots a symmetry plane holds, which get no stiffness); contact: the
+    ContactSet whose nodes rub; rtol: friction_rtol."""
 
     STICK_STIFFNESS = 0.01  # k_t per node over E A_i / h
 
-    def __init__(self, mu: float, k_stick: np.ndarray, held: np.ndarray):
+    def __init__(self, mu: float, k_stick: np.ndarray, held: np.ndarray, contact=None, nodes=None,
+                 rtol: float = 1e-4, trace: bool = False):
         n = len(k_stick)
         self.mu, self.k_stick, self.held = float(mu), k_stick, held
+        self.contact, self.nodes, self.rtol, self.trace = contact, nodes, rtol, trace
+        self.normal = np.zeros(n)  # p, the normal force friction uses (both faces)
+        self.committed_normal = self.normal.copy()
+        self.previous = None  # (lam, tool, p) of the increment before the last converged one
+        self.last = None  # (lam, tool, p) of the last converged one
+        self.refreshing = False
+        self._r_prev, self._omega = None, 1.0
+        self.frames = None
         self.history = np.zeros((n, 3))  # the tangential forces of the last converged increment (x, y, z)
         self.committed = self.history.copy()
         self.force = np.zeros((n, 3))  # of the current iterate (x, y, z)
@@ -53,29 +78,140 @@ class CoulombFriction:
     def active(self) -> bool:
         return self.mu > 0
 
+    def bind(self, driver) -> None:
+        self.comm = driver.model.mesh.comm
+        self.normal = self.contact.face_forces()
+        self.committed_normal = self.normal.copy()
+        self.last = (0.0, self.contact.tool.copy(), self.committed_normal)
+
     # -- the increment's history ----------------------------------------------------------------
-    def start(self) -> None:
-        """An increment (or a retry of it) starts from the committed history."""
+    def start(self, lam: float = 0.0, predicting: bool = False) -> None:
+        """An increment (or a retry of it) starts from the committed history and normal forces,
+        extrapolated where the driver predicts."""
         self.history = self.committed.copy()
+        self.normal = self.committed_normal.copy()
+        self._r_prev, self._omega = None, 1.0  # Aitken's memory of the normal-force updates
+        prev = self.previous
+        if not (predicting and prev is not None):
+            return
+        lam_n = self.last[0]
+        ratio = (lam - lam_n) / (lam_n - prev[0])
+        same = self.contact.tool == prev[1]
+        p = self.normal
+        p[same] = np.maximum(p[same] + ratio * (p[same] - prev[2][same]), 0.0)
+
+    def begin_pass(self) -> None:
+        self.refreshing = False
+
+    def stepped(self, yes: bool) -> None:
+        self.refreshing = yes
 
     def forget(self, nodes: np.ndarray) -> None:
         """Nodes that switched tools start without history."""
         self.history[nodes] = 0.0
 
-    def commit(self) -> None:
+    def commit(self, lam: float = 0.0) -> None:
         """The increment converged: its forces are the next one's history."""
         self.committed = self.force.copy()
         self.history = self.committed.copy()
+        self.previous = self.last
+        self.committed_normal = self.normal.copy()
+        self.last = (lam, self.contact.tool.copy(), self.committed_normal) if self.contact is not None else None
 
     def checkpoint(self) -> dict:
-        return {"contact_friction": self.committed}
+        nodes = {"contact_friction": self.committed, "contact_normal": self.committed_normal}
+        glob = {}
+        if self.previous is not None:
+            nodes.update({"contact_previous_tool": self.previous[1], "contact_previous_normal": self.previous[2]})
+            glob["contact_previous_lam"] = np.array(self.previous[0])
+        return {"nodes": nodes, "global": glob}
 
-    def restore(self, nodes: dict) -> None:
+    def restore(self, state: dict, lam_scale: float = 1.0) -> None:
+        nodes, glob = state["nodes"], state.get("global", {})
         self.committed = nodes["contact_friction"].copy()
         self.history = self.committed.copy()
+        if "contact_normal" in nodes:
+            self.committed_normal = nodes["contact_normal"].copy()
+            self.normal = self.committed_normal.copy()
+        if self.contact is not None and "contact_lam_n" in glob:
+            self.last = (float(glob["contact_lam_n"]) * lam_scale, self.contact.tool.copy(), self.committed_normal)
+        self.previous = None
+        if "contact_previous_lam" in glob:
+            self.previous = (float(glob["contact_previous_lam"]) * lam_scale, nodes["contact_previous_tool"].copy(),
+                             nodes["contact_previous_normal"].copy())
+
+    # -- the part's protocol: one iterate --------------------------------------------------------
+    def follow(self, frames: np.ndarray, lam: float) -> None:
+        """The return mapping at the iterate, on every node on a tool or pressed (by the holder)."""
+        c, n = self.contact, self.nodes.n_owned
+        self.normal[c.slid_off] = c.face_forces()[c.slid_off]
+        self.frames = frames
+        rub = np.flatnonzero(c.on_tools() | (self.normal > 0))
+        self._rub = (rub, c.shift[rub], self.nodes.positions(), frames[:n][rub])
+        self._map()
+
+    def _map(self):
+        """The return mapping on the rubbing nodes of this iterate with the current p."""
+        idx, shift, x, F = self._rub
+        self.slip(idx, shift, x, self.nodes.x_n, F, self.normal)
+
+    def add_residual(self, R: np.ndarray) -> None:
+        """R -= f; on the iterates after a pass's first, p from this iterate's reactions first
+        (R before friction), the return mapping again with it."""
+        n = self.nodes.n_owned
+        if not self.active:
+            return
+        if self.refreshing:
+            self.contact.refresh(R)
+            self.normal = self.contact.face_forces()
+            self._map()
+        subtract_nodal_forces(R[: n * BS].reshape(-1, BS)[:, :3], self.frames[:n], self.force)
+
+    def add_tangent(self, K, R: np.ndarray, fixed: np.ndarray) -> None:
+        """K += -df/ds; on the iterates after a pass's first, the slip force's dp/dq too."""
+        self.slip_rows = None
+        if not self.active:
+            return
+        add_tangent_slot_stiffness(K, self.rate)
+        if self.refreshing:
+            on = self.slipping & self.contact.on_tools() & (self.normal > 0)
+            coef = np.where(on, self.contact.dp_dnet(), 0.0)
+            self.add_normal_force_tangent(K, self.contact.nodes.model, coef, self.frames, self.normal, fixed,
+                                          self.nodes.n_local)
+
+    def update_normal(self, changes: int):
+        """Between passes: p relaxed towards the faces' new sum (module docstring). Returns
+        (|r|, |p~|)."""
+        c = self.contact
+        target = c.face_forces()
+        r = target - self.normal
+        dot = lambda a, b: self.comm.allreduce(float(np.dot(a, b)), op=MPI.SUM)  # noqa: E731
+        omega = 1.0
+        if changes == 0 and self._r_prev is not None:
+            dr = r - self._r_prev
+            dd = dot(dr, dr)
+            if dd > 0:
+                omega = float(np.clip(-self._omega * dot(self._r_prev, dr) / dd, 0.2, 1.5))
+        if self.trace and r.size:
+            i = int(np.argmax(np.abs(r)))
+            say(f"    normal force: omega {omega:.3g}; largest change at node {i}: {self.normal[i]:.1f} -> "
+                f"{target[i]:.1f} N")
+        self._r_prev, self._omega = (r, omega) if changes == 0 else (None, 1.0)
+        self.normal = np.maximum(self.normal + omega * r, 0.0)
+        free = ~c.on_tools()
+        self.normal[free] = target[free]  # off the tools: the holder's load only
+        return np.sqrt(dot(r, r)), np.sqrt(dot(target, target))
+
+    def update(self, lam: float, changes: int) -> Change:
+        """After a converged pass: forget the history of the nodes that switched, relax p."""
+        self.forget(self.contact.switched)
+        dp, pn = self.update_normal(changes)
+        mu = self.mu
+        return Change(0, 0, bool(mu * dp <= self.rtol * mu * pn),
+                      f"friction change |mu dp| {mu * dp:.3e} of |mu p| {mu * pn:.3e}")
 
     # -- one iterate ---------------------------------------------------------------------------
-    def update(self, idx, shift, x, x_n, F, normal) -> None:
+    def slip(self, idx, shift, x, x_n, F, normal) -> None:
         """The return mapping on the rubbing nodes idx at positions x (x_n: at the start of the
         increment; shift: their tool's z-travel in it; F: their frames, normal F[:, 2]) with the
         normal forces `normal` (all nodes); every other node carries no friction."""
@@ -103,14 +239,6 @@ class CoulombFriction:
         self.force[idx] = ratio[:, None] * trial
         self.rate[idx] = rate
         self.slipping[idx] = slip
-
-    def add_residual(self, R3: np.ndarray, frames: np.ndarray) -> None:
-        """R -= f on the owned nodes' u, v, w rows (R3), in their nodal frames."""
-        subtract_nodal_forces(R3, frames, self.force)
-
-    def add_tangent(self, K) -> None:
-        """K += -df/ds in the tangent slots of the rubbing nodes."""
-        add_tangent_slot_stiffness(K, self.rate)
 
     def add_normal_force_tangent(self, K, model, coef, frames, normal, fixed, n_local) -> None:
         """K += the slipping force's dependence on its normal force (module docstring): coef,

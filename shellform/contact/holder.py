@@ -20,17 +20,35 @@ The squeeze left to spread is S = F - sum_i max(-R0_i, 0). ``spread`` says how:
 
 The holder *opens* when the flange pushes it up harder than F holds it down (S < 0). Open, it
 is still a rigid tool: a face lifted by `lift` above its closed position, with one unknown
-(the lift) and one equation (its nodal forces sum to F), solved with the sheet in each Newton
-iteration (semi_inverse.py). A node under it touches it, the die, or neither, and leaves the
+(the lift z_H) and one equation (its nodal forces sum to F), solved with the sheet in each
+Newton iteration as a bordered system, one more solve with the same factors:
+
+    dq = dq_a + dz_H dq_b,   dq_b the response to the holder's nodes lifted by 1,
+    dz_H = (F - sum p_i - sum (K dq_a)_i) / sum (K dq_b)_i   (sums over the holder's normal rows)
+
+F - sum p_i is the derivative of the energy with respect to the lift: it enters the residual's
+norm and the line search's energy slope. A node under it touches it, the die, or neither, and leaves the
 face it touches when its force turns tensile. With the "area" spread the lifted face conforms
 to the flange's thickness as the closed holder's pressure does (over each node it lies `lift`
 above the node's own top when the node is on the die); with "rigid" it is flat. The holder
 closes again when its lift falls to that closed position. With F = 0 there is no holder.
+
+The holder's faces hold the flange flat: under the closed holder the pinched nodes' w and
+slopes are known, under the open one the slopes of every node beneath it. The pinched set only
+grows within an increment (a node drawn out from under the holder leaves at the next one), so
+that a node at the holder's edge cannot switch from one pass to the next. The holder switches
+(opens or closes) at most `max_toggles` times per increment. Its state machine runs in the
+contact set's update (contact_set.py), whose tools its open face joins.
 """
 
 import numpy as np
+from dolfinx import fem
 from mpi4py import MPI
 
+from shellform.assembly.sheet_element import BS
+from shellform.contact.nodes import W_SLOPES
+from shellform.nonlinear.parts import Part
+from shellform.results.log import say
 from shellform.scene import SPREADS
 
 
@@ -47,17 +65,44 @@ def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:
     return float(Z[j])
 
 
-class PinchingHolder:
-    """The holder's force F on the owned nodes under it (plan position over the die's flat top).
+class PinchingHolder(Part):
+    """The holder (tool: a BlankHolder) with force F on the owned nodes under it (plan position
+    over the die's flat top): a part. area: tributary areas of the owned nodes; stiffness: their
+    E A / t (the "rigid" spread); nodes: the SheetNodes; friction: the CoulombFriction whose
+    slip forces depend on the lifted nodes' normal forces."""
 
-    area: tributary areas of the owned nodes; stiffness: their E A / t (the "rigid" spread).
-    """
-
-    def __init__(self, tool, force: float, area: np.ndarray, stiffness: np.ndarray, comm, spread: str = "area"):
+    def __init__(self, tool, force: float, nodes, stiffness: np.ndarray, comm, spread: str = "area",
+                 thickness: float = 0.0, max_toggles: int = 2, trace: bool = False):
         if spread not in SPREADS:
             raise ValueError(f"holder spread must be one of {SPREADS}, got {spread!r}")
         self.tool, self.force, self.comm, self.spread = tool, float(force), comm, spread
-        self.area, self.k = np.asarray(area, dtype=float), np.asarray(stiffness, dtype=float)
+        self.nodes, self.thickness, self.max_toggles, self.trace = nodes, thickness, max_toggles, trace
+        self.area, self.k = np.asarray(nodes.area, dtype=float), np.asarray(stiffness, dtype=float)
+        n = nodes.n_owned
+        self.closed, self.lift, self.toggles = False, 0.0, 0
+        self.pinched = np.zeros(n, dtype=bool)
+        self.pinched_n = self.pinched.copy()  # of the last converged increment
+        self.under_now = np.zeros(n, dtype=bool)  # under the holder in this increment (pinch)
+        self.face = np.zeros(n)  # the holder face's normal force on each node
+        self.contact = self.friction = None
+        self.driver = None
+        self._dlift, self._lift0 = 0.0, 0.0
+        self.committed = None
+
+    def bind(self, driver) -> None:
+        self.driver = driver
+        V = driver.model.V
+        self._unit, self._response = fem.Function(V), fem.Function(V)  # the unit lift and its response
+
+    def compose(self, contact, friction) -> None:
+        """The contact set whose die the holder pinches onto and whose tools its open face joins,
+        and the friction on its nodes."""
+        self.contact, self.friction = contact, friction
+
+    @property
+    def is_open(self) -> bool:
+        """The holder is open and presses (a tool with its own lift)."""
+        return not self.closed and self.force > 0
 
     def under(self, x: np.ndarray) -> np.ndarray:
         """Nodes whose plan position lies under the holder's face."""
@@ -70,7 +115,7 @@ class PinchingHolder:
         """S = F - sum over the pinched nodes of max(-R0, 0), all ranks (< 0: the holder lifts)."""
         return self.force - self._sum(np.maximum(-net[pinched], 0.0))
 
-    def faces(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray):
+    def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray):
         """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed
         holder, from their net normal forces R0 and their tops z + t/2 (the "rigid" spread)."""
         S = max(self.squeeze_left(pinched, net), 0.0)
@@ -89,12 +134,15 @@ class PinchingHolder:
         h = np.where(pinched, s + np.maximum(-net, 0.0), 0.0)
         return d, h
 
-    def face_gap(self, x: np.ndarray, half: np.ndarray, thickness: float, lift: float):
-        """Gap and normal of the lifted face to the nodes at x with half thicknesses `half`: the
-        flat face z_face + lift ("rigid"), or over each node z_face + lift + (2 half - t0), which
-        lies `lift` above the node's top when the node rests on the die ("area")."""
-        offset = half if self.spread == "rigid" else thickness - half
-        return self.tool.gap(x, offset, lift)
+    def face_gap(self, x: np.ndarray, half: np.ndarray):
+        """Gap and normal of the open holder's face to the nodes at x with half thicknesses
+        `half`: the flat face z_face + lift ("rigid"), or over each node z_face + lift + (2 half
+        - t0), which lies `lift` above the node's top when the node rests on the die ("area");
+        an infinite gap when the holder is closed or has no force."""
+        if not self.is_open:
+            return np.full(len(x), np.inf), np.tile([0.0, 0.0, -1.0], (len(x), 1))
+        offset = half if self.spread == "rigid" else self.thickness - half
+        return self.tool.gap(x, offset, self.lift)
 
     def lift_floor(self, tops: np.ndarray) -> float:
         """The closed position of the lift: 0 for the conforming face, the highest top (all
@@ -104,6 +152,188 @@ class PinchingHolder:
         top = self.comm.allreduce(float(np.max(tops, initial=-np.inf)), op=MPI.MAX)
         return max(top - self.tool.z_face, 0.0)
 
-    def total(self, h: np.ndarray) -> float:
-        """The holder's force on the sheet, all ranks."""
-        return self._sum(h)
+    def total(self, h: np.ndarray | None = None) -> float:
+        """The holder's force on the sheet, all ranks (its face forces, or `h`)."""
+        return self._sum(self.face if h is None else h)
+
+    # -- the pinch and the faces ---------------------------------------------------------------
+    def _tops(self, x):
+        return x[:, 2] + self.nodes.half_thickness
+
+    def pinch(self, under, contact, grow: bool) -> None:
+        """The pinched nodes: on the die, under the closed holder (mask `under`); with `grow`
+        the set only grows within the increment (module docstring). The nodes under the open
+        holder, whose slopes it holds flat, follow the same rule."""
+        on_die = contact.on(contact.die)
+        now = self.closed & under & on_die
+        self.pinched = (self.pinched | now) if grow else now
+        self.pinched &= self.closed & on_die
+        self.under_now = (self.under_now | under) if grow else under.copy()
+
+    def faces(self, x, net, contact) -> None:
+        """The face forces of the holder (and of the die under it) from the nodes' net normal
+        forces `net` (die minus holder on a pinched node), at positions x: the closed holder's
+        split; the open holder's face takes the force of the nodes on it."""
+        if self.closed:
+            d, self.face = self.split(self.pinched, net, self._tops(x))
+            contact.press(self.pinched, d[self.pinched])
+        else:
+            on = contact.on(contact.holder_tool)
+            self.face = np.where(on, np.maximum(net, 0.0), 0.0)
+            contact.press(on, 0.0)
+
+    def close_on(self, x, contact) -> None:
+        """At the start: the holder closes on the flange when it has a force."""
+        self.closed = self.force > 0
+        self.pinch(self.under(x), contact, grow=False)
+        self.faces(x, np.zeros(x.shape[0]), contact)
+        self.committed = self._copy()
+
+    def _copy(self):
+        return {"closed": self.closed, "lift": self.lift, "face": self.face.copy()}
+
+    def _lift_floor_over(self, x, under) -> float:
+        """The closed position of the lift over the nodes on the die under the holder."""
+        on_die = under & self.contact.on(self.contact.die)
+        return self.lift_floor(self._tops(x)[on_die])
+
+    def on_face(self):
+        """The owned nodes on the open holder's face, and their number on all ranks."""
+        on = self.contact.on(self.contact.holder_tool)
+        return on, self.comm.allreduce(int(on.sum()), op=MPI.SUM)
+
+    def settle(self, x, under, net, lam, contact) -> int:
+        """After a converged pass: open the holder if the flange lifts it (the squeeze left is
+        negative): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
+        the die, the face at its closed position. Close it once its lift is below that position
+        by more than the contact set's known tolerance (within a pass the lift may pass it),
+        unless that would spend its last switch of the increment; lower an open holder that
+        touches nothing onto the nearest node. Then its face forces. `net`, the nodes' net normal
+        forces, is updated where a node changes faces. Returns the changes (the same on all ranks)."""
+        changes = 0
+        if self.toggles < self.max_toggles and self.force > 0:
+            if self.closed and self.squeeze_left(self.pinched, net) < 0:
+                self.closed = False
+                self.lift = self.lift_floor(self._tops(x)[self.pinched])
+                held = self.pinched & (net < 0)
+                contact.assign(held, contact.holder_tool)
+                net[held] *= -1  # now the force of the face they lie on, along its normal
+                changes = 1
+            elif (not self.closed and self.toggles + 1 < self.max_toggles
+                  and self.lift < self._lift_floor_over(x, under) - contact.known_tolerance):
+                # the face presses into the flange on the die: closed (if it may still open
+                # again in this increment: closed with its switches spent, it could be left
+                # holding more than F)
+                self.closed = True
+                held = contact.on(contact.holder_tool)
+                contact.assign(held, contact.die)  # then pinched (the face is at the sheet)
+                net[held] *= -1  # die minus holder
+                changes = 1
+            elif not self.closed and self.on_face()[1] == 0:
+                gap = self.face_gap(x, self.nodes.half_thickness)[0]
+                nearest = self.comm.allreduce(float(gap[under].min(initial=np.inf)), op=MPI.MIN)
+                if np.isfinite(nearest) and self.lift - nearest <= self._lift_floor_over(x, under):
+                    self.closed = True  # down to the sheet on the die: closed
+                    changes = 1
+                elif np.isfinite(nearest):
+                    self.lift -= nearest  # the face comes down onto the nearest node
+                    free = contact.on(-1)
+                    contact.assign(under & (gap <= nearest + contact.controls.penetration) & free,
+                                   contact.holder_tool)
+                    changes = 1
+            self.toggles += changes
+            if self.trace and changes:
+                say(f"    holder: {'closed' if self.closed else 'open'}, lift {self.lift:.3e} mm, "
+                    f"{self.on_face()[1]} nodes on its face")
+        self.pinch(under, contact, grow=True)
+        self.faces(x, net, contact)
+        return changes
+
+    # -- the part's protocol -------------------------------------------------------------------
+    def start(self, lam: float, predicting: bool) -> None:
+        c = self.committed
+        self.closed, self.lift, self.face = c["closed"], c["lift"], c["face"].copy()
+        self.toggles = 0
+        self.pinch(self.under(self.nodes.x_n), self.contact, grow=False)
+
+    def constrain(self, c, lam: float) -> None:
+        """The holder's flat faces hold the flange flat: the slopes of w are known on the
+        pinched nodes, and on every node under the open holder (on a face or between them);
+        they stay known (and the pinched nodes' w) within the increment."""
+        flat = self.pinched.copy()
+        if self.is_open:
+            flat |= self.under_now
+        c.known[flat, W_SLOPES] = -self.nodes.slopes()[flat]
+        c.flags[flat, W_SLOPES] = True
+        c.stable[flat, W_SLOPES] = True
+        c.stable[self.pinched, 2] = True
+
+    def imbalance(self) -> float:
+        """F - sum p_i over the open holder's nodes (all ranks), 0 when it has none: the
+        derivative of the energy with respect to its lift."""
+        if not self.is_open:
+            return 0.0
+        on, count = self.on_face()
+        if count == 0:
+            return 0.0
+        return self.force - self._sum(self.contact.net_normal_forces()[on])
+
+    def border(self, driver) -> float:
+        """The open holder's lift in this Newton iteration, solved with the sheet (module
+        docstring): dq (frame coordinates, from the solve) becomes dq_a + dz_H dq_b."""
+        self._lift0, self._dlift = self.lift, 0.0
+        if not self.is_open:
+            return 0.0
+        on, count = self.on_face()
+        if count == 0:
+            return 0.0
+        n = self.nodes.n_owned
+        rows = BS * np.flatnonzero(on) + 2  # their normal rows (the frame's normal points down)
+        unit = self._unit.x.array
+        unit[:] = 0.0
+        unit[rows] = -1.0  # the face up by 1: each node 1 up, -1 along its normal
+        self._unit.x.scatter_forward()
+        extra = None
+        if self.friction is not None and self.friction.slip_rows is not None:  # dp/dq on these known columns
+            coef, g = self.friction.slip_rows
+            Ku = driver.apply_tangent(unit)[: n * BS].reshape(-1, BS)[:, 2]
+            extra = np.zeros(n * BS)
+            extra.reshape(-1, BS)[:, :2] = (coef * Ku)[:, None] * g
+        if not driver.solve_lifted(unit, self._response, extra):
+            return np.nan
+        dqa, dqb = driver.dq.x.array, self._response.x.array
+        change = self.comm.allreduce(np.array([driver.apply_tangent(dqa)[rows].sum(),
+                                               driver.apply_tangent(dqb)[rows].sum()]), op=MPI.SUM)
+        dz = (self.imbalance() - change[0]) / change[1]
+        dqa += dz * dqb
+        driver.dq.x.scatter_forward()
+        self._dlift = float(dz)
+        return self._dlift
+
+    def slope(self) -> float:
+        """The lift's share of the energy slope: dz_H (F - sum p)."""
+        return self._dlift * self.imbalance()
+
+    def move(self, alpha: float) -> None:
+        self.lift = self._lift0 + alpha * self._dlift
+
+    def commit(self, lam: float) -> None:
+        self.toggles = 0
+        self.committed = self._copy()
+        self.pinched_n = self.pinched.copy()
+
+    def checkpoint(self) -> dict:
+        c = self.committed
+        return {"nodes": {"contact_holder_face": c["face"], "contact_pinched": self.pinched_n},
+                "global": {"contact_closed": np.array(c["closed"]), "contact_lift": np.array(c["lift"])}}
+
+    def restore(self, state: dict, lam_scale: float) -> None:
+        nodes, glob = state["nodes"], state["global"]
+        self.committed = {"closed": bool(glob["contact_closed"]), "lift": float(glob["contact_lift"]),
+                          "face": nodes["contact_holder_face"].copy()}
+        self.closed, self.lift, self.face = self.committed["closed"], self.committed["lift"], self.committed["face"].copy()
+        self.pinched = nodes["contact_pinched"].copy()
+        self.pinched_n = self.pinched.copy()
+
+    def report(self) -> dict:
+        return {"holder_closed": bool(self.closed), "holder_lift": float(self.lift)}

@@ -61,9 +61,9 @@ class DrawingProblem:
         the nodes the closed holder pinches (their net force, die minus holder, and the
         friction of both faces); the open holder's are its own (HOLDER)."""
         d = self.driver
-        on = d.state.tool == tool
+        on = d.contact.on(tool)
         r = d.reactions()[on]
-        r = np.where(d.sym_fixed[on], 0.0, r)  # the symmetry planes' reactions are not the tool's
+        r = np.where(d.nodes.held[on, :3], 0.0, r)  # the symmetry planes' reactions are not the tool's
         F = d.frames[: d.n_owned][on]
         f = np.einsum("nji,nj->ni", F, r) + d.friction.force[on]
         total = d.model.mesh.comm.allreduce(f.sum(axis=0), op=MPI.SUM)
@@ -81,33 +81,33 @@ class DrawingProblem:
         d = self.driver
         if d.holder is None:
             return 0.0
-        if not d.state.closed[0] and d.holder.force > 0:
+        if d.holder.is_open:
             return -float(self.tool_force(HOLDER)[2])
-        return self.symmetry * d.holder.total(d.state.holder_face)
+        return self.symmetry * d.holder.total()
 
     def holder_share(self) -> float:
         """The largest force one node takes from the holder, as a fraction of the holder's force."""
         d = self.driver
         if d.holder is None or d.holder.force <= 0:
             return 0.0
-        return d.model.mesh.comm.allreduce(float(d.state.holder_face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
+        return d.model.mesh.comm.allreduce(float(d.holder.face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
 
     def holder_held_down(self) -> float:
         """The part of the closed holder's force that holds pinched nodes down against the sheet's
         own lift (their sum of max(-R0, 0), R0 the net normal force), as a fraction of F; the
         holder opens when it passes 1. 0 when the holder is open."""
         d = self.driver
-        if d.holder is None or d.holder.force <= 0 or not d.state.closed[0]:
+        if d.holder is None or d.holder.force <= 0 or not d.holder.closed:
             return 0.0
-        return 1.0 - d.holder.squeeze_left(d.pinched, d.net_normal_forces()) / d.holder.force
+        return 1.0 - d.holder.squeeze_left(d.holder.pinched, d.net_normal_forces()) / d.holder.force
 
     def holder_largest_at(self) -> tuple[float, float]:
         """Initial (x, y) of the node with the largest holder force (mm), all ranks."""
         d = self.driver
         comm = d.model.mesh.comm
-        h = d.state.holder_face
+        h = d.holder.face if d.holder is not None else np.zeros(0)
         i = int(np.argmax(h)) if h.size else -1
-        mine = (float(h[i]), tuple(d.X[i, :2])) if i >= 0 else (-1.0, (np.nan, np.nan))
+        mine = (float(h[i]), tuple(d.nodes.X[i, :2])) if i >= 0 else (-1.0, (np.nan, np.nan))
         _, xy = max(comm.allgather(mine), key=lambda c: c[0])
         return float(xy[0]), float(xy[1])
 
@@ -118,13 +118,13 @@ class DrawingProblem:
             return float("nan")
         x = d.positions()
         under = d.holder.under(x)
-        top = float((x[under, 2] + d.half_thickness[under]).max(initial=-np.inf))
+        top = float((x[under, 2] + d.nodes.half_thickness[under]).max(initial=-np.inf))
         return d.model.mesh.comm.allreduce(top, op=MPI.MAX)
 
     def holder_lift(self) -> float:
         """The open holder's lift above its closed position (mm; 0 when closed)."""
         d = self.driver
-        return 0.0 if d.holder is None or d.state.closed[0] else float(d.state.lift[0])
+        return 0.0 if d.holder is None or d.holder.closed else float(d.holder.lift)
 
     def force_balance(self) -> float:
         """|sum of the tools' and the drawbeads' z-forces on the sheet| / punch force: the
@@ -146,7 +146,7 @@ class DrawingProblem:
         d = self.driver
         x = d.positions()
         worst = 0.0
-        for gap, _ in d.gaps(x, d.lam):
+        for gap, _ in d.contact.gaps(x, d.lam):
             worst = max(worst, float(-gap.min(initial=0.0)))
         return d.model.mesh.comm.allreduce(worst, op=MPI.MAX)
 
@@ -165,8 +165,8 @@ class DrawingProblem:
     def nodal_values(self):
         """Owned nodes: initial (x, y), current position, thickness strain."""
         d = self.driver
-        e33 = np.log(2 * d.half_thickness / self.model.thickness)
-        return d.X[: d.n_owned, :2], d.positions(), e33
+        e33 = np.log(2 * d.nodes.half_thickness / self.model.thickness)
+        return d.nodes.X[: d.n_owned, :2], d.positions(), e33
 
     def in_contact(self) -> dict:
         """Nodes on the punch, on the die (of which pinched by the holder), on the open holder's
@@ -180,7 +180,7 @@ class DrawingProblem:
     def free_under_holder(self) -> int:
         """Nodes under the closed holder that are not pinched (all ranks; 0 when it is open)."""
         d = self.driver
-        if d.holder is None or not d.state.closed[0]:
+        if d.holder is None or not d.holder.closed:
             return 0
-        loose = d.holder.under(d.positions()) & ~d.pinched
+        loose = d.holder.under(d.positions()) & ~d.holder.pinched
         return d.model.mesh.comm.allreduce(int(loose.sum()), op=MPI.SUM)

@@ -49,10 +49,10 @@ def release(contact_driver, controls: Controls | None = None, verbose=False) -> 
     cd = contact_driver
     model, V = cd.model, cd.model.V
     n_owned = cd.n_owned
-    X = cd.X
+    X = cd.nodes.X
     centre = np.flatnonzero(np.hypot(X[:n_owned, 0], X[:n_owned, 1]) < 1e-9 * max(np.abs(X[:, :2]).max(), 1.0))
     held = fem.dirichletbc(np.float64(0), (BS * centre + W).astype(np.int32), V.sub(W))
-    sb = SpringbackDriver(model, list(cd.symmetry_bcs) + [held], controls=controls or Controls(
+    sb = SpringbackDriver(model, list(cd.support_bcs) + [held], controls=controls or Controls(
         initial_step=0.25, max_step=0.5, min_step=1e-3), verbose=verbose)
     sb.q.x.array[:] = cd.q.x.array
     sb.held = sb.q.x.array.copy()

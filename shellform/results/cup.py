@@ -221,7 +221,7 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
     from shellform.results.tables import write_csv
 
     lines = SPRINGBACK_LINES
-    after = profiles(released, p.driver.X)
+    after = profiles(released, p.driver.nodes.X)
     depth = float(-before["transverse"][:, 2].min())
     rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
              "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]

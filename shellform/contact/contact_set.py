@@ -1,0 +1,319 @@
+"""The contact set: which node lies on which rigid tool (model.md section 4, eqs. 24-29).
+
+A node on a tool is seen in the tool's normal frame (frames.py); its normal displacement is
+*known* (it follows the tool: the correction -gap closes the gap at the current iterate), its
+normal contact force R0 is *unknown*, the residual of that known row (the paper's split):
+
+    K11 dq1 = dp1 - K12 dq*      (27)  free increments, the known ones lifted to the right
+    dp*     = K21 dq1 + K22 dq*  (28)  contact forces: the residual on the known rows
+
+The tools are given in contact order (punch, die); tool k moves by lambda travel[k] along z.
+The open holder's face is one more tool (holder.py), the last. Each tool gives its gap,
+normal and shape operator H = dn/dx (tools.py). A node moving along a curved tool turns its
+frame; its tangential rows t_a . R, with R ~ R0 n, then change by R0 n . dt_a = -R0 W_ab dx_b,
+W_ab = t_a . H t_b, so the tangent gets K_ab += -R0 W_ab (softening on a convex nose,
+stiffening in a concave shoulder).
+
+The set is settled between Newton passes (``update``): nodes that penetrate a tool by more than
+`penetration` join it, nodes (not pinched) whose normal force turned tensile leave it, nodes
+drawn under the closed holder join the die; a node may switch at most `max_toggles` times per
+increment (no chattering). A pass may end before it converges where the set will change anyway,
+once Newton's steps are below `early_step` penetrations (a step that long judges the set on an
+iterate still moving; after such passes fail, they end only near convergence, early_step 1).
+Newton's steps are bounded by `trust` thicknesses of nodal move (largest_move).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+
+from shellform.assembly.sheet_element import BS
+from shellform.contact.frames import nodal_frames
+from shellform.nonlinear.parts import Change, Part
+from shellform.results.log import say
+
+FREE = -1
+
+
+@dataclass
+class ContactControls:
+    penetration: float  # a free node may penetrate a tool by at most this much (length)
+    max_toggles: int = 2  # switches of one node (or of the holder) per increment before it is frozen
+    friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
+    trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
+    holder_spread: str = "area"  # "area" or "rigid" (holder.py)
+    trace: bool = False  # log every pass, step and iterate (the largest residuals) and each node that switches
+
+
+class ContactSet(Part):
+    """The nodes on the tools: per owned node its tool (or FREE), its tool face's normal force
+    and its switches in this increment; the die index, where the closed holder pinches."""
+
+    EARLY_STEP = 10.0  # a pass ends once the set will change and the steps are below this many penetrations
+
+    def __init__(self, nodes, tools, travel, controls: ContactControls, thickness: float, die=None, holder=None):
+        self.nodes, self.tools, self.travel = nodes, list(tools), np.asarray(travel, dtype=float)
+        self.controls, self.thickness = controls, thickness
+        self.die = len(self.tools) - 1 if die is None else int(die)
+        self.holder = holder
+        self.holder_tool = len(self.tools)  # the open holder's index
+        n = nodes.n_owned
+        self.tool = np.full(n, FREE, dtype=np.int8)
+        self.pressure = np.zeros(n)  # the tool face's normal force (the die's on a pinched node)
+        self.toggles = np.zeros(n, dtype=np.int32)
+        self.known_tolerance = 1e-3 * controls.penetration  # |known corrections| at convergence
+        self.early_step = self.EARLY_STEP
+        self.lam_n = self.lam = 0.0
+        self.curvature = np.zeros((n, 2, 2))  # W of each node's tool in its tangent slots
+        self.shift = np.zeros(n)  # z-travel of each node's tool in this increment
+        self.slid_off = np.zeros(n, dtype=bool)  # nodes that slid off their tool's extent (this iterate)
+        self.switched = np.zeros(n, dtype=bool)  # nodes that switched in the last update
+        self.net = np.zeros(n)  # the net normal forces of the last refresh
+        self.frozen = 0
+        self._step = np.inf
+        self.residual = None  # the driver's residual with its reactions (bind)
+        self.comm = None
+        self.committed = None
+
+    def bind(self, driver) -> None:
+        self.residual = lambda: driver.residual_full
+        self.comm = driver.model.mesh.comm
+        self._initial_set()
+
+    # -- geometry ------------------------------------------------------------------------------
+    def gaps(self, x, lam):
+        """Gap and normal of every owned node to every tool at load factor lam, the open holder
+        last (an infinite gap when it is closed or has no force)."""
+        h = self.nodes.half_thickness
+        gaps = [tool.gap(x, h, lam * dz) for tool, dz in zip(self.tools, self.travel)]
+        if self.holder is not None:
+            gaps.append(self.holder.face_gap(x, h))
+        return gaps
+
+    def on(self, k: int) -> np.ndarray:
+        """The owned nodes on tool k (the open holder: holder_tool)."""
+        return self.tool == k
+
+    def on_tools(self) -> np.ndarray:
+        return self.tool != FREE
+
+    def assign(self, nodes: np.ndarray, k: int) -> None:
+        """Put `nodes` (a mask or indices) on tool k (FREE: off every tool)."""
+        self.tool[nodes] = k
+
+    def _initial_set(self):
+        """Nodes touching a tool at the start (gap within the penetration tolerance); the holder
+        closes on the flange when it has a force."""
+        x = self.nodes.positions()
+        for k, (gap, _) in enumerate(self.gaps(x, 0.0)):
+            touch = (gap <= self.controls.penetration) & (self.tool == FREE)
+            self.tool[touch] = k
+        if self.holder is not None:
+            self.holder.close_on(x, self)
+        self.committed = self._copy()
+
+    def _copy(self):
+        return {"tool": self.tool.copy(), "pressure": self.pressure.copy()}
+
+    # -- forces ------------------------------------------------------------------------------
+    def net_normal_forces(self, R=None) -> np.ndarray:
+        """Each owned node's net normal force R0 from its tool (die minus holder on a pinched
+        node; 0 off the tools), from the residual R (nodal frames; default: the driver's last)."""
+        R = self.residual() if R is None else R
+        rows = R[: self.nodes.n_owned * BS].reshape(-1, BS)
+        return np.where(self.tool != FREE, rows[:, 2], 0.0)
+
+    def refresh(self, R) -> np.ndarray:
+        """The faces' normal forces from the reactions of this iterate (R: before friction):
+        the tool's face max(R0, 0), the holder's faces split from R0. Returns R0."""
+        net = self.net_normal_forces(R)
+        self.net = net
+        self.pressure = np.maximum(net, 0.0)
+        if self.holder is not None:
+            self.holder.faces(self._x, net, self)
+        return net
+
+    def press(self, nodes, values) -> None:
+        """Set the tool face's normal force of `nodes` (the holder's split on the die under it)."""
+        self.pressure[nodes] = values
+
+    def face_forces(self) -> np.ndarray:
+        """The sum of both faces' normal forces on each node (what friction presses with)."""
+        return self.pressure + (self.holder.face if self.holder is not None else 0.0)
+
+    def dp_dnet(self) -> np.ndarray:
+        """d(face forces)/dR0 per node: 1 on a tool, sign(R0) on a pinched node (the closed
+        holder's share of F through sum max(-R0, 0) left out), 0 off the tools."""
+        pinched = self.holder.pinched if self.holder is not None else np.zeros(self.tool.size, dtype=bool)
+        on = self.tool != FREE
+        return np.where(on, np.where(pinched, np.sign(self.net), (self.net > 0).astype(float)), 0.0)
+
+    # -- the part's protocol -------------------------------------------------------------------
+    def start(self, lam: float, predicting: bool) -> None:
+        c = self.committed
+        self.tool, self.pressure = c["tool"].copy(), c["pressure"].copy()
+        self.toggles = np.zeros_like(self.toggles)
+        self.lam = lam
+
+    def constrain(self, c, lam: float) -> None:
+        """Frames and known normal rows of the nodes on the tools, at the current iterate."""
+        x = self.nodes.positions()
+        self._x = x
+        gaps = self.gaps(x, lam)
+        self.curvature = np.zeros((x.shape[0], 2, 2))
+        self.shift = np.zeros(x.shape[0])
+        self.slid_off = np.zeros(x.shape[0], dtype=bool)
+        for k in range(len(gaps)):
+            off = (self.tool == k) & ~np.isfinite(gaps[k][0])  # slid off the tool's extent
+            self.tool[off], self.pressure[off] = FREE, 0.0
+            self.slid_off |= off
+            on = np.flatnonzero(self.tool == k)
+            if on.size == 0:
+                continue
+            gap, normal = gaps[k][0][on], gaps[k][1][on]
+            c.frames[on] = nodal_frames(normal)
+            c.known[on, 2] = -gap  # the normal correction that closes the gap
+            c.flags[on, 2] = True
+            if k == self.holder_tool:
+                continue  # flat, and still in plan
+            self.curvature[on] = self._shape_operator(k, x[on], c.frames[on], normal, lam)
+            self.shift[on] = (lam - self.lam_n) * self.travel[k]
+
+    def _shape_operator(self, k, x, F, n, lam):
+        h = 1e-4 * self.thickness
+        tool, dz = self.tools[k], lam * self.travel[k]
+        W = np.zeros((len(x), 2, 2))
+        for b in range(2):
+            W[:, :, b] = np.einsum("nij,nj->ni", F[:, :2], (tool.gap(x + h * F[:, b], 0.0, dz)[1] - n) / h)
+        return 0.5 * (W + W.transpose(0, 2, 1))
+
+    def add_tangent(self, K, R, fixed) -> None:
+        """K_ab += -R0 W_ab on the tangent slots of the nodes on curved tools (module
+        docstring; R0 the node's net normal force with every part's forces)."""
+        b = np.flatnonzero((self.tool != FREE) & (np.abs(self.curvature).max(axis=(1, 2)) > 0))
+        if b.size == 0:
+            return
+        net = R[: self.nodes.n_owned * BS].reshape(-1, BS)[:, 2]
+        held = self.nodes.held[b, :2]
+        blocks = -net[b, None, None] * self.curvature[b]
+        blocks[held[:, :, None] | held[:, None, :]] = 0.0
+        rows = (BS * b[:, None] + np.arange(2)).astype(np.int32)
+        K.setValuesLocalRCV(rows, rows, blocks.reshape(b.size, 4), addv=True)
+
+    def largest_move(self) -> float:
+        return self.controls.trust * self.thickness
+
+    def ends_pass(self, move: float, lam: float) -> bool:
+        """Once the steps are short (early_step penetrations), whether the set will change at the
+        end of this pass, seen from this iterate: a free node penetrating a tool, a node drawn
+        under the closed holder, or a node (not pinched) pulled off its tool by more than 1e-3
+        of the largest normal force."""
+        if move > self.early_step * self.controls.penetration:
+            return False
+        x = self.nodes.positions()
+        under = self._under(x)
+        join, release, _ = self._changes(x, lam, under, self.net_normal_forces(), tensile=1e-3)
+        return self.comm.allreduce(int(np.sum(join | release)), op=MPI.SUM) > 0
+
+    def retry(self) -> str | None:
+        """Where passes that end early failed: from now on they end only near convergence."""
+        if self.early_step <= 1.0:
+            return None
+        self.early_step, before = 1.0, self.early_step
+        return f"from now on the contact passes end only near convergence (early_step {before:g} -> 1)"
+
+    def easy_iterations(self, max_iterations: int) -> int:
+        return 2 * max_iterations // 3  # an increment of a few contact passes is still an easy one
+
+    def _under(self, x):
+        return self.holder.under(x) if self.holder is not None else np.zeros(x.shape[0], dtype=bool)
+
+    def _changes(self, x, lam, under, net, tensile: float):
+        """The nodes that join a tool (penetrating it by more than `penetration`, or drawn under
+        the closed holder: onto the die) and those that leave theirs (not pinched, pulled off by
+        more than `tensile` times the largest normal force), among the nodes that may still
+        switch in this increment; with the tool each joining node joins."""
+        on, can = self.tool != FREE, self.toggles < self.controls.max_toggles
+        scale = max(self.comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
+        pinched = self.holder.pinched if self.holder is not None else np.zeros_like(on)
+        release = on & ~pinched & (net < -tensile * scale) & can
+        depth = np.stack([g for g, _ in self.gaps(x, lam)])  # (tools, nodes)
+        deepest = np.argmin(depth, axis=0)
+        enters = under & ~on & (self.holder is not None and self.holder.closed)  # the closed holder pinches
+        deepest[enters] = self.die
+        allowed = np.full(len(x), self.controls.penetration)
+        if self.holder is not None and self.holder.is_open:  # between its faces: as tight as the pinch it opened
+            allowed[self.holder.under_now] = self.known_tolerance
+        join = ~on & ((depth.min(axis=0) < -allowed) | enters) & can
+        return join, release, deepest
+
+    def update(self, lam: float, changes: int) -> Change:
+        """After a converged pass: normal forces from the reactions, the holder's state and
+        faces (holder.py), release of tensile nodes (not pinched), join of penetrating ones.
+        Counts the switches back (a node's second switch, or the holder's): a pass whose changes
+        are all first switches moves the contact front on (a sheet peeling off the punch's face
+        releases one row of nodes per pass) and is not counted against the driver's passes."""
+        x = self.nodes.positions()
+        net = self.net_normal_forces()
+        self.pressure = np.maximum(net, 0.0)
+        under = self._under(x)
+        holder_changes = 0
+        if self.holder is not None:
+            self.holder.pinch(under, self, grow=True)
+            holder_changes = self.holder.settle(x, under, net, lam, self)
+        join, release, deepest = self._changes(x, lam, under, net, tensile=1e-8)
+        if self.controls.trace:
+            X = self.nodes.X
+            for i in np.flatnonzero(release | join):
+                say(f"      node {i} at {X[i, :2].round(2)} -> {x[i].round(3)}: "
+                    + (f"leaves tool {self.tool[i]} (net normal force {net[i]:.3g} N)" if release[i] else
+                       f"joins tool {deepest[i]}") + f", switch {self.toggles[i] + 1}")
+        self.tool[release] = FREE
+        self.tool[join] = deepest[join]
+        if self.holder is not None:
+            self.holder.pinch(under, self, grow=True)  # the nodes drawn under the closed holder
+        switched = release | join
+        self.switched = switched
+        self.pressure[switched] = 0.0
+        self.toggles[switched] += 1
+        self.frozen = int((self.toggles >= self.controls.max_toggles).sum())
+        count, back = self.comm.allreduce(
+            np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum())]),
+            op=MPI.SUM)
+        return Change(int(count), int(back), True, f"{int(count)} set changes")
+
+    def commit(self, lam: float) -> None:
+        self.toggles[:] = 0
+        self.committed = self._copy()
+        self.lam_n = lam
+
+    def checkpoint(self) -> dict:
+        c = self.committed
+        return {"nodes": {"contact_tool": c["tool"], "contact_pressure": c["pressure"]},
+                "global": {"contact_lam_n": np.array(self.lam_n), "contact_travel": self.travel,
+                           "contact_early_step": np.array(self.early_step)}}
+
+    def restore(self, state: dict, lam_scale: float) -> None:
+        nodes, glob = state["nodes"], state["global"]
+        if nodes["contact_tool"].shape != self.tool.shape:
+            from shellform.errors import InputError
+
+            raise InputError("resume", "the checkpoint's contact state does not fit this model")
+        self.committed = {"tool": nodes["contact_tool"].astype(np.int8).copy(),
+                          "pressure": nodes["contact_pressure"].copy()}
+        self.tool, self.pressure = self.committed["tool"].copy(), self.committed["pressure"].copy()
+        self.lam_n = float(glob["contact_lam_n"]) * lam_scale
+        if "contact_early_step" in glob:
+            self.early_step = float(glob["contact_early_step"])
+
+    def count(self) -> dict:
+        """Nodes on each tool (the open holder last) and pinched by the holder, all ranks."""
+        counts = {f"tool{k}": self.comm.allreduce(int((self.tool == k).sum()), op=MPI.SUM)
+                  for k in range(len(self.tools) + (self.holder is not None))}
+        pinched = self.holder.pinched if self.holder is not None else np.zeros(0, dtype=bool)
+        counts["pinched"] = self.comm.allreduce(int(pinched.sum()), op=MPI.SUM)
+        return counts
+
+    def report(self) -> dict:
+        return {"frozen": self.frozen, "in_contact": self.count()}

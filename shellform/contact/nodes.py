@@ -1,0 +1,80 @@
+"""The blank seen from its nodes, as the contact parts need it.
+
+Reference positions X, the current positions x = X + (u, v, w) of the carrier, the positions
+x_n at the start of the increment (slip is measured from them), each node's tributary area
+A_i (a third of each cell around it) and half thickness h_i = t/2 exp(e33_i) (e33 the
+area-weighted thickness strain of the cells around it, updated with every converged increment:
+the sheet's surface is h_i from its mid-surface), and the carrier slots a symmetry plane holds.
+A part of its own: it commits and checkpoints x_n and h_i.
+"""
+
+import numpy as np
+from dolfinx import fem, la
+
+from shellform.assembly.sheet_element import BS, COMPONENTS
+from shellform.nonlinear.parts import Part
+
+
+W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
+
+
+class SheetNodes(Part):
+    def __init__(self, model, bcs):
+        self.model = model
+        V = model.V
+        imap = V.dofmap.index_map
+        self.n_owned, self.n_local = imap.size_local, imap.size_local + imap.num_ghosts
+        self.X = V.tabulate_dof_coordinates()[: self.n_local].copy()
+        held = np.zeros(self.n_local * BS, dtype=bool)
+        for bc in bcs:
+            held[bc.dof_indices()[0]] = True
+        self.held = held.reshape(-1, BS)[: self.n_owned]  # carrier slots fixed by symmetry
+        self.area, e33 = self._areas_and_thickness_strain()
+        self.half_thickness = 0.5 * model.thickness * np.exp(e33)
+        self.q = None
+        self.x_n = self.X[: self.n_owned].copy()
+
+    def bind(self, driver) -> None:
+        self.q = driver.q
+
+    def positions(self) -> np.ndarray:
+        """Current positions of the owned nodes."""
+        d = self.q.x.array.reshape(-1, BS)[: self.n_owned, :3]
+        return self.X[: self.n_owned] + d
+
+    def local_positions(self) -> np.ndarray:
+        """Current positions of the owned and ghost nodes."""
+        return self.X + self.q.x.array.reshape(-1, BS)[: self.n_local, :3]
+
+    def slopes(self) -> np.ndarray:
+        """(n_owned, 2) the slopes (w_x, w_y) of the owned nodes."""
+        return self.q.x.array.reshape(-1, BS)[: self.n_owned, W_SLOPES]
+
+    def _areas_and_thickness_strain(self):
+        """Tributary areas (a third of each cell) and their area-weighted thickness strain."""
+        m = self.model
+        x = m.cell_coords.reshape(-1, 3, 3)
+        a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
+        cell_area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+        e33 = m.thickness_strain() if m.plastic else np.zeros(m.num_cells)
+        f = fem.Function(m.V)
+        arr = f.x.array.reshape(-1, BS)
+        for col, values in ((0, cell_area / 3), (1, cell_area / 3 * e33)):
+            np.add.at(arr[:, col], m.dofs.ravel(), np.repeat(values, 3))
+        f.x.scatter_reverse(la.InsertMode.add)
+        f.x.scatter_forward()
+        area = arr[: self.n_owned, 0].copy()
+        return area, arr[: self.n_owned, 1] / area
+
+    def commit(self, lam: float) -> None:
+        self.x_n = self.positions()
+        if self.model.plastic:
+            _, e33 = self._areas_and_thickness_strain()
+            self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
+
+    def checkpoint(self) -> dict:
+        return {"nodes": {"contact_x_n": self.x_n, "contact_half_thickness": self.half_thickness}}
+
+    def restore(self, state: dict, lam_scale: float) -> None:
+        self.x_n = state["nodes"]["contact_x_n"].copy()
+        self.half_thickness = state["nodes"]["contact_half_thickness"].copy()
