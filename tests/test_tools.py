@@ -251,3 +251,73 @@ def test_no_nan_deep_inside_or_at_the_core():
     np.testing.assert_array_equal(n, [[0, 0, -1], [0, 0, -1]])
     _, n = DIE.gap(x[3:5])  # the opening's centre deep down (no plan gradient), inside the core
     np.testing.assert_array_equal(n, [[0, 0, 1], [0, 0, 1]])
+
+
+# -- the shape operator H = dn/dx, the Hessian of the signed distance ------------------------
+EPS, MARGIN = 1e-5, 0.05  # central differences' step; least distance of a point to a region's edge
+
+
+def finite_difference_shape(tool, x, eps=EPS):
+    """Central differences of gap's normals: column k is dn/dx_k."""
+    H = np.empty((len(x), 3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = eps
+        H[:, :, k] = (tool.gap(x + e)[1] - tool.gap(x - e)[1]) / (2 * eps)
+    return H
+
+
+def plan_parts(x, a, rc):
+    """sdf of the rounded square (a, rc) and its q = |x| - (a - rc), |y| - (a - rc)."""
+    s, _, _ = rounded_square_sdf(x[:, 0], x[:, 1], a, rc)
+    return s, np.abs(x[:, 0]) - (a - rc), np.abs(x[:, 1]) - (a - rc)
+
+
+def straight(qx, qy, m=MARGIN):
+    """Beside a straight side of the plan, or inside the inner square, off its diagonals' kinks."""
+    return ((qx > m) & (qy < -m)) | ((qy > m) & (qx < -m)) | ((qx < -m) & (qy < -m) & (np.abs(qx - qy) > m))
+
+
+def punch_regions(x, m=MARGIN):
+    rp = PUNCH.profile_radius
+    s, qx, qy = plan_parts(x, PUNCH.half_width - rp, PUNCH.corner_radius - rp)
+    h = PUNCH.z_face + rp - x[:, 2]
+    corner = (qx > m) & (qy > m)
+    far = np.hypot(np.maximum(s, 0), np.maximum(h, 0)) > 0.2  # the core distance: FD error ~ eps^2 / D^2
+    return {"face": (s < -m) & (h > m), "nose straight": (s > m) & (h > m) & straight(qx, qy) & far,
+            "nose corner": (s > m) & (h > m) & corner & far, "wall straight": (s > m) & (h < -m) & straight(qx, qy),
+            "wall corner": (s > m) & (h < -m) & corner}
+
+
+def die_regions(x, m=MARGIN):
+    rd = DIE.profile_radius
+    s, qx, qy = plan_parts(x, DIE.half_width + rd, DIE.corner_radius + rd)
+    h = x[:, 2] - (DIE.z_top - rd)
+    corner = (qx > m) & (qy > m) & (np.hypot(qx, qy) > 0.5)  # off the arcs' centres (the medial axis)
+    side, inner = straight(qx, qy) & ((qx > m) | (qy > m)), straight(qx, qy) & (qx < -m) & (qy < -m)
+    far = np.hypot(np.minimum(s, 0), np.maximum(h, 0)) > 0.2
+    return {"top": s > m, "shoulder straight": (s < -m) & (h > m) & straight(qx, qy) & far,
+            "shoulder corner": (s < -m) & (h > m) & corner & far, "wall straight": (s < -m) & (h < -m) & side,
+            "wall corner": (s < -m) & (h < -m) & corner, "opening": (h < -m) & inner}  # deeper than a corner radius
+
+
+REGIONS = [("punch", r) for r in punch_regions(np.zeros((1, 3)))] + [("die", r) for r in die_regions(np.zeros((1, 3)))]
+
+
+@pytest.mark.parametrize("name,region", REGIONS)
+def test_shape_is_the_derivative_of_the_normal(name, region):
+    tool, _, (lo, hi) = CASES[name]
+    x = near(np.array(lo) - [hi[0], hi[1], 0], hi, 40000)  # all four quadrants
+    x = x[(punch_regions if tool is PUNCH else die_regions)(x)[region]][:400]
+    assert len(x) >= 200
+    H = tool.shape(x, offset=0.3)
+    fd = finite_difference_shape(tool, x)
+    if region in ("face", "top", "wall straight", "opening"):  # flat: the normal is constant, to the bit
+        assert np.array_equal(fd, np.zeros_like(fd)) and np.array_equal(H, fd)
+    else:  # to 1e-6 of each point's largest entry
+        scale = np.abs(fd).max(axis=(1, 2), keepdims=True)
+        assert scale.min() > 0.01
+        assert (np.abs(H - fd) / scale).max() < 1e-6
+    np.testing.assert_array_equal(H, H.transpose(0, 2, 1))
+    _, n = tool.gap(x)
+    assert np.abs(np.einsum("nij,nj->ni", H, n)).max() < 1e-14 * max(1.0, np.abs(H).max())
