@@ -1,5 +1,6 @@
 """The analytic tools of the square cup: signed distances against a sampled surface, normals
-against finite differences, symmetry to the bit, and the faces, walls and offsets exactly."""
+against finite differences, symmetry to the bit, the faces, walls and offsets exactly, and the
+shape operator (the Hessian of the signed distance) against central differences and closed forms."""
 
 import numpy as np
 import pytest
