@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from shellform.contact.tools import BlankHolder, Die, Punch, rounded_square_sdf, square_cup_tools
+from shellform.contact.tools import (BlankHolder, Die, Punch, rounded_square_hessian, rounded_square_sdf,
+                                     square_cup_tools)
 from shellform.scene import ToolsSpec
 
 H = 0.04  # sampling spacing of the brute-force surfaces (mm)
@@ -167,6 +168,18 @@ def test_rounded_square_sdf():
     np.testing.assert_allclose(sy, [0.0, 0.0, np.sin(0.3), 1.0, -1.0, 0.0, 1.0], atol=1e-15)
     s0, _, _ = rounded_square_sdf(np.array([5.0, 5.0]), np.array([5.0, 0.0]), a, 0.0)  # sharp corner
     np.testing.assert_array_equal(s0, [0.0, 0.0])
+
+
+def test_rounded_square_hessian():
+    """tau tau^T / r on the corner arcs' sectors (r from the arc's centre), 0 on the sides and inside."""
+    a, rc, th = 5.0, 2.0, 0.3
+    x = np.array([3.0 + 3 * np.cos(th), -(3.0 + 0.5 * np.cos(th)), 6.0, 1.0, 0.0])
+    y = np.array([3.0 + 3 * np.sin(th), 3.0 + 0.5 * np.sin(th), 1.0, 4.5, 0.0])
+    H = rounded_square_hessian(x, y, a, rc)
+    tau = np.array([[-np.sin(th), np.cos(th), 0.0], [-np.sin(th), -np.cos(th), 0.0]])
+    np.testing.assert_allclose(H[0], np.outer(tau[0], tau[0]) / 3.0, atol=1e-15)
+    np.testing.assert_allclose(H[1], np.outer(tau[1], tau[1]) / 0.5, atol=1e-14)  # inside the arc, x < 0
+    np.testing.assert_array_equal(H[2:], np.zeros((3, 3, 3)))
 
 
 def test_flat_faces_have_exact_normals():
