@@ -1,11 +1,13 @@
 """The analytic tools of the square cup: signed distances against a sampled surface, normals
-against finite differences, symmetry to the bit, and the faces, walls and offsets exactly."""
+against finite differences, symmetry to the bit, the faces, walls and offsets exactly, and the
+shape operator (the Hessian of the signed distance) against central differences and closed forms."""
 
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from shellform.contact.tools import BlankHolder, Die, Punch, rounded_square_sdf, square_cup_tools
+from shellform.contact.tools import (BlankHolder, Die, Punch, rounded_square_hessian, rounded_square_sdf,
+                                     square_cup_tools)
 from shellform.scene import ToolsSpec
 
 H = 0.04  # sampling spacing of the brute-force surfaces (mm)
@@ -168,6 +170,18 @@ def test_rounded_square_sdf():
     np.testing.assert_array_equal(s0, [0.0, 0.0])
 
 
+def test_rounded_square_hessian():
+    """tau tau^T / r on the corner arcs' sectors (r from the arc's centre), 0 on the sides and inside."""
+    a, rc, th = 5.0, 2.0, 0.3
+    x = np.array([3.0 + 3 * np.cos(th), -(3.0 + 0.5 * np.cos(th)), 6.0, 1.0, 0.0])
+    y = np.array([3.0 + 3 * np.sin(th), 3.0 + 0.5 * np.sin(th), 1.0, 4.5, 0.0])
+    H = rounded_square_hessian(x, y, a, rc)
+    tau = np.array([[-np.sin(th), np.cos(th), 0.0], [-np.sin(th), -np.cos(th), 0.0]])
+    np.testing.assert_allclose(H[0], np.outer(tau[0], tau[0]) / 3.0, atol=1e-15)
+    np.testing.assert_allclose(H[1], np.outer(tau[1], tau[1]) / 0.5, atol=1e-14)  # inside the arc, x < 0
+    np.testing.assert_array_equal(H[2:], np.zeros((3, 3, 3)))
+
+
 def test_flat_faces_have_exact_normals():
     x = near([-6, -6, -1.5], [6, 6, 0.29], 500)  # under the punch's flat face (plan core 8 - 2)
     _, n = PUNCH.gap(x)
@@ -251,3 +265,177 @@ def test_no_nan_deep_inside_or_at_the_core():
     np.testing.assert_array_equal(n, [[0, 0, -1], [0, 0, -1]])
     _, n = DIE.gap(x[3:5])  # the opening's centre deep down (no plan gradient), inside the core
     np.testing.assert_array_equal(n, [[0, 0, 1], [0, 0, 1]])
+
+
+# -- the shape operator H = dn/dx, the Hessian of the signed distance ------------------------
+EPS, MARGIN = 1e-5, 0.05  # central differences' step; least distance of a point to a region's edge
+
+
+def finite_difference_shape(tool, x, eps=EPS):
+    """Central differences of gap's normals: column k is dn/dx_k."""
+    H = np.empty((len(x), 3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = eps
+        H[:, :, k] = (tool.gap(x + e)[1] - tool.gap(x - e)[1]) / (2 * eps)
+    return H
+
+
+def plan_parts(x, a, rc):
+    """sdf of the rounded square (a, rc) and its q = |x| - (a - rc), |y| - (a - rc)."""
+    s, _, _ = rounded_square_sdf(x[:, 0], x[:, 1], a, rc)
+    return s, np.abs(x[:, 0]) - (a - rc), np.abs(x[:, 1]) - (a - rc)
+
+
+def straight(qx, qy, m=MARGIN):
+    """Beside a straight side of the plan, or inside the inner square, off its diagonals' kinks."""
+    return ((qx > m) & (qy < -m)) | ((qy > m) & (qx < -m)) | ((qx < -m) & (qy < -m) & (np.abs(qx - qy) > m))
+
+
+def punch_regions(x, m=MARGIN):
+    rp = PUNCH.profile_radius
+    s, qx, qy = plan_parts(x, PUNCH.half_width - rp, PUNCH.corner_radius - rp)
+    h = PUNCH.z_face + rp - x[:, 2]
+    corner = (qx > m) & (qy > m)
+    far = np.hypot(np.maximum(s, 0), np.maximum(h, 0)) > 0.2  # the core distance: FD error ~ eps^2 / D^2
+    return {"face": (s < -m) & (h > m), "nose straight": (s > m) & (h > m) & straight(qx, qy) & far,
+            "nose corner": (s > m) & (h > m) & corner & far, "wall straight": (s > m) & (h < -m) & straight(qx, qy),
+            "wall corner": (s > m) & (h < -m) & corner}
+
+
+def die_regions(x, m=MARGIN):
+    rd = DIE.profile_radius
+    s, qx, qy = plan_parts(x, DIE.half_width + rd, DIE.corner_radius + rd)
+    h = x[:, 2] - (DIE.z_top - rd)
+    corner = (qx > m) & (qy > m) & (np.hypot(qx, qy) > 0.5)  # off the arcs' centres (the medial axis)
+    side, inner = straight(qx, qy) & ((qx > m) | (qy > m)), straight(qx, qy) & (qx < -m) & (qy < -m)
+    far = np.hypot(np.minimum(s, 0), np.maximum(h, 0)) > 0.2
+    return {"top": s > m, "shoulder straight": (s < -m) & (h > m) & straight(qx, qy) & far,
+            "shoulder corner": (s < -m) & (h > m) & corner & far, "wall straight": (s < -m) & (h < -m) & side,
+            "wall corner": (s < -m) & (h < -m) & corner, "opening": (h < -m) & inner}  # deeper than a corner radius
+
+
+REGIONS = [("punch", r) for r in punch_regions(np.zeros((1, 3)))] + [("die", r) for r in die_regions(np.zeros((1, 3)))]
+
+
+@pytest.mark.parametrize("name,region", REGIONS)
+def test_shape_is_the_derivative_of_the_normal(name, region):
+    tool, _, (lo, hi) = CASES[name]
+    x = near(np.array(lo) - [hi[0], hi[1], 0], hi, 40000)  # all four quadrants
+    x = x[(punch_regions if tool is PUNCH else die_regions)(x)[region]][:400]
+    assert len(x) >= 200
+    H = tool.shape(x, offset=0.3)
+    fd = finite_difference_shape(tool, x)
+    if region in ("face", "top", "wall straight", "opening"):  # flat: the normal is constant, to the bit
+        assert np.array_equal(fd, np.zeros_like(fd)) and np.array_equal(H, fd)
+    else:  # to 1e-6 of each point's largest entry
+        scale = np.abs(fd).max(axis=(1, 2), keepdims=True)
+        assert scale.min() > 0.01
+        assert (np.abs(H - fd) / scale).max() < 1e-6
+    np.testing.assert_array_equal(H, H.transpose(0, 2, 1))
+    _, n = tool.gap(x)
+    assert np.abs(np.einsum("nij,nj->ni", H, n)).max() < 1e-14 * max(1.0, np.abs(H).max())
+
+
+def principal(H, t):
+    """t . H t for unit vectors t (one per point)."""
+    return np.einsum("ni,nij,nj->n", t, H, t)
+
+
+@pytest.mark.parametrize("delta", [0.1, 1.0, -0.5])  # outside, and into the tool (shallower than its radii)
+def test_shape_closed_forms(delta):
+    """On the tori and cylinders of the tools the principal curvatures of the distance's level
+    surface at distance delta are known: across a profile of radius r, 1/(r + delta); along a
+    plan arc of radius R about its centre, the normal's plan component over R (Meusnier)."""
+    phi = np.array([0.2, 0.7, 1.3])
+    ones, zeros = np.ones_like(phi), np.zeros_like(phi)
+    # punch nose, straight part (the side y = -half_width): across 1/(rp + delta), along x 0
+    ap, rp, zc = PUNCH.half_width, PUNCH.profile_radius, PUNCH.z_face + PUNCH.profile_radius
+    x = np.c_[zeros + 1.0, -(ap - rp + (rp + delta) * np.sin(phi)), zc - (rp + delta) * np.cos(phi)]
+    n, t = np.c_[zeros, -np.sin(phi), -np.cos(phi)], np.c_[zeros, -np.cos(phi), np.sin(phi)]
+    H = PUNCH.shape(x)
+    np.testing.assert_allclose(PUNCH.gap(x)[1], n, atol=1e-15)
+    np.testing.assert_allclose(H, t[:, :, None] * t[:, None, :] / (rp + delta), atol=1e-14)
+    # punch nose at the plan corner (towards theta): the plan arc of the core has radius rc - rp,
+    # the point lies R = rc - rp + (rp + delta) sin(phi) from its centre
+    theta, b, rc = 0.4, ap - PUNCH.corner_radius, PUNCH.corner_radius - rp
+    R = rc + (rp + delta) * np.sin(phi)
+    x = np.c_[b + R * np.cos(theta), b + R * np.sin(theta), zc - (rp + delta) * np.cos(phi)]
+    n = np.c_[np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), -np.cos(phi)]
+    t = np.c_[np.cos(phi) * np.cos(theta), np.cos(phi) * np.sin(theta), np.sin(phi)]
+    tau = np.c_[-np.sin(theta) * ones, np.cos(theta) * ones, zeros]
+    H = PUNCH.shape(x)
+    np.testing.assert_allclose(PUNCH.gap(x)[1], n, atol=1e-15)
+    np.testing.assert_allclose(principal(H, t), 1 / (rp + delta), rtol=1e-14)
+    np.testing.assert_allclose(principal(H, tau), np.sin(phi) / R, rtol=1e-14)
+    np.testing.assert_allclose(H, t[:, :, None] * t[:, None, :] / (rp + delta)
+                               + (np.sin(phi) / R)[:, None, None] * tau[:, :, None] * tau[:, None, :], atol=1e-14)
+    # punch wall at the plan corner: 1 / (delta + corner_radius), straight wall 0
+    x = np.array([[b + (PUNCH.corner_radius + delta) * np.cos(theta), b + (PUNCH.corner_radius + delta) * np.sin(theta),
+                   zc + 2.0], [ap + delta, 1.0, zc + 2.0]])
+    H = PUNCH.shape(x)
+    np.testing.assert_allclose(H[0], np.outer(tau[0], tau[0]) / (PUNCH.corner_radius + delta), atol=1e-14)
+    np.testing.assert_array_equal(H[1], np.zeros((3, 3)))
+    # die shoulder, straight part (x = half_width + rd): across +1/(rd + delta) (the section is
+    # convex, as the nose's), along y 0
+    A, rd, zt = DIE.half_width + DIE.profile_radius, DIE.profile_radius, DIE.z_top - DIE.profile_radius
+    x = np.c_[A - (rd + delta) * np.sin(phi), zeros + 1.0, zt + (rd + delta) * np.cos(phi)]
+    n, t = np.c_[-np.sin(phi), zeros, np.cos(phi)], np.c_[np.cos(phi), zeros, np.sin(phi)]
+    H = DIE.shape(x)
+    np.testing.assert_allclose(DIE.gap(x)[1], n, atol=1e-15)
+    np.testing.assert_allclose(H, t[:, :, None] * t[:, None, :] / (rd + delta), atol=1e-14)
+    # die shoulder at the opening's plan corner: along it -sin(phi) / R, concave (the sign
+    # opposite to the punch nose's), R = rc + rd - (rd + delta) sin(phi) from the arc's centre
+    B, RC = A - (DIE.corner_radius + rd), DIE.corner_radius + rd
+    R = RC - (rd + delta) * np.sin(phi)
+    x = np.c_[B + R * np.cos(theta), B + R * np.sin(theta), zt + (rd + delta) * np.cos(phi)]
+    n = np.c_[-np.sin(phi) * np.cos(theta), -np.sin(phi) * np.sin(theta), np.cos(phi)]
+    t = np.c_[np.cos(phi) * np.cos(theta), np.cos(phi) * np.sin(theta), np.sin(phi)]
+    H = DIE.shape(x)
+    np.testing.assert_allclose(DIE.gap(x)[1], n, atol=1e-15)
+    np.testing.assert_allclose(principal(H, t), 1 / (rd + delta), rtol=1e-14)
+    np.testing.assert_allclose(principal(H, tau), -np.sin(phi) / R, rtol=1e-14)
+    assert (principal(H, tau) < 0).all()
+    # die wall at the opening's corner: -1 / (corner_radius - delta), concave
+    b = DIE.half_width - DIE.corner_radius
+    x = np.array([[b + (DIE.corner_radius - delta) * np.cos(theta), b + (DIE.corner_radius - delta) * np.sin(theta),
+                   zt - 2.0]])
+    np.testing.assert_allclose(DIE.shape(x)[0], -np.outer(tau[0], tau[0]) / (DIE.corner_radius - delta), atol=1e-14)
+
+
+@pytest.mark.parametrize("name", TOOLS)
+def test_shape_ignores_the_offset_moves_with_the_tool_and_keeps_the_symmetry(name):
+    tool = TOOLS[name]
+    x = near([-20, -20, -6], [20, 20, 6], 5000)
+    H = tool.shape(x)
+    assert H.shape == (len(x), 3, 3)
+    np.testing.assert_array_equal(tool.shape(x, offset=RNG.uniform(0, 0.5, len(x))), H)
+    np.testing.assert_allclose(tool.shape(x + [0, 0, -1.5], 0.0, dz=-1.5), H, rtol=0, atol=1e-12)
+    # mirrored about x = y, x = 0, y = 0: H -> S H S, to the bit
+    swap = [1, 0, 2]
+    assert np.array_equal(tool.shape(x[:, swap])[:, swap][:, :, swap], H)
+    for k in (0, 1):
+        S = np.ones(3)
+        S[k] = -1.0
+        Hm = tool.shape(x * S) * S[:, None] * S[None, :]
+        assert np.array_equal(Hm + 0.0, H)
+    assert np.isfinite(H).all()
+    if tool is HOLDER:  # a flat face
+        assert np.array_equal(H, np.zeros_like(H))
+
+
+def test_shape_is_vectorised():
+    """No loop over points: shape costs a few times gap, not a Python call per point."""
+    import time
+
+    x = near([-20, -20, -6], [20, 20, 6], 200_000)
+    for tool in (PUNCH, DIE):
+        cost = {}
+        for f in (tool.gap, tool.shape):
+            t = []
+            for _ in range(3):
+                t0 = time.perf_counter()
+                f(x)
+                t.append(time.perf_counter() - t0)
+            cost[f.__name__] = min(t)
+        assert cost["shape"] < 10 * cost["gap"] + 0.05, cost

@@ -15,6 +15,22 @@ which the tool pushes the sheet.
 ``gap(x, offset, dz)`` is the signed distance minus ``offset`` (half the sheet thickness at the
 node: the sheet's surface lies that far from its mid-surface), with the tool moved by dz along
 z: > 0 clear, < 0 penetration. Units mm.
+
+``shape(x, offset, dz)`` is the shape operator of the normal field, H = dn/dx, the Hessian of
+the signed distance (the offset, a constant, does not change it): (n, 3, 3), symmetric, H n = 0,
+its eigenvalues at x the principal curvatures of the distance's level surface through x (> 0
+convex, < 0 concave). Where the distance to the core is D > 0, n = (p - c(p)) / D for the
+nearest core point c, and with the core a product set, n = (s grad s, -/+ h) / D in terms of the
+plan sdf s and the height h. Differentiating,
+
+    H = (P - n n^T + s Hs) / D,   P = m m^T + e_z e_z^T,   m = grad s (a unit plan vector),
+
+Hs the plan Hessian of s (rounded_square_hessian): P - n n^T = t t^T for the unit t in the
+section plane (m, e_z) orthogonal to n (curvature 1/D across the profile), and s Hs = s/(s + rc)
+tau tau^T on the plan corner arcs (tau the plan tangent, s + rc the distance to the arc's
+centre), 0 along the straight sides. Beside a wall (D = |s|) only the plan term is left; on the
+flat faces and inside the core H = 0. On a region boundary H takes the side that ``gap`` takes
+for the normal (H jumps there: the curvature of a nose is not that of the face it meets).
 """
 
 from dataclasses import dataclass
@@ -45,6 +61,35 @@ def rounded_square_sdf(x, y, a: float, rc: float):
     gx = np.where(out, px / rs, qx > qy)  # d sdf / d|x|
     gy = np.where(out, py / rs, qx <= qy)  # d sdf / d|y|
     return sdf, gx * np.sign(x) + 0.0, gy * np.sign(y) + 0.0  # + 0.0: no -0.0
+
+
+def rounded_square_hessian(x, y, a: float, rc: float):
+    """The Hessian of rounded_square_sdf, (n, 3, 3) with zero z row and column.
+
+    On the corner arcs' sectors (both |x|, |y| > a - rc) sdf = r - rc with r = |q| the distance
+    to the arc's centre, so Hs = (I - g g^T) / r = tau tau^T / r, g the (signed) gradient and tau
+    the plan tangent; elsewhere sdf is linear (the sides) or a maximum of linear functions (inside
+    the inner square, kinked on its diagonals): Hs = 0. On a sector's edge (|x| or |y| = a - rc)
+    Hs takes the side's value, the side the gradient takes.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    qx, qy = np.abs(x) - (a - rc), np.abs(y) - (a - rc)
+    arc = (qx > 0.0) & (qy > 0.0)
+    r = np.where(arc, np.sqrt(qx * qx + qy * qy), 1.0)
+    _, gx, gy = rounded_square_sdf(x, y, a, rc)
+    H = np.zeros(x.shape + (3, 3))
+    H[:, 0, 0], H[:, 1, 1], H[:, 0, 1] = gy * gy, gx * gx, -gx * gy
+    H[:, 1, 0] = H[:, 0, 1]
+    return H * (arc / r)[:, None, None] + 0.0
+
+
+def _profile_hessian(n, sx, sy, sHs, D):
+    """H = (P - n n^T + s Hs) / D at points whose nearest core point lies on the core's rounded
+    edge (module docstring): n the normal, (sx, sy) = grad s, sHs = s Hs, D the core distance."""
+    m = np.stack([sx, sy, np.zeros_like(sx)], axis=1)
+    P = m[:, :, None] * m[:, None, :]
+    P[:, 2, 2] = 1.0
+    return (P - n[:, :, None] * n[:, None, :] + sHs) / D[:, None, None]
 
 
 def _points(x, offset):
@@ -85,6 +130,26 @@ class Punch:
         n[nose] = np.stack([sp * sx, sp * sy, -hp], axis=1)[nose] / d[nose, None]
         return d - rp - offset, n + 0.0
 
+    def shape(self, x, offset=0.0, dz: float = 0.0):
+        """H = dn/dx, (n, 3, 3) (module docstring). Under the face and inside the core 0; beside
+        the wall the plan term Hs, 1/(d + corner_radius) along the plan corner's arc, d the
+        distance to the wall; on the nose (P - n n^T + s Hs) / D: 1/(d + rp) across the profile
+        and s / ((s + rc - rp) D) along it at the plan corner (the plan arc's curvature 1/(s + rc
+        - rp) times the normal's plan component s / D), 0 along a straight side."""
+        x, _ = _points(x, offset)
+        rp = self.profile_radius
+        a, rc = self.half_width - rp, self.corner_radius - rp
+        s, sx, sy = rounded_square_sdf(x[:, 0], x[:, 1], a, rc)
+        h = (self.z_face + dz + rp) - x[:, 2]
+        Hs = rounded_square_hessian(x[:, 0], x[:, 1], a, rc)
+        beside, nose = (s > 0.0) & (h <= 0.0), (s > 0.0) & (h > 0.0)  # as in gap
+        H = np.zeros((len(x), 3, 3))
+        H[beside] = Hs[beside]
+        _, n = self.gap(x[nose], 0.0, dz)
+        s, sx, sy, h = s[nose], sx[nose], sy[nose], h[nose]
+        H[nose] = _profile_hessian(n, sx, sy, s[:, None, None] * Hs[nose], np.sqrt(s * s + h * h))
+        return H + 0.0
+
 
 @dataclass
 class Die:
@@ -121,6 +186,28 @@ class Die:
         n[bend] = np.stack([-e * sx, -e * sy, hp], axis=1)[bend] / d[bend, None]
         return d - rd - offset, n + 0.0
 
+    def shape(self, x, offset=0.0, dz: float = 0.0):
+        """H = dn/dx, (n, 3, 3) (module docstring), with s = -e < 0 in the opening. Over the top,
+        inside the core and at the opening's centre (no plan direction) 0; beside the wall -Hs,
+        -1/(corner_radius - d) along the opening's corner arc (concave), d the distance to the
+        wall; on the shoulder (P - n n^T - e Hs) / D: +1/(d + rd) across the profile (the section
+        is convex) and -e / ((rc + rd - e) D) along it at the plan corner (concave: the opposite
+        sign of the punch nose's), 0 along a straight side."""
+        x, _ = _points(x, offset)
+        rd = self.profile_radius
+        a, rc = self.half_width + rd, self.corner_radius + rd
+        s, sx, sy = rounded_square_sdf(x[:, 0], x[:, 1], a, rc)
+        h = x[:, 2] - (self.z_top + dz - rd)
+        Hs = rounded_square_hessian(x[:, 0], x[:, 1], a, rc)
+        plan = (sx != 0.0) | (sy != 0.0)  # as in gap
+        wall, bend = (s < 0.0) & (h <= 0.0) & plan, (s < 0.0) & (h > 0.0) & plan
+        H = np.zeros((len(x), 3, 3))
+        H[wall] = -Hs[wall]
+        _, n = self.gap(x[bend], 0.0, dz)
+        s, sx, sy, h = s[bend], sx[bend], sy[bend], h[bend]
+        H[bend] = _profile_hessian(n, sx, sy, s[:, None, None] * Hs[bend], np.sqrt(s * s + h * h))
+        return H + 0.0
+
 
 @dataclass
 class BlankHolder:
@@ -141,6 +228,11 @@ class BlankHolder:
         s, _, _ = rounded_square_sdf(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)
         sd = np.where(s >= 0.0, (self.z_face + dz) - x[:, 2], np.inf)
         return sd - offset, np.tile(DOWN, (len(x), 1))
+
+    def shape(self, x, offset=0.0, dz: float = 0.0):
+        """H = dn/dx = 0: a flat face (and nothing over the opening)."""
+        x, _ = _points(x, offset)
+        return np.zeros((len(x), 3, 3))
 
 
 def square_cup_tools(spec, thickness: float) -> dict:
