@@ -445,13 +445,12 @@ def test_passes_that_only_move_the_contact_front_are_not_counted():
 
 
 def test_the_trace_names_every_node_that_switches(capsys):
-    """contact.trace logs each node that joins or leaves a tool, with its position and force:
+    """The trace (shellform run --trace) logs each node that joins or leaves a tool, with its position and force:
     in the aluminium cup's first increment (the blank peeling off the punch's face, the holder
     closed throughout) one line per counted set change."""
     s = scene.load(ROOT / "demos" / "numisheet93_aluminium.toml")
     s.mesh.n = 16
-    p = DrawingProblem.from_scene(s, verbose=False)
-    p.driver.contact.trace = True
+    p = DrawingProblem.from_scene(s, verbose=False, trace=True)
     p.driver.run(s.process.initial_step)
     lines = capsys.readouterr().out.splitlines()
     switches = [ln for ln in lines if " joins tool " in ln or " leaves tool " in ln]

@@ -177,16 +177,10 @@ class ContactSet(Part):
             c.flags[on, 2] = True
             if k == self.holder_tool:
                 continue  # flat, and still in plan
-            self.curvature[on] = self._shape_operator(k, x[on], c.frames[on], normal, lam)
+            H = self.tools[k].shape(x[on], 0.0, lam * self.travel[k])  # dn/dx
+            t = c.frames[on][:, :2]
+            self.curvature[on] = np.einsum("nai,nij,nbj->nab", t, H, t)  # W_ab = t_a . H t_b
             self.shift[on] = (lam - self.lam_n) * self.travel[k]
-
-    def _shape_operator(self, k, x, F, n, lam):
-        h = 1e-4 * self.thickness
-        tool, dz = self.tools[k], lam * self.travel[k]
-        W = np.zeros((len(x), 2, 2))
-        for b in range(2):
-            W[:, :, b] = np.einsum("nij,nj->ni", F[:, :2], (tool.gap(x + h * F[:, b], 0.0, dz)[1] - n) / h)
-        return 0.5 * (W + W.transpose(0, 2, 1))
 
     def add_tangent(self, K, R, fixed) -> None:
         """K_ab += -R0 W_ab on the tangent slots of the nodes on curved tools (module

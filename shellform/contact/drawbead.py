@@ -143,7 +143,7 @@ class Drawbeads(Part):
     # -- the part's protocol: one iterate --------------------------------------------------------
     def follow(self, frames: np.ndarray, lam: float) -> None:
         self.frames = frames[: self.n]
-        self.update(self.nodes.local_positions(), self.nodes.x_n, self.frames)
+        self.slide(self.nodes.local_positions(), self.nodes.x_n, self.frames)
 
     def add_residual(self, R: np.ndarray) -> None:
         """R -= f on the owned nodes' u, v, w rows, in their nodal frames."""
@@ -153,7 +153,7 @@ class Drawbeads(Part):
         add_tangent_slot_stiffness(K, self.rate)
 
     # -- one iterate ---------------------------------------------------------------------------
-    def update(self, x_local: np.ndarray, x_n: np.ndarray, frames: np.ndarray) -> None:
+    def slide(self, x_local: np.ndarray, x_n: np.ndarray, frames: np.ndarray) -> None:
         """The restraint and uplift at the current positions (x_local: every local node; x_n:
         the owned nodes' at the start of the increment; frames: the owned nodes' frames)."""
         self.shares(x_local)

@@ -162,6 +162,10 @@ class DrawingProblem:
         """(u, v, w) of every local node, the owned ones first (a view of the carrier)."""
         return self.driver.q.x.array.reshape(-1, BS)[:, :3]
 
+    def initial_positions(self) -> np.ndarray:
+        """(n_owned, 3) the owned nodes' initial positions."""
+        return self.driver.nodes.X[: self.driver.n_owned]
+
     def nodal_values(self):
         """Owned nodes: initial (x, y), current position, thickness strain."""
         d = self.driver

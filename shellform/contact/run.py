@@ -182,7 +182,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
     sprung = None
     if s.process.springback and stopped is None:
-        before = cup.profiles(p.driver, p.driver.nodes.X)
+        before = cup.profiles(p.initial_positions(), p.driver.displacements(), comm)
         try:
             released = springback.release(p.driver)
         except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported

@@ -32,11 +32,25 @@ class ReleasedForces:
 
 
 class SpringbackDriver(Driver):
-    """Newton from the drawn state (load factor 1) to the released one (0); the held dofs keep
-    the values they have (symmetry: 0; the centre's w: its drawn height)."""
+    """Newton from the drawn state q (load factor 1, the tools' forces f applied as a nodal
+    load) to the released one (0). The supports keep the values they have: the symmetry
+    planes (`symmetry`) 0, the others (`held`: the centre's w) their drawn values."""
+
+    def __init__(self, model, symmetry, held, q, controls=None, verbose=False):
+        super().__init__(model, list(symmetry) + list(held), controls=controls, verbose=verbose)
+        self.q.x.array[:] = q
+        self.held = q.copy()
+        for bc in symmetry:
+            self.held[bc.dof_indices()[0]] = 0.0
+        self.continue_from(1.0)  # run(0) is a load reversal: elastic first tangent
+        self.residual(0.0, tangent=False)
+        n = model.V.dofmap.index_map.size_local * BS
+        f = self.residual_full[:n].copy()  # f_int(q): the tools' forces
+        f[self.bc_dofs[self.bc_dofs < n]] = 0.0
+        self.nodal = ReleasedForces(f, model.mesh.comm)
 
     def _set_dirichlet(self, lam, dofs=None):
-        d = self.bc_dofs if dofs is None else dofs
+        d = self.support_dofs if dofs is None else dofs
         self.g[d] = self.held[d]
         return self._largest(self.g[d] - self.q.x.array[d])
 
@@ -48,19 +62,11 @@ def release(contact_driver, controls: Controls | None = None, verbose=False) -> 
 
     cd = contact_driver
     model, V = cd.model, cd.model.V
-    n_owned = cd.n_owned
     X = cd.nodes.X
+    n_owned = cd.n_owned
     centre = np.flatnonzero(np.hypot(X[:n_owned, 0], X[:n_owned, 1]) < 1e-9 * max(np.abs(X[:, :2]).max(), 1.0))
     held = fem.dirichletbc(np.float64(0), (BS * centre + W).astype(np.int32), V.sub(W))
-    sb = SpringbackDriver(model, list(cd.support_bcs) + [held], controls=controls or Controls(
+    sb = SpringbackDriver(model, cd.support_bcs, [held], cd.q.x.array, controls=controls or Controls(
         initial_step=0.25, max_step=0.5, min_step=1e-3), verbose=verbose)
-    sb.q.x.array[:] = cd.q.x.array
-    sb.held = sb.q.x.array.copy()
-    sb.held[cd.support_dofs] = 0.0  # symmetry planes
-    sb.continue_from(1.0)  # run(0) is a load reversal: elastic first tangent
-    sb.residual(0.0, tangent=False)
-    f = sb.residual_full[: V.dofmap.index_map.size_local * BS].copy()  # f_int(q): the tools' forces
-    f[sb.bc_dofs[sb.bc_dofs < f.size]] = 0.0
-    sb.nodal = ReleasedForces(f, model.mesh.comm)
     sb.run(0.0)
     return sb

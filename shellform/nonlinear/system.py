@@ -83,6 +83,10 @@ class System:
         self.solves = 0  # linear solves: Newton iterations, those of failed attempts included
         self.residual_full = np.zeros(self.n_owned * BS)
 
+    def displacements(self) -> np.ndarray:
+        """(n_owned, 3) the owned nodes' displacements (u, v, w) (a view of the carrier)."""
+        return self.q.x.array.reshape(-1, BS)[: self.n_owned, :3]
+
     # -- constraints -----------------------------------------------------------------------------
     def _in_frames(self) -> np.ndarray:
         """The carrier in the basis the system is solved in (edge frames turned; else q itself)."""

@@ -14,7 +14,6 @@ import numpy as np
 from dolfinx import fem, io
 from mpi4py import MPI
 
-from shellform.assembly.sheet_element import BS
 from shellform.results.fields import offscreen_backend
 
 
@@ -183,14 +182,14 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.close()
 
 
-def profile(driver, X, diagonal=False):
-    """(initial distance, x or r, z) of the owned nodes on the line y = 0 (or x = y), by initial
-    distance from the centre, gathered on every rank."""
-    n = driver.model.V.dofmap.index_map.size_local
-    x = X[:n] + driver.q.x.array.reshape(-1, BS)[:n, :3]
+def profile(X, u, comm, diagonal=False):
+    """(initial distance, x or r, z) of the owned nodes (initial positions X, displacements u)
+    on the line y = 0 (or x = y), by initial distance from the centre, gathered on every rank."""
+    n = len(u)
+    x = X[:n] + u
     on = LINES["square"]["diagonal" if diagonal else "transverse"](X[:n], 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
     r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
-    rows, = _gather(driver.model.mesh.comm, np.column_stack([np.hypot(X[:n, 0], X[:n, 1])[on], r, x[on, 2]]))
+    rows, = _gather(comm, np.column_stack([np.hypot(X[:n, 0], X[:n, 1])[on], r, x[on, 2]]))
     return rows[np.argsort(rows[:, 0])]
 
 
@@ -208,10 +207,10 @@ def wall_angle(rows, depth: float) -> float:
 SPRINGBACK_LINES = {"transverse": False, "diagonal": True}
 
 
-def profiles(driver, X) -> dict:
-    """The transverse and diagonal profiles of `driver`'s state (before or after springback);
-    X: the nodes' initial positions."""
-    return {k: profile(driver, X, diagonal=v) for k, v in SPRINGBACK_LINES.items()}
+def profiles(X, u, comm) -> dict:
+    """The transverse and diagonal profiles of a state (before or after springback): X the
+    owned nodes' initial positions, u their displacements."""
+    return {k: profile(X, u, comm, diagonal=v) for k, v in SPRINGBACK_LINES.items()}
 
 
 def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
@@ -221,7 +220,7 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
     from shellform.results.tables import write_csv
 
     lines = SPRINGBACK_LINES
-    after = profiles(released, p.driver.nodes.X)
+    after = profiles(p.initial_positions(), released.displacements(), p.model.mesh.comm)
     depth = float(-before["transverse"][:, 2].min())
     rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
              "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]
