@@ -81,10 +81,10 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            ("bending", "membrane"), why="is an effect of the nonlinear sheet, a full shell",
            doc="the membrane strain tied to the element edges (the string net), against membrane locking "
                "of thin sheets that bend far (docs/locking.md)"),
-    Effect("contact", "contact part", "shellform.contact.tools", (TOOLS,), ("geometric_nonlinearity",),
+    Effect("contact", "contact part", "shellform.contact.contact_set.ContactSet", (TOOLS,), ("geometric_nonlinearity",),
            why="with the tools moves the sheet far", keys=("tools",),
            doc="contact of the sheet with the rigid tools of [tools]"),
-    Effect("friction", "contact part", "shellform.contact.semi_inverse.SemiInverseDriver", (TOOLS,), ("contact",),
+    Effect("friction", "contact part", "shellform.contact.friction.CoulombFriction", (TOOLS,), ("contact",),
            why="acts at the contact with the tools", keys=("tools.friction",),
            doc="Coulomb friction at that contact, coefficient tools.friction > 0"),
     Effect("drawbeads", "contact part", "shellform.contact.drawbead.Drawbeads", (TOOLS,), ("contact",),

@@ -25,6 +25,7 @@ A pass may end before it converges where a part's set will change anyway (ends_p
 the passes fail, the increment is tried once more where a part offers another way (retry).
 """
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,10 +114,12 @@ class Newton(System):
             if not ok:
                 return False, iterations, residuals, ev
             changes, back, settled, lines = 0, 0, True, []
+            t0 = time.perf_counter()
             for part in self.parts:
                 change = part.update(lam, changes)
                 changes, back, settled = changes + change.changes, back + change.back, settled and change.settled
                 lines += [change.line] if change.line else []
+            self.times["parts_s"] += time.perf_counter() - t0
             counted += not (changes > 0 and back == 0)  # a front moving on is not counted
             if self.trace:
                 say(f"    pass {self.passes}: {its} iterations, |R| {res[0]:.3e} -> {res[-1]:.3e}, " + ", ".join(lines))

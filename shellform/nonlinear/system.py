@@ -61,7 +61,7 @@ class System:
         self._shared = [fem.Function(V) for _ in range(3)]  # frames (9 values = 3 x 3), known, flags
         self._known = np.zeros_like(self.g)
         self._array_frames = (self.rotated.copy(), self.frames.copy())
-        self.times = {"element_s": 0.0, "constitutive_s": 0.0, "assembly_s": 0.0, "solve_s": 0.0}
+        self.times = {"element_s": 0.0, "constitutive_s": 0.0, "assembly_s": 0.0, "solve_s": 0.0, "parts_s": 0.0}
         self.f_ext = fem_petsc.create_vector(V)  # external load at lambda = 1: dead pressure
         self.f_ext.set(0.0)
         if pressure:
@@ -104,6 +104,7 @@ class System:
         largest known correction (all ranks). Without parts the supports are all."""
         if not self.parts:
             return 0.0
+        t0 = time.perf_counter()
         n = self.n_owned
         c = Constraints.none(n, BS)
         for part in self.parts:
@@ -123,6 +124,7 @@ class System:
         self._set_bcs(flag)
         for part in self.parts:
             part.follow(self.frames, lam)
+        self.times["parts_s"] += time.perf_counter() - t0
         return self._largest(known)
 
     def _set_bcs(self, flag):

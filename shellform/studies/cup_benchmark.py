@@ -18,7 +18,7 @@ the mesh 1e-3 to 1e-2; docs/performance.md).
 Writes cup_benchmark.csv, one row per run:
 - ranks, threads per rank, Newton's rtol, cells, stroke, wall time, increments, Newton iterations, contact passes;
 - one iteration's time in ms, split into the element loop, the constitutive update, the
-  contact (frames, friction, set updates), DOLFINx assembly, the MUMPS solve and the rest
+  parts (frames, friction, set updates), DOLFINx assembly, the MUMPS solve and the rest
   (Python and other work between them), and the rest's share of the run;
 - the punch force, draw-in DX and DD and the peak thinning at 15 and 40 mm (where reached),
   so that speed is always shown next to accuracy;
@@ -48,7 +48,7 @@ STROKES = {71: 5.0}  # mm; the others to the scene's 40 mm
 MPI_LEVELS = (35, 71)  # the levels drawn once more on 2 ranks (issue 12's 2-rank target: the 10,000-cell cup)
 ONE_CORE = (71,)  # the levels drawn once more on one core (1 rank, 1 thread): the baseline of the ranks' speed-up
 LOOSE = (35, (1e-4, 1e-3))  # the level drawn again with these Newton tolerances
-PARTS = ("element", "constitutive", "contact", "assembly", "solve")
+PARTS = ("element", "constitutive", "parts", "assembly", "solve")
 REPORTS = (15.0, 40.0)
 COLUMNS = ["case", "ranks", "threads", "rtol", "n", "cells", "stroke_mm", "finished", "wall_s", "increments", "newton_iterations",
            "contact_passes", "iteration_ms", *(f"{p}_ms" for p in PARTS), "rest_ms", "rest_share",
