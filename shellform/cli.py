@@ -28,7 +28,8 @@ from shellform.errors import InputError
 
 
 STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark", "outlines", "locking"]
+           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark", "outlines", "locking",
+           "cup-convergence"]
 
 
 def main(argv=None) -> int:

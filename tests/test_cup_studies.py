@@ -92,3 +92,38 @@ def test_cup_benchmark_short(tmp_path):
     for a, b in zip(one["reports"], loose["reports"]):
         assert b["punch_force_kN"] == pytest.approx(a["punch_force_kN"], rel=1e-4)
         assert b["draw_in_mm"]["DX"] == pytest.approx(a["draw_in_mm"]["DX"], rel=1e-4)
+
+
+@pytest.mark.parametrize("h", [(1.0, 0.5, 0.25), (1.0, 0.6, 0.35), (0.2, 0.15, 0.07)])
+def test_richardson_recovers_the_order_and_the_limit(h):
+    """q(h) = q* + C h^p on three meshes of any ratios: the observed order p and q* come back
+    (to 1e-9); differences that change sign give no order and their spread as the uncertainty."""
+    from shellform.studies.cup_convergence import richardson
+
+    for p, C in ((1.0, 3.0), (1.7, -0.4), (2.0, 5.0)):
+        q = [2.5 + C * x**p for x in h]
+        r = richardson(h, q)
+        assert r["p"] == pytest.approx(p, rel=1e-9) and r["estimate"] == pytest.approx(2.5, rel=1e-9)
+        assert r["uncertainty"] == pytest.approx(1.25 * abs(2.5 - q[-1]), rel=1e-6)
+    r = richardson(h, [1.0, 1.2, 1.1])
+    assert math.isnan(r["p"]) and math.isnan(r["estimate"]) and r["uncertainty"] == pytest.approx(0.2)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_cup_convergence_quick(tmp_path):
+    """cup-convergence's plumbing on three coarse meshes to 2 mm: a row per run with its answers,
+    the holder's largest share and holding-down peak from force_stroke.csv, and an estimate per
+    answer with the successive differences of the three meshes."""
+    from shellform.studies import cup_convergence
+
+    rows = cup_convergence.run(tmp_path, levels=cup_convergence.QUICK_LEVELS)
+    assert [(r["case"], r["n"]) for r in rows] == [(c, n) for c in cup_convergence.CASES
+                                                  for n in cup_convergence.QUICK_LEVELS]
+    for r in rows:
+        assert r["finished"] and r["stroke_mm"] == pytest.approx(2.0)
+        assert 0 < r["largest_share"] < 1 and r["DX_2"] > 0 and r["force_2"] > 0
+    est = list(csv.DictReader(open(tmp_path / "cup_convergence_estimates.csv")))
+    dx = next(e for e in est if e["case"] == "aluminium" and e["answer"] == "DX_2")
+    assert len(dx["values"].split()) == 3 and len(dx["differences"].split()) == 2
+    assert (tmp_path / "cup_convergence.png").stat().st_size > 0
