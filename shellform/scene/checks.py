@@ -15,7 +15,8 @@ from shellform import effects as registry
 from shellform.errors import InputError
 from shellform.mesh import outline
 from shellform.scene import machine
-from shellform.scene.schema import (CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING, MAY_BE_INFINITE,
+from shellform.scene.schema import (ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING,
+                                    MAY_BE_INFINITE, YIELD_FUNCTIONS,
                                     MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, REGIONS, SIDES, SPREADS,
                                     SUPPORTS, TOOL_SHAPES, Scene, ToolsSpec, bounds)
 
@@ -168,6 +169,18 @@ def _validate_material(s: Scene) -> None:
     require(math.isfinite(mat.m) and mat.m >= 1, "material.m",
             f"must be >= 1 (convex yield function), got {mat.m}")
     _keys_of_effects(s, "material")
+    require(mat.yield_function in YIELD_FUNCTIONS, "material.yield_function",
+            f"must be one of {', '.join(YIELD_FUNCTIONS)}, got {mat.yield_function!r}")
+    require(math.isfinite(mat.rolling_direction), "material.rolling_direction",
+            f"must be finite (degrees), got {mat.rolling_direction}")
+    for name in ANISOTROPY_PARAMETERS:
+        v = getattr(mat, name)
+        require(math.isfinite(v) and v >= 0.0, f"material.{name}", f"must be > 0 (0: unset), got {v}")
+        require(v == 0.0 or mat.yield_function == "hill48", f"material.{name}",
+                f"is no parameter of yield_function = {mat.yield_function!r}")
+    for name, default in (("r", 1.0), ("m", 2.0)):
+        require(mat.yield_function == "hill79" or getattr(mat, name) == default, f"material.{name}",
+                f"is Hill 1979's; yield_function = {mat.yield_function!r} takes its own parameters")
     require(mat.hardening in HARDENING, "material.hardening",
             f"must be one of {', '.join(HARDENING)}, got {mat.hardening!r}")
     plastic = "plasticity" in s.effects

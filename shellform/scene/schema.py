@@ -19,6 +19,7 @@ from shellform.mesh import outline
 
 __all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "SPREADS", "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
+           "YIELD_FUNCTIONS", "ANISOTROPY_PARAMETERS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
            "Drawbead", "ToolsSpec", "Output", "Scene", "bounds"]
 
@@ -37,6 +38,8 @@ CIRCLE_REGIONS = ("full", "half", "quarter")
 MESH_KINDS = ("structured", "unstructured")
 DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
 HARDENING = ("none", "power", "swift")
+YIELD_FUNCTIONS = ("hill79", "hill48")  # shellform.material.criteria.CRITERIA
+ANISOTROPY_PARAMETERS = ("r0", "r45", "r90", "sigma0", "sigma45", "sigma90", "sigma_b")  # 0: unset
 CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n")}
 
 
@@ -79,6 +82,15 @@ class Material:
     eps0: float = 0.0  # Swift (0: unset)
     r: float = 1.0  # Lankford coefficient of Hill 1979 (> 0; != 1 needs 'anisotropy')
     m: float = 2.0  # Hill 1979 exponent (>= 1; != 2 needs 'anisotropy')
+    yield_function: str = "hill79"  # one of YIELD_FUNCTIONS (shellform.material.criteria); others need 'anisotropy'
+    rolling_direction: float = 0.0  # degrees from the x axis to the rolling direction (needs 'anisotropy')
+    r0: float = 0.0  # hill48: Lankford coefficients at 0, 45, 90 degrees to the rolling direction (0: unset)
+    r45: float = 0.0
+    r90: float = 0.0
+    sigma0: float = 0.0  # hill48, instead of r0, r45, r90: uniaxial yield stresses at 0, 45, 90 degrees
+    sigma45: float = 0.0  # and the balanced-biaxial one, MPa (only their ratios count; 0: unset)
+    sigma90: float = 0.0
+    sigma_b: float = 0.0
 
 
 @dataclass
@@ -233,18 +245,20 @@ class Scene:
         return self.route != registry.LINEAR
 
     def hill79(self):
-        """The scene's shellform.material.Hill79Material: elastic (hardening "none") unless the
-        effect 'plasticity' is on. Its own validation names the field (material.yield_stress, ...)."""
-        from shellform.material import Hill79Material  # numba modules: imported only when needed
+        """The scene's shellform.material.SheetMaterial (its yield function, Hill 1979 by default):
+        elastic (hardening "none") unless the effect 'plasticity' is on. Its own validation names
+        the field (material.yield_stress, material.r0, ...)."""
+        from shellform.material import SheetMaterial  # numba modules: imported only when needed
 
         mat = self.material
         if "plasticity" not in self.effects:
-            return Hill79Material(mat.E, mat.nu, mat.r, mat.m)
+            return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
         unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
         # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
         n = unset(mat.n) if mat.hardening == "power" else mat.n
-        return Hill79Material(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
-                              unset(mat.K), unset(mat.eps0))
+        given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
+        return SheetMaterial(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
+                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction)
 
 
 def bounds(s: Scene) -> tuple[float, float, float, float]:

@@ -1,0 +1,29 @@
+"""The registered yield functions and the dispatch the return mapping calls.
+
+A yield function is one file in shellform/material/ holding
+
+    NAME                      its name in a scene (material.yield_function)
+    parameters(values)        its parameters from the material's keys, validated (InputError
+                              naming the field), as a list of at most NPAR floats (packed at PAR_)
+    yield_function(s0, s1, s2, mat, order)   numba: sigma_bar(s) in the rolling-direction axes,
+                              and for order > 0 its gradient (3) and Hessian (6, upper triangle),
+                              as one 10-tuple
+
+and it is registered by one line in ``yield_function`` below (its id is its place in
+CRITERIA, listed in the same order). numba compiles the dispatch into a switch on the packed
+id; each criterion's code is inlined into its branch (docs/material.md: cost).
+"""
+
+from shellform.material import CRITERION_, hill48, hill79
+from shellform import _jit as jit
+
+CRITERIA = {m.NAME: m for m in (hill79, hill48)}  # name -> module; the id of each is its place here
+
+
+@jit.njit
+def yield_function(s0, s1, s2, mat, order):
+    """sigma_bar(s) and (order > 0) its derivatives, of the packed material's criterion."""
+    c = mat[CRITERION_]
+    if c == 1.0:
+        return hill48.yield_function(s0, s1, s2, mat, order)
+    return hill79.yield_function(s0, s1, s2, mat, order)

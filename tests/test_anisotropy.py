@@ -1,0 +1,235 @@
+"""Planar anisotropy (issue 33): Hill 1948 from r0, r45, r90 (or the yield stresses) with a
+rolling direction, against its closed forms; the consistent tangent with a turned rolling
+direction against finite differences; a yielded anisotropic strip turned rigidly; the
+registration of the yield functions; input errors naming the field."""
+
+import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
+
+import numpy as np
+import pytest
+
+from shellform import scene
+from shellform.errors import InputError
+from shellform.material import (
+    SheetMaterial, criteria, flow_stress, hill48, hill79, point, return_map, section_response,
+    through_thickness_rule,
+)
+
+E, NU, SY = 200e3, 0.3, 250.0
+EY = SY / E
+STEEL = {"r0": 1.79, "r45": 1.51, "r90": 2.27}  # NUMISHEET'93 mild steel
+ALUMINIUM = {"r0": 0.71, "r45": 0.58, "r90": 0.70}
+ANGLES = range(0, 91, 15)
+
+
+def hill48_material(values, rolling_direction=0.0, hardening="swift", **curve):
+    curve = curve or dict(K=500.0, eps0=0.02, n=0.25)
+    return SheetMaterial(E, NU, hardening=hardening, yield_function="hill48", yield_parameters=values,
+                         rolling_direction=rolling_direction, **curve)
+
+
+def perfect(values, rolling_direction=0.0):
+    return hill48_material(values, rolling_direction, K=SY, eps0=1.0, n=0.0).pack()
+
+
+@pytest.mark.parametrize("values", [STEEL, ALUMINIUM], ids=["steel", "aluminium"])
+@pytest.mark.parametrize("theta", ANGLES)
+def test_hill48_lankford_and_yield_stress_against_closed_forms(values, theta):
+    """Uniaxial tension along x with the rolling direction at -theta from x (the load at theta
+    to the rolling direction): r(theta) and sigma(theta)/sigma0 of the material point equal
+    Hill's closed forms to 1e-8; at 0, 45, 90 degrees r is the given r0, r45, r90."""
+    mat = hill48_material(values, rolling_direction=-theta).pack()
+    r = point.lankford(mat, 0.05)
+    assert r == pytest.approx(hill48.r_theta(values, theta), rel=1e-8)
+    if theta in (0, 45, 90):
+        assert r == pytest.approx(values[f"r{theta}"], rel=1e-8)
+    ratio = point.stress_ratio_yield(perfect(values, -theta), 0.0) / SY
+    assert ratio == pytest.approx(hill48.sigma_theta(values, theta), rel=1e-8)
+
+
+def test_hill48_from_yield_stresses():
+    """Given sigma0, sigma45, sigma90, sigma_b the material point yields at them: uniaxial at
+    0, 45, 90 degrees to the rolling direction and balanced biaxially, to 1e-8."""
+    stresses = {"sigma0": 1.0, "sigma45": 0.96, "sigma90": 1.04, "sigma_b": 1.02}
+    for theta, key in ((0, "sigma0"), (45, "sigma45"), (90, "sigma90")):
+        mat = perfect(stresses, -theta)
+        assert point.stress_ratio_yield(mat, 0.0) / SY == pytest.approx(stresses[key], rel=1e-8)
+    assert point.stress_ratio_yield(perfect(stresses, 20.0), 1.0) / SY == pytest.approx(1.02, rel=1e-8)
+
+
+@pytest.mark.parametrize("r", [0.5, 1.0, 1.79])
+def test_hill48_with_equal_r_is_hill79_with_m_2(r):
+    """r0 = r45 = r90 = r (any rolling direction): the same yield function, gradient and
+    Hessian as Hill 1979 with m = 2, and the same return mapping, to rounding."""
+    h48 = hill48_material({"r0": r, "r45": r, "r90": r}, rolling_direction=37.0).pack()
+    h79 = SheetMaterial(E, NU, r, 2.0, "swift", K=500.0, eps0=0.02, n=0.25).pack()
+    rng = np.random.default_rng(3)
+    for s in rng.normal(size=(20, 3)) * SY:
+        a48, a79 = np.array(criteria.yield_function(*s, h48, 2)), np.array(criteria.yield_function(*s, h79, 2))
+        assert np.abs(a48 - a79).max() <= 1e-13 * np.abs(a79).max()
+    ep_n, p_n = np.array([0.003, -0.001, 0.002]), 0.004
+    for d in rng.normal(size=(6, 3)):
+        e = ep_n + 3 * EY * d / np.linalg.norm(d)
+        out = []
+        for mat in (h48, h79):
+            s, D, ep = np.zeros(3), np.zeros((3, 3)), np.zeros(3)
+            p, st = return_map(e, ep_n, p_n, mat, s, D, ep)
+            out.append((st, p, s, D, ep))
+        assert out[0][0] == out[1][0] == 1
+        assert out[0][1] == pytest.approx(out[1][1], rel=1e-12)
+        for a, b in zip(out[0][2:], out[1][2:]):
+            assert np.abs(a - b).max() <= 1e-11 * np.abs(b).max()
+
+
+def test_each_registered_criterion_is_dispatched_to_its_file():
+    """The packed id of every name in CRITERIA reaches that criterion's own yield_function."""
+    mats = {"hill79": SheetMaterial(E, NU, 1.7, 6.0, "swift", K=500.0, eps0=0.02, n=0.25).pack(),
+            "hill48": hill48_material(STEEL, 25.0).pack()}
+    assert set(mats) == set(criteria.CRITERIA)
+    s = np.array([210.0, -80.0, 55.0])
+    for name, mat in mats.items():
+        own = criteria.CRITERIA[name].yield_function(*s, mat, 2)
+        assert criteria.yield_function(*s, mat, 2) == own
+        others = [m.yield_function(*s, mat, 2)[0] for n, m in criteria.CRITERIA.items() if n != name]
+        assert all(abs(o - own[0]) > 1e-3 * own[0] for o in others)
+
+
+DIRECTIONS = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [1.0, -0.3, 0.8],
+              [0.2, 0.5, -1.5], [-1.0, 0.4, 0.6], [0.0, 0.0, 1.0]]
+
+
+@pytest.mark.parametrize("hardening", ["perfect", "swift"])
+def test_consistent_tangent_with_a_turned_rolling_direction(hardening):
+    """Hill 1948 (steel r values), rolling direction 30 degrees: D_out equals the central
+    difference of return_map's stress to 1e-6, and is symmetric."""
+    mat = perfect(STEEL, 30.0) if hardening == "perfect" else hill48_material(STEEL, 30.0).pack()
+    ey = flow_stress(0.0, mat)[0] / E
+    ep_n, p_n = np.array([0.003, -0.001, 0.002]), 0.004
+    h = 1e-5 * ey
+
+    def rmap(e):
+        s, D, ep = np.zeros(3), np.zeros((3, 3)), np.zeros(3)
+        p, st = return_map(e, ep_n, p_n, mat, s, D, ep)
+        return s, D, st
+
+    for d in DIRECTIONS:
+        e = ep_n + 3 * ey * np.array(d) / np.linalg.norm(d)
+        _, D, st = rmap(e)
+        assert st == 1
+        D_fd = np.zeros((3, 3))
+        for j in range(3):
+            de = np.zeros(3)
+            de[j] = h
+            D_fd[:, j] = (rmap(e + de)[0] - rmap(e - de)[0]) / (2 * h)
+        assert np.abs(D - D_fd).max() <= 1e-6 * np.abs(D).max()
+        np.testing.assert_allclose(D, D.T, atol=1e-12 * E)
+
+
+@pytest.mark.parametrize("finite", [False, True])
+def test_section_tangent_with_a_turned_rolling_direction(finite):
+    """The layered section (5 layers, all plastic) of Hill 1948 with the rolling direction at
+    30 degrees: its tangent equals central differences of its resultants (small and finite
+    strains)."""
+    mat = hill48_material(STEEL, 30.0).pack()
+    zeta, wz = through_thickness_rule(5)
+
+    def section(x, ep_n, p_n):
+        S, D, ep, p = np.zeros(6), np.zeros((6, 6)), np.zeros((5, 3)), np.zeros(5)
+        st, _ = section_response(x[:3].copy(), x[3:].copy(), 1.0, 0.8, zeta, wz, ep_n, p_n, mat, finite, False,
+                                 S, D, ep, p)
+        return S, D, st, ep, p
+
+    x0 = np.array([0.3, -0.05, 0.1, 0.05, -0.02, 0.03])
+    _, _, st, ep_n, p_n = section(x0, np.zeros((5, 3)), np.zeros(5))
+    assert st == 5
+    x = x0 + np.array([0.05, 0.01, -0.02, 0.01, 0.0, 0.01])
+    S, D, st, _, _ = section(x, ep_n, p_n)
+    assert st == 5
+    h = 1e-7
+    for j in range(6):
+        dx = np.zeros(6)
+        dx[j] = h
+        fd = (section(x + dx, ep_n, p_n)[0] - section(x - dx, ep_n, p_n)[0]) / (2 * h)
+        assert np.abs(fd - D[:, j]).max() < 1e-6 * np.abs(D).max()
+
+
+def test_rigid_rotation_of_a_yielded_anisotropic_sheet(rotation):
+    """A strip of Hill 1948 (steel r values, rolling direction 30 degrees from x) stretched by
+    1.3 (yielded), then turned rigidly by 100 degrees about an inclined axis: resultants,
+    plastic strains, equivalent plastic strain and thickness stretch are unchanged to 1e-10
+    (the anisotropy axes are material directions of the total-Lagrangian strains)."""
+    from dolfinx import fem
+
+    from shellform.studies import strip
+
+    mat = SheetMaterial(E=206e3, nu=0.3, hardening="swift", K=565.32, eps0=0.007117, n=0.2589,
+                        yield_function="hill48", yield_parameters=STEEL, rolling_direction=30.0)
+    p, _ = strip.strip(mat, 1.3, steps=3)
+    model = p.model
+    x = model.V.tabulate_dof_coordinates()[:, :2]
+    vals = p.driver.q.x.array.reshape(-1, 9).copy()
+    pos = np.column_stack([x, np.zeros(len(x))]) + vals[:, :3]
+    grad = vals[:, 3:].reshape(-1, 3, 2) + np.eye(3, 2)
+    R = rotation([1.0, -2.0, 0.7], 100.0)
+    q = fem.Function(model.V)
+    states = []
+    for rot in (np.eye(3), R):
+        turned = np.zeros_like(vals)
+        turned[:, :3] = pos @ rot.T - np.column_stack([x, np.zeros(len(x))])
+        turned[:, 3:] = (np.einsum("ij,njk->nik", rot, grad) - np.eye(3, 2)).reshape(-1, 6)
+        q.x.array[:] = turned.ravel()
+        model.evaluate(q)
+        states.append([a.copy() for a in (model.resultants, model.ep, model.p, model.stretch)])
+    assert model.p.min() > 0.1
+    assert np.abs(states[0][1][..., 2]).max() > 1e-3  # the turned axes give a plastic shear strain
+    for a, b in zip(*states):
+        assert np.abs(a - b).max() <= 1e-10 * max(np.abs(a).max(), 1.0)
+
+
+@pytest.mark.parametrize("values, field", [
+    ({"r0": 1.5, "r45": 1.2}, "material.r90"),
+    ({"r0": -1.5, "r45": 1.2, "r90": 2.0}, "material.r0"),
+    ({"r0": 1.5, "r45": 0.0, "r90": 2.0}, "material.r45"),
+    ({"r0": 1.5, "r45": 1.2, "r90": 2.0, "sigma0": 1.0}, "material.r0"),
+    ({"sigma0": 1.0, "sigma45": 1.0, "sigma90": 1.0}, "material.sigma_b"),
+    ({"sigma0": 1.0, "sigma45": 3.0, "sigma90": 1.0, "sigma_b": 1.0}, "material.sigma45"),
+    ({"sigma0": 1.0, "sigma45": 1.0, "sigma90": 1.0, "sigma_b": 0.4}, "material.sigma_b"),
+])
+def test_hill48_input_errors_name_the_field(values, field):
+    with pytest.raises(InputError) as err:
+        hill48_material(values)
+    assert err.value.field == field
+
+
+SHEET = ["bending", "membrane", "geometric_nonlinearity", "plasticity"]
+SWIFT = {"E": 206000.0, "nu": 0.3, "thickness": 0.78, "hardening": "swift", "K": 565.32, "eps0": 0.007117,
+         "n": 0.2589}
+
+
+def test_scene_material_with_hill48_and_a_rolling_direction():
+    """[material] yield_function = "hill48", r0, r45, r90, rolling_direction: the scene's
+    material packs Hill's P matrix and the turned axes."""
+    s = scene.from_dict({"effects": SHEET + ["anisotropy"],
+                         "material": {**SWIFT, "yield_function": "hill48", "r0": 1.79, "r45": 1.51, "r90": 2.27,
+                                      "rolling_direction": 90.0}})
+    mat = s.hill79().pack()
+    from shellform.material import COS_, PAR_, ROTATED_, SIN_
+    F, G, H, N = hill48.coefficients(STEEL)
+    np.testing.assert_allclose(mat[PAR_:PAR_ + 4], [G + H, -H, F + H, 2 * N], rtol=1e-15)
+    assert (mat[ROTATED_], mat[SIN_]) == (1.0, 1.0) and abs(mat[COS_]) < 1e-16
+
+
+@pytest.mark.parametrize("material, effects, field", [
+    ({"yield_function": "hill48", "r0": 1.8, "r45": 1.5, "r90": 2.3}, SHEET, "material.yield_function"),
+    ({"rolling_direction": 45.0}, SHEET, "material.rolling_direction"),
+    ({"yield_function": "barlat89"}, SHEET + ["anisotropy"], "material.yield_function"),
+    ({"yield_function": "hill48", "r0": 1.8, "r45": 1.5}, SHEET + ["anisotropy"], "material.r90"),
+    ({"r0": 1.8}, SHEET + ["anisotropy"], "material.r0"),
+    ({"yield_function": "hill48", "r": 1.8, "r0": 1.8, "r45": 1.5, "r90": 2.3}, SHEET + ["anisotropy"],
+     "material.r"),
+    ({"yield_function": "hill48", "r0": -1.8, "r45": 1.5, "r90": 2.3}, SHEET + ["anisotropy"], "material.r0"),
+])
+def test_scene_anisotropy_errors_name_the_field(material, effects, field):
+    with pytest.raises(InputError) as err:
+        scene.from_dict({"effects": effects, "material": {**SWIFT, **material}})
+    assert err.value.field == field
