@@ -67,7 +67,9 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
                "initial-stress stiffness"),
     Effect("plasticity", "sheet part", "shellform.material.section", (SHEET, TOOLS), ("bending", "membrane"),
            why="is an effect of the nonlinear sheet, a full shell",
-           keys=("material.hardening", "material.yield_stress", "material.n", "material.K", "material.eps0"),
+           keys=("material.hardening", "material.yield_stress", "material.n", "material.K", "material.eps0",
+                 "material.Q", "material.beta", "material.swift_weight", "material.flow_curve",
+                 "material.extrapolation"),
            doc="elastic-plastic layers through the thickness (process.thickness_points), Hill 1979 with "
                "isotropic hardening"),
     Effect("anisotropy", "material data", "shellform.material.criteria", (SHEET, TOOLS), ("plasticity",),

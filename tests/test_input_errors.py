@@ -77,7 +77,7 @@ POWER = {"hardening": "power", "yield_stress": 2.0e-3, "n": 5.0}
     ({"effects": PLASTIC, "material": {"hardening": "swift", "eps0": 0.01, "n": 0.2}}, "material.K"),
     ({"effects": PLASTIC, "material": {"hardening": "swift", "K": 1.0, "n": 0.2}}, "material.eps0"),
     ({"effects": PLASTIC, "material": {**POWER, "K": 1.0}}, "material.K"),  # not a power-law parameter
-    ({"effects": PLASTIC, "material": {"hardening": "voce"}}, "material.hardening"),
+    ({"effects": PLASTIC, "material": {"hardening": "ludwik"}}, "material.hardening"),
     ({"effects": PLASTIC, "material": {**POWER, "thickness": -0.01}}, "material.thickness"),
     ({"effects": PLASTIC, "material": POWER, "process": {"thickness_points": 1}}, "process.thickness_points"),
     ({"process": {"min_step": 0.2, "initial_step": 0.1}}, "process.min_step"),

@@ -3,14 +3,17 @@
 A material travels to the numba functions as one packed float64 array ``mat`` (slots by name):
 
     E_, NU_       Young's modulus and Poisson ratio (plane-stress isotropic elasticity)
-    LAW_          the hardening law: 0 elastic (never yields), 1 power law, 2 Swift
-                  (shellform.material.hardening states each law and its parameters H_ ...)
+    LAW_          the hardening law: 0 elastic (never yields), 1 power law, 2 Swift, 3 Voce,
+                  4 Swift-Voce, 5 table (shellform.material.hardening states each law and its
+                  parameters H_ ...)
     H_ .. H_+NH   the hardening law's parameters (A_, B_, C_ the first three)
     CRITERION_    the yield function's id (shellform.material.criteria: its place in CRITERIA)
     COS_, SIN_    cos and sin of the rolling direction's angle theta from the x axis
     ROTATED_      1.0 where the return mapping turns strains into the rolling-direction axes
                   (theta not a multiple of 180 degrees), else 0.0
     PAR_ .. PAR_+NPAR  the yield function's parameters (its file says which)
+    TABLE_ ..     a tabulated flow curve: its number of points N + 1, p_0..p_N, sigma_0..sigma_N
+                  (shellform.material.flow_curve; the array ends there, 1 + 0 points without one)
 
 The yield function, its parameters and its derivatives live in one file each (hill79, ...);
 the return mapping (plane_stress) is written once for all of them; section integrates the
@@ -29,9 +32,11 @@ E_, NU_, LAW_, CRITERION_, COS_, SIN_, ROTATED_ = range(7)
 H_, NH = 8, 8  # hardening parameters
 A_, B_, C_ = H_, H_ + 1, H_ + 2
 PAR_, NPAR = H_ + NH, 12  # yield-function parameters
-SIZE = PAR_ + NPAR
-LAW_ELASTIC, LAW_POWER, LAW_SWIFT = 0, 1, 2
-LAWS = {"none": LAW_ELASTIC, "power": LAW_POWER, "swift": LAW_SWIFT}
+TABLE_ = PAR_ + NPAR
+SIZE = TABLE_ + 1  # without a table
+LAW_ELASTIC, LAW_POWER, LAW_SWIFT, LAW_VOCE, LAW_SWIFT_VOCE, LAW_TABLE = range(6)
+LAWS = {"none": LAW_ELASTIC, "power": LAW_POWER, "swift": LAW_SWIFT, "voce": LAW_VOCE, "swift_voce": LAW_SWIFT_VOCE,
+        "table": LAW_TABLE}
 
 
 def number(field: str, value) -> float:
@@ -55,8 +60,10 @@ class SheetMaterial:
     """Plane-stress elastic-plastic sheet: isotropic elasticity, a yield function, isotropic
     hardening.
 
-    hardening: "none" (elastic), "power" (needs yield_stress, n >= 1) or "swift" (needs K,
-    eps0 > 0, n >= 0). yield_function: a name of shellform.material.criteria.CRITERIA (the
+    hardening: "none" (elastic), "power" (needs yield_stress, n >= 1), "swift" (needs K,
+    eps0 > 0, n >= 0), "voce" (yield_stress > 0, Q >= 0, beta > 0), "swift_voce" (all of these
+    and the Swift share 0 < swift_weight < 1) or "table" (flow_curve: rows (p, true stress),
+    extrapolation one of shellform.material.flow_curve.EXTRAPOLATIONS). yield_function: a name of shellform.material.criteria.CRITERIA (the
     paper's "hill79" with r, m by default); its parameters are r, m and the entries of
     yield_parameters (the criterion's file names them). rolling_direction: the angle of the
     rolling direction from the x axis, degrees. Invalid fields raise InputError naming
@@ -75,6 +82,11 @@ class SheetMaterial:
     yield_function: str = "hill79"
     yield_parameters: dict = field(default_factory=dict)
     rolling_direction: float = 0.0
+    Q: float | None = None
+    beta: float | None = None
+    swift_weight: float | None = None
+    flow_curve: object = None  # a table (N + 1, 2) of (p, sigma), or None
+    extrapolation: str | None = None  # table: beyond its last point (required)
 
     def __post_init__(self):
         self.pack()
@@ -106,18 +118,37 @@ class SheetMaterial:
             h = [self._curve("yield_stress"), self._curve("n")]
             require(h[0] > 0.0, "material.yield_stress", f"must be positive, got {h[0]}")
             require(h[1] >= 1.0, "material.n", f"must be >= 1 for the power law, got {h[1]}")
-        elif law == LAW_SWIFT:
+        if law in (LAW_SWIFT, LAW_SWIFT_VOCE):
             h = [self._curve("K"), self._curve("eps0"), self._curve("n")]
             require(h[0] > 0.0, "material.K", f"must be positive, got {h[0]}")
             require(h[1] > 0.0, "material.eps0", f"must be positive, got {h[1]}")
             require(h[2] >= 0.0, "material.n", f"must be >= 0 for the Swift law, got {h[2]}")
-        mat = np.zeros(SIZE)
+        if law in (LAW_VOCE, LAW_SWIFT_VOCE):
+            v = [self._curve("yield_stress"), self._curve("Q"), self._curve("beta")]
+            require(v[0] > 0.0, "material.yield_stress", f"must be positive, got {v[0]}")
+            require(v[1] >= 0.0, "material.Q", f"must be >= 0 (a Voce curve that hardens), got {v[1]}")
+            require(v[2] > 0.0, "material.beta", f"must be positive, got {v[2]}")
+            h += v
+        if law == LAW_SWIFT_VOCE:
+            w = self._curve("swift_weight")
+            require(0.0 < w < 1.0, "material.swift_weight", f"must lie in (0, 1) (0, 1: use voce, swift), got {w}")
+            h.append(w)
+        table = np.zeros(1)
+        if law == LAW_TABLE:
+            from shellform.material.flow_curve import FlowCurve
+
+            require(self.flow_curve is not None, "material.flow_curve", "is required for hardening = 'table'")
+            curve = FlowCurve.from_table(self.flow_curve, self.extrapolation)
+            h = [float(curve.extrapolation_id), *curve.parameters]
+            table = curve.packed
+        mat = np.zeros(SIZE - 1 + len(table))
         mat[E_], mat[NU_], mat[LAW_] = E, nu, float(law)
         mat[CRITERION_] = float(list(criteria.CRITERIA).index(self.yield_function))
         turns = math.remainder(math.degrees(theta), 180.0) != 0.0
         mat[COS_], mat[SIN_], mat[ROTATED_] = (math.cos(theta), math.sin(theta), 1.0) if turns else (1.0, 0.0, 0.0)
         mat[H_:H_ + len(h)] = h
         mat[PAR_:PAR_ + len(par)] = par
+        mat[TABLE_:] = table
         return mat
 
 
@@ -131,7 +162,8 @@ from shellform.material.section import (  # noqa: E402
 )
 
 __all__ = [
-    "SheetMaterial", "Hill79Material", "LAW_ELASTIC", "LAW_POWER", "LAW_SWIFT", "flow_stress",
+    "SheetMaterial", "Hill79Material", "LAW_ELASTIC", "LAW_POWER", "LAW_SWIFT", "LAW_VOCE", "LAW_SWIFT_VOCE",
+    "LAW_TABLE", "flow_stress",
     "equivalent_stress", "yield_derivatives", "return_map", "thickness_strain", "through_thickness_rule",
     "section_response", "elastic_section",
 ]

@@ -186,11 +186,12 @@ def _validate_material(s: Scene) -> None:
     plastic = "plasticity" in s.effects
     if plastic and mat.hardening == "none":
         raise InputError("material.hardening",
-                         "plasticity needs a hardening curve: 'power' (yield_stress, n) or 'swift' (K, eps0, n)")
-    for name in ("yield_stress", "n", "K", "eps0"):
+                         "plasticity needs a hardening curve: " + ", ".join(
+                             f"'{k}' ({', '.join(v)})" for k, v in CURVE_PARAMETERS.items() if v))
+    for name in ("yield_stress", "n", "K", "eps0", "Q", "beta", "swift_weight", "flow_curve", "extrapolation"):
         v = getattr(mat, name)
-        require(math.isfinite(v), f"material.{name}", f"must be finite, got {v}")
-        if v != 0.0:
+        require(isinstance(v, str) or math.isfinite(v), f"material.{name}", f"must be finite, got {v}")
+        if v != 0.0 and v != "":
             require(name in CURVE_PARAMETERS[mat.hardening], f"material.{name}",
                     f"is no parameter of hardening = {mat.hardening!r} "
                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")

@@ -133,6 +133,9 @@ def load(path: str | Path) -> Scene:
     geometry = data.get("geometry")
     if isinstance(geometry, dict) and isinstance(geometry.get("file"), str) and geometry["file"]:
         data["geometry"] = {**geometry, "file": str(path.parent / geometry["file"])}  # relative to the scene
+    material = data.get("material")
+    if isinstance(material, dict) and isinstance(material.get("flow_curve"), str) and material["flow_curve"]:
+        data["material"] = {**material, "flow_curve": str(path.parent / material["flow_curve"])}
     return from_dict(data)
 
 

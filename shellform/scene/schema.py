@@ -37,10 +37,13 @@ REGIONS = ("full", "quarter")  # rectangle
 CIRCLE_REGIONS = ("full", "half", "quarter")
 MESH_KINDS = ("structured", "unstructured")
 DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
-HARDENING = ("none", "power", "swift")
+HARDENING = ("none", "power", "swift", "voce", "swift_voce", "table")
 YIELD_FUNCTIONS = ("hill79", "hill48")  # shellform.material.criteria.CRITERIA
 ANISOTROPY_PARAMETERS = ("r0", "r45", "r90", "sigma0", "sigma45", "sigma90", "sigma_b")  # 0: unset
-CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n")}
+CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n"),
+                    "voce": ("yield_stress", "Q", "beta"),
+                    "swift_voce": ("K", "eps0", "n", "yield_stress", "Q", "beta", "swift_weight"),
+                    "table": ("flow_curve", "extrapolation")}
 
 
 @dataclass
@@ -75,11 +78,16 @@ class Material:
     E: float = 1.0
     nu: float = 0.3
     thickness: float = 0.01
-    hardening: str = "none"  # "none" (elastic), "power" (yield_stress, n) or "swift" (K, eps0, n)
-    yield_stress: float = 0.0  # power law: sigma_y (0: unset)
+    hardening: str = "none"  # one of HARDENING; its parameters: CURVE_PARAMETERS
+    yield_stress: float = 0.0  # power law: sigma_y; Voce: sigma0 (0: unset), MPa
     n: float = 0.0  # power law: n >= 1; Swift: n >= 0
-    K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset)
+    K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset), MPa
     eps0: float = 0.0  # Swift (0: unset)
+    Q: float = 0.0  # Voce: sigma_bar = sigma0 + Q (1 - exp(-beta p)), MPa
+    beta: float = 0.0  # Voce (0: unset)
+    swift_weight: float = 0.0  # Swift-Voce: w Swift + (1 - w) Voce, 0 < w < 1 (0: unset)
+    flow_curve: str = ""  # table: a CSV file of (plastic strain, true stress MPa), relative to the scene
+    extrapolation: str = ""  # table: beyond its last point, one of flow_curve.EXTRAPOLATIONS
     r: float = 1.0  # Lankford coefficient of Hill 1979 (> 0; != 1 needs 'anisotropy')
     m: float = 2.0  # Hill 1979 exponent (>= 1; != 2 needs 'anisotropy')
     yield_function: str = "hill79"  # one of YIELD_FUNCTIONS (shellform.material.criteria); others need 'anisotropy'
@@ -257,8 +265,15 @@ class Scene:
         # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
         n = unset(mat.n) if mat.hardening == "power" else mat.n
         given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
+        table = None
+        if mat.hardening == "table" and mat.flow_curve:
+            from shellform.material.flow_curve import read_csv
+
+            table = read_csv(mat.flow_curve)
         return SheetMaterial(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
-                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction)
+                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction,
+                             unset(mat.Q), unset(mat.beta), unset(mat.swift_weight), table,
+                             mat.extrapolation or None)
 
 
 def bounds(s: Scene) -> tuple[float, float, float, float]:
