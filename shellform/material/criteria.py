@@ -14,10 +14,10 @@ CRITERIA, listed in the same order). numba compiles the dispatch into a switch o
 id; each criterion's code is inlined into its branch (docs/material.md: cost).
 """
 
-from shellform.material import CRITERION_, hill48, hill79
+from shellform.material import CRITERION_, hill48, hill79, yld2000
 from shellform import _jit as jit
 
-CRITERIA = {m.NAME: m for m in (hill79, hill48)}  # name -> module; the id of each is its place here
+CRITERIA = {m.NAME: m for m in (hill79, hill48, yld2000)}  # name -> module; the id of each is its place here
 
 
 @jit.njit
@@ -26,4 +26,6 @@ def yield_function(s0, s1, s2, mat, order):
     c = mat[CRITERION_]
     if c == 1.0:
         return hill48.yield_function(s0, s1, s2, mat, order)
+    if c == 2.0:
+        return yld2000.yield_function(s0, s1, s2, mat, order)
     return hill79.yield_function(s0, s1, s2, mat, order)

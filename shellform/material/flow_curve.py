@@ -30,19 +30,20 @@ FIELD = "material.flow_curve"
 MAX_BYTES = 1_000_000  # a flow curve is a few hundred rows at most
 
 
-def read_csv(path) -> np.ndarray:
-    """The (p, sigma) rows of a .csv file (at most MAX_BYTES): two numeric columns, an optional
-    header line, '#' comments; InputError naming material.flow_curve where it cannot be read
-    (no line of the file is echoed)."""
+def read_csv(path, field: str = FIELD, columns: str = "plastic strain, true stress") -> np.ndarray:
+    """The rows of a .csv file (at most MAX_BYTES) of two numeric columns (here the flow
+    curve's p, sigma; shellform.results.fld reads a forming-limit curve with it), an optional
+    header line, '#' comments; InputError naming `field` where it cannot be read (no line of
+    the file is echoed)."""
     path = Path(path)
     if path.suffix.lower() != ".csv":
-        raise InputError(FIELD, f"must be a .csv file, got {path.name!r}")
+        raise InputError(field, f"must be a .csv file, got {path.name!r}")
     try:
         if path.stat().st_size > MAX_BYTES:
-            raise InputError(FIELD, f"{path.name} is larger than {MAX_BYTES // 1000} kB: no flow curve is")
+            raise InputError(field, f"{path.name} is larger than {MAX_BYTES // 1000} kB: no such table is")
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as err:
-        raise InputError(FIELD, f"cannot read {str(path)!r}: {err}") from None
+        raise InputError(field, f"cannot read {str(path)!r}: {err}") from None
     rows = []
     for k, row in enumerate(csv.reader(line for line in text.splitlines() if line.strip()
                                        and not line.lstrip().startswith("#"))):
@@ -51,10 +52,9 @@ def read_csv(path) -> np.ndarray:
         except ValueError:
             if k == 0 and not rows:
                 continue  # a header
-            raise InputError(FIELD, f"{path.name}: row {k + 1} is not two numbers") from None
+            raise InputError(field, f"{path.name}: row {k + 1} is not two numbers") from None
         if len(values) != 2:
-            raise InputError(FIELD, f"{path.name}: row {k + 1} has {len(values)} columns, needs 2 "
-                                    "(plastic strain, true stress)")
+            raise InputError(field, f"{path.name}: row {k + 1} has {len(values)} columns, needs 2 ({columns})")
         rows.append(values)
     return np.array(rows, dtype=np.float64).reshape(-1, 2)
 

@@ -16,7 +16,7 @@ from shellform.errors import InputError
 from shellform.mesh import outline
 from shellform.scene import machine
 from shellform.scene.schema import (ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING,
-                                    MAY_BE_INFINITE, YIELD_FUNCTIONS,
+                                    MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS,
                                     MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, REGIONS, SIDES, SPREADS,
                                     SUPPORTS, TOOL_SHAPES, Scene, ToolsSpec, bounds)
 
@@ -173,11 +173,13 @@ def _validate_material(s: Scene) -> None:
             f"must be one of {', '.join(YIELD_FUNCTIONS)}, got {mat.yield_function!r}")
     require(math.isfinite(mat.rolling_direction), "material.rolling_direction",
             f"must be finite (degrees), got {mat.rolling_direction}")
-    for name in ANISOTROPY_PARAMETERS:
+    for name in ANISOTROPY_PARAMETERS + ("alpha",):
         v = getattr(mat, name)
-        require(math.isfinite(v) and v >= 0.0, f"material.{name}", f"must be > 0 (0: unset), got {v}")
-        require(v == 0.0 or mat.yield_function == "hill48", f"material.{name}",
-                f"is no parameter of yield_function = {mat.yield_function!r}")
+        if name != "alpha":
+            require(math.isfinite(v) and v >= 0.0, f"material.{name}", f"must be > 0 (0: unset), got {v}")
+        require(not v or name in YIELD_PARAMETERS[mat.yield_function], f"material.{name}",
+                f"is no parameter of yield_function = {mat.yield_function!r} "
+                f"(its parameters: {', '.join(YIELD_PARAMETERS[mat.yield_function])})")
     for name, default in (("r", 1.0), ("m", 2.0)):
         require(mat.yield_function == "hill79" or getattr(mat, name) == default, f"material.{name}",
                 f"is Hill 1979's; yield_function = {mat.yield_function!r} takes its own parameters")
@@ -196,7 +198,11 @@ def _validate_material(s: Scene) -> None:
                     f"is no parameter of hardening = {mat.hardening!r} "
                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")
     if plastic:
-        s.hill79()  # Hill79Material validates the curve and names the field
+        s.hill79()  # SheetMaterial validates the curve and names the field
+    if plastic and (mat.forming_limit_curve or (s.tools is not None and s.output.fld)):
+        from shellform.results import fld
+
+        fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n
 
 
 def _validate_loads(s: Scene) -> None:

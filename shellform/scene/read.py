@@ -134,8 +134,9 @@ def load(path: str | Path) -> Scene:
     if isinstance(geometry, dict) and isinstance(geometry.get("file"), str) and geometry["file"]:
         data["geometry"] = {**geometry, "file": str(path.parent / geometry["file"])}  # relative to the scene
     material = data.get("material")
-    if isinstance(material, dict) and isinstance(material.get("flow_curve"), str) and material["flow_curve"]:
-        data["material"] = {**material, "flow_curve": str(path.parent / material["flow_curve"])}
+    for key in ("flow_curve", "forming_limit_curve"):  # files relative to the scene
+        if isinstance(material, dict) and isinstance(material.get(key), str) and material[key]:
+            material = data["material"] = {**material, key: str(path.parent / material[key])}
     return from_dict(data)
 
 
