@@ -5,13 +5,15 @@ A yield function is one file in shellform/material/ holding
     NAME                      its name in a scene (material.yield_function)
     parameters(values)        its parameters from the material's keys, validated (InputError
                               naming the field), as a list of at most NPAR floats (packed at PAR_)
-    yield_function(s0, s1, s2, mat, order)   numba: sigma_bar(s) in the rolling-direction axes,
-                              and for order > 0 its gradient (3) and Hessian (6, upper triangle),
-                              as one 10-tuple
+    yield_function(s0, s1, s2, mat, order)   numba (inline="always"): sigma_bar(s) in the
+                              rolling-direction axes, and for order > 0 its gradient (3)
+                              and Hessian (6, upper triangle), as one 10-tuple
 
-and it is registered by one line in ``yield_function`` below (its id is its place in
-CRITERIA, listed in the same order). numba compiles the dispatch into a switch on the packed
-id; each criterion's code is inlined into its branch (docs/material.md: cost).
+It is registered here: its module in CRITERIA (its id is its place there) and one line in
+``yield_function`` below, in the same order; its scene keys go to YIELD_PARAMETERS in
+shellform/scene/schema.py. numba compiles the dispatch into a switch on the packed
+id; each criterion's yield_function is declared inline="always" (numba IR inlining) and so
+inlined into its branch (docs/material.md: cost).
 """
 
 from shellform.material import CRITERION_, hill48, hill79, yld2000
@@ -20,7 +22,7 @@ from shellform import _jit as jit
 CRITERIA = {m.NAME: m for m in (hill79, hill48, yld2000)}  # name -> module; the id of each is its place here
 
 
-@jit.njit
+@jit.njit(inline="always")
 def yield_function(s0, s1, s2, mat, order):
     """sigma_bar(s) and (order > 0) its derivatives, of the packed material's criterion."""
     c = mat[CRITERION_]

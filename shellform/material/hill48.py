@@ -86,7 +86,7 @@ def sigma_theta(values: dict, theta_deg: float) -> float:
     return (F * s2 * s2 + G * c2 * c2 + H * (c2 - s2) ** 2 + 2.0 * N * s2 * c2) ** -0.5
 
 
-@jit.njit
+@jit.njit(inline="always")
 def yield_function(s0, s1, s2, mat, order):
     """sigma_bar (order 0: the rest zero) or sigma_bar, gradient and Hessian (upper triangle)."""
     p11, p12, p22, p33 = mat[PAR_], mat[PAR_ + 1], mat[PAR_ + 2], mat[PAR_ + 3]

@@ -140,7 +140,7 @@ def yield_derivatives(s, r, m, a, H):
     return sb
 
 
-@jit.njit
+@jit.njit(inline="always")
 def yield_function(s0, s1, s2, mat, order):
     """sigma_bar (order 0: the rest zero) or sigma_bar, gradient (3) and Hessian (h00, h01, h02,
     h11, h12, h22) for the packed material (shellform.material.criteria)."""

@@ -133,7 +133,7 @@ def _rho(l00, l01, l10, l11, l22, s0, s1, s2):
             (gd1 * gd1 + EPS2 - r1 * r1) * g, -r1 * r2 * g, (l22 * l22 + 2.0 * EPS2 - r2 * r2) * g)
 
 
-@jit.njit
+@jit.njit(inline="always")
 def yield_function(s0, s1, s2, mat, order):
     """sigma_bar (order 0: the rest zero) or sigma_bar, gradient and Hessian (upper triangle)."""
     P = PAR_
