@@ -359,3 +359,39 @@ def test_scene_material_with_yld2000_fitted_from_the_data():
                          "material": {**SWIFT, "yield_function": "hill48", "r0": 1.0, "r45": 1.0, "r90": 1.0,
                                       "alpha": AA2090}})
     assert err.value.field == "material.alpha"
+
+
+@pytest.mark.parametrize("criterion", ["hill48", "yld2000"])
+def test_assembled_tangent_with_a_turned_rolling_direction(criterion):
+    """A strip of Hill 1948 (steel) or Yld2000-2d (AA2090-T3), rolling direction 30 degrees from
+    its axis, finite strains, pulled at one end to a stretch of 1.2; at a state a little further
+    on (every plastic layer loading, nothing committed) the assembled tangent equals a central
+    difference of the assembled residual, to 1e-5 of its largest entry."""
+    from shellform.studies import strip
+
+    params = ({"yield_function": "hill48", "yield_parameters": STEEL} if criterion == "hill48" else
+              {"yield_function": "yld2000", "yield_parameters": {"alpha": AA2090, "a": 8.0}})
+    mat = SheetMaterial(E=206e3, nu=0.3, hardening="swift", K=565.32, eps0=0.007117, n=0.2589,
+                        rolling_direction=30.0, **params)
+    p, _ = strip.strip(mat, 1.2, homogeneous=False, steps=4, n=2)
+    d = p.driver
+    x0 = 1.003 * d.q.x.array  # further along the pull: the layers keep loading
+
+    def residual(x):
+        d.q.x.array[:] = x
+        _, _, ev = d.residual(1.0, tangent=True)
+        assert not ev.failed
+        return d.b.getArray().copy(), ev
+
+    _, ev = residual(x0)
+    assert ev.plastic_layers > 0
+    A = d.A.copy().convert("dense").getDenseArray()
+    free = np.setdiff1d(np.arange(x0.size), d.bc_dofs)
+    h = 1e-7 * np.abs(x0).max()
+    scale = np.abs(A[free][:, free]).max()
+    for j in np.random.default_rng(0).choice(free, 12, replace=False):
+        xp, xm = x0.copy(), x0.copy()
+        xp[j] += h
+        xm[j] -= h
+        col = (residual(xp)[0] - residual(xm)[0]) / (2 * h)
+        assert np.abs(col[free] - A[free, j]).max() <= 1e-5 * scale
