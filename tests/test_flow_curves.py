@@ -145,3 +145,10 @@ def test_a_csv_that_cannot_be_read_is_named(tmp_path, content, name, words):
         scene.from_dict({"effects": SHEET, "material": {"hardening": "table", "extrapolation": "constant",
                                                          "flow_curve": str(tmp_path / name)}})
     assert err.value.field == "material.flow_curve" and words in str(err.value)
+
+
+def test_the_material_line_states_the_extrapolation():
+    """SheetMaterial.describe (a run's log line) names the table's fitted extrapolation."""
+    line = SheetMaterial(E, NU, hardening="table", flow_curve=table(swift), extrapolation="swift").describe()
+    assert line.startswith("material: yield function hill79; r 1, m 2; hardening table; beyond p = 0.3")
+    assert "Swift 565.32 (0.007117 + p)^0.2589 fitted to the last 7 points" in line

@@ -151,6 +151,22 @@ class SheetMaterial:
         mat[TABLE_:] = table
         return mat
 
+    def describe(self) -> str:
+        """One line: the yield function (its parameters, the rolling direction) and the flow
+        curve (a table's extrapolation as fitted), for a run's log."""
+        words = [f"yield function {self.yield_function}"]
+        if self.yield_function == "hill79":
+            words.append(f"r {self.r:g}, m {self.m:g}")
+        else:
+            words.append(", ".join(f"{k} {v}" for k, v in self.yield_parameters.items()))
+            words.append(f"rolling direction {float(self.rolling_direction):g} deg from x")
+        words.append(f"hardening {self.hardening}")
+        if self.hardening == "table":
+            from shellform.material.flow_curve import FlowCurve
+
+            words.append(FlowCurve.from_table(self.flow_curve, self.extrapolation).extrapolation_text)
+        return "material: " + "; ".join(words)
+
 
 Hill79Material = SheetMaterial  # the paper's material (Hill 1979 by default), by its former name
 
