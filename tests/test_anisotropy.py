@@ -305,6 +305,18 @@ def test_yld2000_aa2090_reproduces_the_data_it_was_fitted_to():
     assert biaxial == pytest.approx(closed["sigma_b"], rel=1e-8)
 
 
+@pytest.mark.parametrize("theta", ANGLES)
+def test_yld2000_lankford_and_yield_stress_at_every_15_degrees(theta):
+    """AA2090-T3: the material point's r(theta) (uniaxial tension) and sigma(theta)/sigma_bar
+    (perfectly plastic) equal the closed forms of the yield function to 1e-8 at 0, 15, .., 90
+    degrees to the rolling direction; the Lankford value swings from 0.21 to 1.58 and back."""
+    sigma, r = yld2000.uniaxial(AA2090, 8.0, theta)
+    assert point.lankford(yld2000_material(-theta).pack(), 0.05) == pytest.approx(r, rel=1e-8)
+    ratio = point.stress_ratio_yield(yld2000_material(-theta, perfect=True).pack(), 0.0) / SY
+    assert ratio == pytest.approx(sigma, rel=1e-8)
+    assert 0.2 < r < 1.6 and 0.8 < sigma < 1.01
+
+
 def test_yld2000_fit_recovers_the_published_alphas():
     """The alphas fitted to AA2090-T3's eight data (a = 8) are the published ones to within
     the data's and the alphas' 4 digits (2e-3 absolute), and meet the data to 1e-8; the

@@ -175,6 +175,17 @@ def yield_function(s0, s1, s2, mat, order):
     return sb, a0, a1, a2, h00, h01, h02, h11, h12, h22
 
 
+def uniaxial(alpha, a, theta_deg: float) -> tuple[float, float]:
+    """(sigma(theta)/sigma_bar, r(theta)) of uniaxial tension at theta degrees to the rolling
+    direction: s = sigma (c^2, s^2, c s) on the yield surface, r the width over the thickness
+    plastic strain rate of the flow a(s): (s^2 a0 + c^2 a1 - s c a2) / -(a0 + a1)."""
+    mat = np.zeros(PAR_ + 11)
+    mat[PAR_:] = pack(alpha, a)
+    c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
+    sb, a0, a1, a2 = yield_function(c * c, s * s, c * s, mat, 1)[:4]
+    return 1.0 / sb, (s * s * a0 + c * c * a1 - s * c * a2) / -(a0 + a1)
+
+
 def uniaxial_and_biaxial(alpha, a) -> dict:
     """The yield stresses (over sigma_bar) and Lankford values of the alpha set: sigma and r at
     0, 45, 90 degrees to the rolling direction, and the balanced-biaxial sigma_b and
@@ -183,11 +194,7 @@ def uniaxial_and_biaxial(alpha, a) -> dict:
     mat[PAR_:] = pack(alpha, a)
     out = {}
     for theta in (0, 45, 90):
-        c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
-        n = (c * c, s * s, c * s)
-        sb, a0, a1, a2 = yield_function(*n, mat, 1)[:4]
-        out[f"sigma{theta}"] = 1.0 / sb
-        out[f"r{theta}"] = (s * s * a0 + c * c * a1 - s * c * a2) / -(a0 + a1)
+        out[f"sigma{theta}"], out[f"r{theta}"] = uniaxial(alpha, a, theta)
     sb, a0, a1, _ = yield_function(1.0, 1.0, 0.0, mat, 1)[:4]
     out["sigma_b"], out["r_b"] = 1.0 / sb, a1 / a0
     return out
