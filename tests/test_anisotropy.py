@@ -407,3 +407,16 @@ def test_assembled_tangent_with_a_turned_rolling_direction(criterion):
         xm[j] -= h
         col = (residual(xp)[0] - residual(xm)[0]) / (2 * h)
         assert np.abs(col[free] - A[free, j]).max() <= 1e-5 * scale
+
+
+def test_a_planar_isotropic_criterion_ignores_the_rolling_direction():
+    """Hill 1979 is planar isotropic: a rolling direction packs the same material (no turn);
+    Hill 1948 with a turned rolling direction is turned, with one a whole turn of 180 degrees
+    away is not."""
+    from shellform.material import ROTATED_
+
+    h79 = [SheetMaterial(E, NU, 1.7, 6.0, "swift", K=500.0, eps0=0.02, n=0.25, rolling_direction=rd).pack()
+           for rd in (0.0, 30.0)]
+    np.testing.assert_array_equal(h79[0], h79[1])
+    assert hill48_material(STEEL, 30.0).pack()[ROTATED_] == 1.0
+    np.testing.assert_array_equal(hill48_material(STEEL, 180.0).pack(), hill48_material(STEEL, 0.0).pack())

@@ -10,7 +10,8 @@ A material travels to the numba functions as one packed float64 array ``mat`` (s
     CRITERION_    the yield function's id (shellform.material.criteria: its place in CRITERIA)
     COS_, SIN_    cos and sin of the rolling direction's angle theta from the x axis
     ROTATED_      1.0 where the return mapping turns strains into the rolling-direction axes
-                  (theta not a multiple of 180 degrees), else 0.0
+                  (theta not a multiple of 180 degrees, a criterion that is not planar
+                  isotropic), else 0.0
     PAR_ .. PAR_+NPAR  the yield function's parameters (its file says which)
     TABLE_ ..     a tabulated flow curve: its number of points N + 1, p_0..p_N, sigma_0..sigma_N
                   (shellform.material.flow_curve; the array ends there, 1 + 0 points without one)
@@ -144,7 +145,7 @@ class SheetMaterial:
         mat = np.zeros(SIZE - 1 + len(table))
         mat[E_], mat[NU_], mat[LAW_] = E, nu, float(law)
         mat[CRITERION_] = float(list(criteria.CRITERIA).index(self.yield_function))
-        turns = math.remainder(math.degrees(theta), 180.0) != 0.0
+        turns = math.remainder(math.degrees(theta), 180.0) != 0.0 and not criterion.PLANAR_ISOTROPIC
         mat[COS_], mat[SIN_], mat[ROTATED_] = (math.cos(theta), math.sin(theta), 1.0) if turns else (1.0, 0.0, 0.0)
         mat[H_:H_ + len(h)] = h
         mat[PAR_:PAR_ + len(par)] = par

@@ -3,6 +3,8 @@
 A yield function is one file in shellform/material/ holding
 
     NAME                      its name in a scene (material.yield_function)
+    PLANAR_ISOTROPIC          True where the rolling direction changes nothing (the return
+                              mapping then does not turn into its axes)
     parameters(values)        its parameters from the material's keys, validated (InputError
                               naming the field), as a list of at most NPAR floats (packed at PAR_)
     yield_function(s0, s1, s2, mat, order)   numba (inline="always"): sigma_bar(s) in the

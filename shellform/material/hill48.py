@@ -31,6 +31,7 @@ from shellform.material import PAR_, number, require
 from shellform import _jit as jit
 
 NAME = "hill48"
+PLANAR_ISOTROPIC = False  # the rolling direction matters: the return mapping turns into its axes
 LANKFORD = ("r0", "r45", "r90")
 STRESSES = ("sigma0", "sigma45", "sigma90", "sigma_b")
 

@@ -45,6 +45,7 @@ from shellform.material import PAR_, number, require
 from shellform import _jit as jit
 
 NAME = "yld2000"
+PLANAR_ISOTROPIC = False  # the rolling direction matters: the return mapping turns into its axes
 EPS2 = 1.0e-24
 
 
