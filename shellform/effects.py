@@ -67,12 +67,18 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
                "initial-stress stiffness"),
     Effect("plasticity", "sheet part", "shellform.material.section", (SHEET, TOOLS), ("bending", "membrane"),
            why="is an effect of the nonlinear sheet, a full shell",
-           keys=("material.hardening", "material.yield_stress", "material.n", "material.K", "material.eps0"),
+           keys=("material.hardening", "material.yield_stress", "material.n", "material.K", "material.eps0",
+                 "material.Q", "material.beta", "material.swift_weight", "material.flow_curve",
+                 "material.extrapolation", "material.forming_limit_curve"),
            doc="elastic-plastic layers through the thickness (process.thickness_points), Hill 1979 with "
                "isotropic hardening"),
-    Effect("anisotropy", "material data", "shellform.material.hill79", (SHEET, TOOLS), ("plasticity",),
-           why="shapes the yield function", keys=("material.r", "material.m"),
-           doc="r != 1 or m != 2 in the Hill 1979 yield function; it adds no term"),
+    Effect("anisotropy", "material data", "shellform.material.criteria", (SHEET, TOOLS), ("plasticity",),
+           why="shapes the yield function",
+           keys=("material.r", "material.m", "material.yield_function", "material.rolling_direction",
+                 "material.r0", "material.r45", "material.r90", "material.r_b", "material.sigma0",
+                 "material.sigma45", "material.sigma90", "material.sigma_b", "material.alpha", "material.a"),
+           doc="r != 1 or m != 2 in the Hill 1979 yield function, or a planar-anisotropic one "
+               "(material.yield_function, its parameters, material.rolling_direction); it adds no term"),
     Effect("finite_strain", "sheet part", "shellform.material.hencky", (SHEET, TOOLS),
            ("plasticity", "geometric_nonlinearity"), why="(logarithmic strains, thinning) acts on plastic layers "
                                                           "in large displacements",

@@ -56,6 +56,10 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     way = route(s)
     if resume and way != "tools":
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
+    if s.nonlinear and "plasticity" in s.effects:
+        from shellform.results.log import say
+
+        say(s.hill79().describe())  # the material as it is taken, a table's extrapolation stated
     if way == "tools":
         from shellform.contact import run as tools
 

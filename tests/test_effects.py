@@ -66,7 +66,13 @@ def test_keys_of_an_effect_that_is_off_keep_their_defaults():
     is refused naming that key; with the effect (and its needs) on, the same value is taken."""
     values = {"surface.R1": 2.0, "surface.R2": 3.0, "surface.z0": "0.1*x*y", "material.hardening": "power",
               "material.yield_stress": 1e-3, "material.n": 5.0, "material.K": 1.0, "material.eps0": 0.01,
-              "material.r": 1.5, "material.m": 8.0, "tools.friction": 0.1,
+              "material.r": 1.5, "material.m": 8.0, "material.yield_function": "hill48",
+              "material.rolling_direction": 30.0, "material.r0": 1.8, "material.r45": 1.5, "material.r90": 2.3,
+              "material.sigma0": 1.0, "material.sigma45": 1.0, "material.sigma90": 1.0, "material.sigma_b": 1.0, "material.r_b": 0.7, "material.a": 8.0,
+              "material.alpha": [1.0] * 8,
+              "material.Q": 100.0, "material.beta": 10.0, "material.swift_weight": 0.5, "material.flow_curve": "c.csv",
+              "material.extrapolation": "swift", "material.forming_limit_curve": "flc.csv",
+              "tools.friction": 0.1,
               "tools.drawbead": [{"points": [[45.0, 0.0], [45.0, 50.0]], "restraint": 10.0}]}
     base = {"effects": ["bending", "membrane", "geometric_nonlinearity", "contact"],
             "geometry": {"lx": 100.0, "ly": 100.0, "region": "quarter"}, "material": {"thickness": 0.8},

@@ -10,7 +10,8 @@ from shellform.material import (
     Hill79Material, elastic_section, equivalent_stress, flow_stress, point, return_map,
     section_response, thickness_strain, through_thickness_rule, yield_derivatives,
 )
-from shellform.material.hill79 import _return_core
+from shellform.material import A_, B_, C_, COS_, E_, LAW_, NU_, PAR_
+from shellform.material.plane_stress import return_core as _return_core
 
 E, NU, SY = 200e3, 0.3, 250.0
 EY = SY / E
@@ -144,7 +145,7 @@ def test_consistent_tangent_is_derivative(m, law):
 def check_closest_point(e, mat, ep_n, p_n, s, ep, p):
     """C^-1 s + dlambda a(s) = e - ep_n and sigma_bar(s) = sigma_f(p)."""
     a = np.zeros(3)
-    sb = yield_derivatives(s, mat[2], mat[3], a, np.zeros((3, 3)))
+    sb = yield_derivatives(s, mat[PAR_], mat[PAR_ + 1], a, np.zeros((3, 3)))
     assert sb == pytest.approx(flow_stress(p, mat)[0], rel=1e-11)
     np.testing.assert_allclose(compliance() @ s + (p - p_n) * a, e - ep_n,
                                atol=1e-11 * np.linalg.norm(e - ep_n))
@@ -410,9 +411,11 @@ def test_material_input_errors_name_the_field(kwargs, field):
 
 def test_pack_layout():
     mat = Hill79Material(E, NU, 1.5, 6.0, "swift", K=500.0, eps0=0.01, n=0.2).pack()
-    np.testing.assert_array_equal(mat, [E, NU, 1.5, 6.0, 2.0, 500.0, 0.01, 0.2])
+    slots = [E_, NU_, PAR_, PAR_ + 1, LAW_, A_, B_, C_]
+    np.testing.assert_array_equal(mat[slots], [E, NU, 1.5, 6.0, 2.0, 500.0, 0.01, 0.2])
+    assert mat[COS_] == 1.0 and np.count_nonzero(np.delete(mat, slots + [COS_])) == 0  # rolling direction along x
     assert mat.dtype == np.float64
-    np.testing.assert_array_equal(power(2.0, 1.0, 4.0)[4:7], [1.0, SY, 4.0])
+    np.testing.assert_array_equal(power(2.0, 1.0, 4.0)[[LAW_, A_, B_]], [1.0, SY, 4.0])
 
 
 @pytest.mark.slow

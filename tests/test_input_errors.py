@@ -77,7 +77,7 @@ POWER = {"hardening": "power", "yield_stress": 2.0e-3, "n": 5.0}
     ({"effects": PLASTIC, "material": {"hardening": "swift", "eps0": 0.01, "n": 0.2}}, "material.K"),
     ({"effects": PLASTIC, "material": {"hardening": "swift", "K": 1.0, "n": 0.2}}, "material.eps0"),
     ({"effects": PLASTIC, "material": {**POWER, "K": 1.0}}, "material.K"),  # not a power-law parameter
-    ({"effects": PLASTIC, "material": {"hardening": "voce"}}, "material.hardening"),
+    ({"effects": PLASTIC, "material": {"hardening": "ludwik"}}, "material.hardening"),
     ({"effects": PLASTIC, "material": {**POWER, "thickness": -0.01}}, "material.thickness"),
     ({"effects": PLASTIC, "material": POWER, "process": {"thickness_points": 1}}, "process.thickness_points"),
     ({"process": {"min_step": 0.2, "initial_step": 0.1}}, "process.min_step"),
@@ -125,14 +125,20 @@ def test_elastic_plastic_anisotropic_scene():
     assert s.loads.moment == [scene.EdgeMoment("right", -2.0)]
     assert s.process.path == [1.0, 0.0] and s.process.thickness_points == 7
     mat = s.hill79().pack()
-    assert (mat[2], mat[3]) == (1.8, 6.0)  # r and m
-    assert list(mat) == [2.1e5, 0.3, 1.8, 6.0, 2.0, 550.0, 0.005, 0.22]  # law 2: Swift
+    import numpy as np
+
+    from shellform.material import A_, B_, C_, COS_, E_, LAW_, NU_, PAR_
+    assert (mat[PAR_], mat[PAR_ + 1]) == (1.8, 6.0)  # r and m
+    slots = [E_, NU_, PAR_, PAR_ + 1, LAW_, A_, B_, C_]
+    assert list(mat[slots]) == [2.1e5, 0.3, 1.8, 6.0, 2.0, 550.0, 0.005, 0.22]  # law 2: Swift
+    assert mat[COS_] == 1.0 and np.count_nonzero(np.delete(mat, slots + [COS_])) == 0  # rolling direction along x
 
 
 def test_linear_scenes_are_not_nonlinear():
     s = scene.from_dict({"effects": FULL, "process": {"path": [0.5]}})  # [process] is allowed, ignored
     assert not s.nonlinear
-    assert s.hill79().pack()[4] == 0.0  # elastic
+    from shellform.material import LAW_
+    assert s.hill79().pack()[LAW_] == 0.0  # elastic
 
 
 def test_mesh_that_is_not_triangles():

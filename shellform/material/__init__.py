@@ -1,21 +1,27 @@
-"""Elastic-plastic sheet material: plane stress, Hill 1979 (planar isotropy), numba kernels.
+"""Elastic-plastic sheet material: plane stress, a registered yield function, numba kernels.
 
-A material travels to the numba functions as one packed float64 array
+A material travels to the numba functions as one packed float64 array ``mat`` (slots by name):
 
-    mat = [E, nu, r, m, law, a, b, c]
+    E_, NU_       Young's modulus and Poisson ratio (plane-stress isotropic elasticity)
+    LAW_          the hardening law: 0 elastic (never yields), 1 power law, 2 Swift, 3 Voce,
+                  4 Swift-Voce, 5 table (shellform.material.hardening states each law and its
+                  parameters H_ ...)
+    H_ .. H_+NH   the hardening law's parameters (A_, B_, C_ the first three)
+    CRITERION_    the yield function's id (shellform.material.criteria: its place in CRITERIA)
+    COS_, SIN_    cos and sin of the rolling direction's angle theta from the x axis
+    ROTATED_      1.0 where the return mapping turns strains into the rolling-direction axes
+                  (theta not a multiple of 180 degrees, a criterion that is not planar
+                  isotropic), else 0.0
+    PAR_ .. PAR_+NPAR  the yield function's parameters (its file says which)
+    TABLE_ ..     a tabulated flow curve: its number of points N + 1, p_0..p_N, sigma_0..sigma_N
+                  (shellform.material.flow_curve; the array ends there, 1 + 0 points without one)
 
-    E, nu   Young's modulus and Poisson ratio (plane-stress isotropic elasticity)
-    r, m    Lankford coefficient and Hill-1979 exponent (r > 0, m >= 1)
-    law     0 elastic (never yields)
-            1 power law  eps_bar / eps_y = (sigma_bar / sigma_y)^n above yield, eps_y = sigma_y/E,
-                         eps_bar the total uniaxial strain; a = sigma_y, b = n >= 1 (1: perfect)
-            2 Swift      sigma_bar = K (eps0 + p)^n;  a = K, b = eps0 > 0, c = n >= 0 (0: perfect)
-
-Modules: hardening (flow stress), hill79 (yield function, return map), section (through-thickness
-integration), point (material-point drivers for tests and studies).
+The yield function, its parameters and its derivatives live in one file each (hill79, ...);
+the return mapping (plane_stress) is written once for all of them; section integrates the
+layers through the thickness; point drives a material point for tests and studies.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 
 import numpy as np
@@ -23,12 +29,19 @@ import numpy as np
 from shellform.errors import InputError
 
 # Packed layout (the numba modules read these as compile-time constants).
-E_, NU_, R_, M_, LAW_, A_, B_, C_ = range(8)
-LAW_ELASTIC, LAW_POWER, LAW_SWIFT = 0, 1, 2
-LAWS = {"none": LAW_ELASTIC, "power": LAW_POWER, "swift": LAW_SWIFT}
+E_, NU_, LAW_, CRITERION_, COS_, SIN_, ROTATED_ = range(7)
+H_, NH = 8, 8  # hardening parameters
+A_, B_, C_ = H_, H_ + 1, H_ + 2
+PAR_, NPAR = H_ + NH, 12  # yield-function parameters
+TABLE_ = PAR_ + NPAR
+SIZE = TABLE_ + 1  # without a table
+LAW_ELASTIC, LAW_POWER, LAW_SWIFT, LAW_VOCE, LAW_SWIFT_VOCE, LAW_TABLE = range(6)
+LAWS = {"none": LAW_ELASTIC, "power": LAW_POWER, "swift": LAW_SWIFT, "voce": LAW_VOCE, "swift_voce": LAW_SWIFT_VOCE,
+        "table": LAW_TABLE}
 
 
-def _number(field: str, value) -> float:
+def number(field: str, value) -> float:
+    """value as a finite float, else InputError naming `field`."""
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -38,17 +51,24 @@ def _number(field: str, value) -> float:
     return x
 
 
-def _require(ok: bool, field: str, message: str) -> None:
+def require(ok: bool, field: str, message: str) -> None:
     if not ok:
         raise InputError(field, message)
 
 
 @dataclass(frozen=True)
-class Hill79Material:
-    """Plane-stress elastic-plastic sheet: isotropic elasticity, Hill 1979, isotropic hardening.
+class SheetMaterial:
+    """Plane-stress elastic-plastic sheet: isotropic elasticity, a yield function, isotropic
+    hardening.
 
-    hardening: "none" (elastic), "power" (needs yield_stress, n >= 1) or "swift" (needs K,
-    eps0 > 0, n >= 0). Invalid fields raise InputError naming ``material.<field>``.
+    hardening: "none" (elastic), "power" (needs yield_stress, n >= 1), "swift" (needs K,
+    eps0 > 0, n >= 0), "voce" (yield_stress > 0, Q >= 0, beta > 0), "swift_voce" (all of these
+    and the Swift share 0 < swift_weight < 1) or "table" (flow_curve: rows (p, true stress),
+    extrapolation one of shellform.material.flow_curve.EXTRAPOLATIONS). yield_function: a name of shellform.material.criteria.CRITERIA (the
+    paper's "hill79" with r, m by default); its parameters are r, m and the entries of
+    yield_parameters (the criterion's file names them). rolling_direction: the angle of the
+    rolling direction from the x axis, degrees. Invalid fields raise InputError naming
+    ``material.<field>``.
     """
 
     E: float
@@ -60,52 +80,107 @@ class Hill79Material:
     n: float | None = None
     K: float | None = None
     eps0: float | None = None
+    yield_function: str = "hill79"
+    yield_parameters: dict = field(default_factory=dict)
+    rolling_direction: float = 0.0
+    Q: float | None = None
+    beta: float | None = None
+    swift_weight: float | None = None
+    flow_curve: object = None  # a table (N + 1, 2) of (p, sigma), or None
+    extrapolation: str | None = None  # table: beyond its last point (required)
 
     def __post_init__(self):
         self.pack()
 
     def _curve(self, name: str) -> float:
         value = getattr(self, name)
-        _require(value is not None, f"material.{name}",
-                 f"is required for hardening = {self.hardening!r}")
-        return _number(f"material.{name}", value)
+        require(value is not None, f"material.{name}", f"is required for hardening = {self.hardening!r}")
+        return number(f"material.{name}", value)
 
     def pack(self) -> np.ndarray:
-        """Validate the fields and return mat = [E, nu, r, m, law, a, b, c] (float64)."""
-        E = _number("material.E", self.E)
-        nu = _number("material.nu", self.nu)
-        r = _number("material.r", self.r)
-        m = _number("material.m", self.m)
-        _require(E > 0.0, "material.E", f"must be positive, got {E}")
-        _require(-1.0 < nu < 0.5, "material.nu", f"must lie in (-1, 0.5), got {nu}")
-        _require(r > 0.0, "material.r", f"must be positive, got {r}")
-        _require(m >= 1.0, "material.m", f"must be >= 1 (convex yield function), got {m}")
-        _require(isinstance(self.hardening, str) and self.hardening in LAWS, "material.hardening",
-                 f"must be one of {', '.join(LAWS)}, got {self.hardening!r}")
-        law = LAWS[self.hardening]
-        a = b = c = 0.0
-        if law == LAW_POWER:
-            a, b = self._curve("yield_stress"), self._curve("n")
-            _require(a > 0.0, "material.yield_stress", f"must be positive, got {a}")
-            _require(b >= 1.0, "material.n", f"must be >= 1 for the power law, got {b}")
-        elif law == LAW_SWIFT:
-            a, b, c = self._curve("K"), self._curve("eps0"), self._curve("n")
-            _require(a > 0.0, "material.K", f"must be positive, got {a}")
-            _require(b > 0.0, "material.eps0", f"must be positive, got {b}")
-            _require(c >= 0.0, "material.n", f"must be >= 0 for the Swift law, got {c}")
-        return np.array([E, nu, r, m, float(law), a, b, c], dtype=np.float64)
+        """Validate the fields and return the packed material (float64, layout above)."""
+        from shellform.material import criteria
 
+        E = number("material.E", self.E)
+        nu = number("material.nu", self.nu)
+        require(E > 0.0, "material.E", f"must be positive, got {E}")
+        require(-1.0 < nu < 0.5, "material.nu", f"must lie in (-1, 0.5), got {nu}")
+        require(isinstance(self.yield_function, str) and self.yield_function in criteria.CRITERIA,
+                "material.yield_function",
+                f"must be one of {', '.join(criteria.CRITERIA)}, got {self.yield_function!r}")
+        criterion = criteria.CRITERIA[self.yield_function]
+        par = criterion.parameters({"r": self.r, "m": self.m, **self.yield_parameters})
+        theta = math.radians(number("material.rolling_direction", self.rolling_direction))
+        require(isinstance(self.hardening, str) and self.hardening in LAWS, "material.hardening",
+                f"must be one of {', '.join(LAWS)}, got {self.hardening!r}")
+        law = LAWS[self.hardening]
+        h = []
+        if law == LAW_POWER:
+            h = [self._curve("yield_stress"), self._curve("n")]
+            require(h[0] > 0.0, "material.yield_stress", f"must be positive, got {h[0]}")
+            require(h[1] >= 1.0, "material.n", f"must be >= 1 for the power law, got {h[1]}")
+        if law in (LAW_SWIFT, LAW_SWIFT_VOCE):
+            h = [self._curve("K"), self._curve("eps0"), self._curve("n")]
+            require(h[0] > 0.0, "material.K", f"must be positive, got {h[0]}")
+            require(h[1] > 0.0, "material.eps0", f"must be positive, got {h[1]}")
+            require(h[2] >= 0.0, "material.n", f"must be >= 0 for the Swift law, got {h[2]}")
+        if law in (LAW_VOCE, LAW_SWIFT_VOCE):
+            v = [self._curve("yield_stress"), self._curve("Q"), self._curve("beta")]
+            require(v[0] > 0.0, "material.yield_stress", f"must be positive, got {v[0]}")
+            require(v[1] >= 0.0, "material.Q", f"must be >= 0 (a Voce curve that hardens), got {v[1]}")
+            require(v[2] > 0.0, "material.beta", f"must be positive, got {v[2]}")
+            h += v
+        if law == LAW_SWIFT_VOCE:
+            w = self._curve("swift_weight")
+            require(0.0 < w < 1.0, "material.swift_weight", f"must lie in (0, 1) (0, 1: use voce, swift), got {w}")
+            h.append(w)
+        table = np.zeros(1)
+        if law == LAW_TABLE:
+            from shellform.material.flow_curve import FlowCurve
+
+            require(self.flow_curve is not None, "material.flow_curve", "is required for hardening = 'table'")
+            curve = FlowCurve.from_table(self.flow_curve, self.extrapolation)
+            h = [float(curve.extrapolation_id), *curve.parameters]
+            table = curve.packed
+        mat = np.zeros(SIZE - 1 + len(table))
+        mat[E_], mat[NU_], mat[LAW_] = E, nu, float(law)
+        mat[CRITERION_] = float(list(criteria.CRITERIA).index(self.yield_function))
+        turns = math.remainder(math.degrees(theta), 180.0) != 0.0 and not criterion.PLANAR_ISOTROPIC
+        mat[COS_], mat[SIN_], mat[ROTATED_] = (math.cos(theta), math.sin(theta), 1.0) if turns else (1.0, 0.0, 0.0)
+        mat[H_:H_ + len(h)] = h
+        mat[PAR_:PAR_ + len(par)] = par
+        mat[TABLE_:] = table
+        return mat
+
+    def describe(self) -> str:
+        """One line: the yield function (its parameters, the rolling direction) and the flow
+        curve (a table's extrapolation as fitted), for a run's log."""
+        words = [f"yield function {self.yield_function}"]
+        if self.yield_function == "hill79":
+            words.append(f"r {self.r:g}, m {self.m:g}")
+        else:
+            words.append(", ".join(f"{k} {v}" for k, v in self.yield_parameters.items()))
+            words.append(f"rolling direction {float(self.rolling_direction):g} deg from x")
+        words.append(f"hardening {self.hardening}")
+        if self.hardening == "table":
+            from shellform.material.flow_curve import FlowCurve
+
+            words.append(FlowCurve.from_table(self.flow_curve, self.extrapolation).extrapolation_text)
+        return "material: " + "; ".join(words)
+
+
+Hill79Material = SheetMaterial  # the paper's material (Hill 1979 by default), by its former name
 
 from shellform.material.hardening import flow_stress  # noqa: E402
-from shellform.material.hill79 import (  # noqa: E402
-    equivalent_stress, return_map, thickness_strain, yield_derivatives,
-)
+from shellform.material.hill79 import equivalent_stress, yield_derivatives  # noqa: E402
+from shellform.material.plane_stress import return_map, thickness_strain  # noqa: E402
 from shellform.material.section import (  # noqa: E402
     elastic_section, section_response, through_thickness_rule,
 )
 
 __all__ = [
-    "Hill79Material", "LAW_ELASTIC", "LAW_POWER", "LAW_SWIFT", "flow_stress", "equivalent_stress",
-    "yield_derivatives", "return_map", "thickness_strain", "through_thickness_rule",
+    "SheetMaterial", "Hill79Material", "LAW_ELASTIC", "LAW_POWER", "LAW_SWIFT", "LAW_VOCE", "LAW_SWIFT_VOCE",
+    "LAW_TABLE", "flow_stress",
+    "equivalent_stress", "yield_derivatives", "return_map", "thickness_strain", "through_thickness_rule",
     "section_response", "elastic_section",
 ]

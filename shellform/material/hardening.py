@@ -8,13 +8,20 @@ power law (law 1), a = sigma_y, b = n >= 1, eps_y = sigma_y / E:
     g is convex and increasing on x >= 1 (n > 1); Newton from a point right of the root decreases
     monotonically onto it. Slope ds/dp = E / (n x^(n-1) - 1). n = 1: perfectly plastic.
 Swift (law 2), a = K, b = eps0, c = n:  s = K (eps0 + p)^n, slope n K (eps0 + p)^(n-1).
+Voce (law 3), H_.. = sigma0, Q, beta:  s = sigma0 + Q (1 - exp(-beta p)), slope Q beta exp(-beta p).
+Swift-Voce (law 4), H_.. = K, eps0, n, sigma0, Q, beta, w:  s = w Swift(p) + (1 - w) Voce(p).
+table (law 5): (p_i, sigma_i) from TABLE_ (shellform.material.flow_curve), linear between the
+    points; beyond the last one the extrapolation H_ = 0 constant, 1 linear (slope H_+1),
+    2 Swift (K, eps0, n at H_+1..), 3 Voce s_inf - (s_inf - sigma_N) exp(-beta (p - p_N))
+    (s_inf, beta at H_+1..).
 elastic (law 0): no yield; returns (inf, 0).
 """
 
 import math
 
 
-from shellform.material import A_, B_, C_, E_, LAW_, LAW_POWER, LAW_SWIFT
+from shellform.material import (A_, B_, C_, E_, H_, LAW_, LAW_POWER, LAW_SWIFT, LAW_SWIFT_VOCE, LAW_TABLE,
+                                LAW_VOCE, TABLE_)
 from shellform import _jit as jit
 
 
@@ -43,10 +50,56 @@ def flow_stress(p, mat):
     if law == LAW_POWER:
         return _power_law(p, mat[E_], mat[A_], mat[B_])
     if law == LAW_SWIFT:
-        K, e0, n = mat[A_], mat[B_], mat[C_]
-        if n == 0.0:
-            return K, 0.0
-        base = e0 + p
-        s = K * base**n
-        return s, n * s / base
+        return _swift(p, mat[A_], mat[B_], mat[C_])
+    if law == LAW_VOCE:
+        return _voce(p, mat[H_], mat[H_ + 1], mat[H_ + 2])
+    if law == LAW_SWIFT_VOCE:
+        w = mat[H_ + 6]
+        s1, h1 = _swift(p, mat[H_], mat[H_ + 1], mat[H_ + 2])
+        s2, h2 = _voce(p, mat[H_ + 3], mat[H_ + 4], mat[H_ + 5])
+        return w * s1 + (1.0 - w) * s2, w * h1 + (1.0 - w) * h2
+    if law == LAW_TABLE:
+        return _table(p, mat)
     return math.inf, 0.0
+
+
+@jit.njit
+def _swift(p, K, e0, n):
+    if n == 0.0:
+        return K, 0.0
+    base = e0 + p
+    s = K * base**n
+    return s, n * s / base
+
+
+@jit.njit
+def _voce(p, s0, Q, beta):
+    x = Q * math.exp(-beta * p)
+    return s0 + Q - x, beta * x
+
+
+@jit.njit
+def _table(p, mat):
+    n = int(mat[TABLE_])
+    ps, ss = mat[TABLE_ + 1:TABLE_ + 1 + n], mat[TABLE_ + 1 + n:TABLE_ + 1 + 2 * n]
+    if p >= ps[n - 1]:
+        kind = int(mat[H_])
+        pN, sN = ps[n - 1], ss[n - 1]
+        if kind == 1:
+            return sN + mat[H_ + 1] * (p - pN), mat[H_ + 1]
+        if kind == 2:
+            return _swift(p, mat[H_ + 1], mat[H_ + 2], mat[H_ + 3])
+        if kind == 3:
+            sinf = mat[H_ + 1]
+            x = (sinf - sN) * math.exp(-mat[H_ + 2] * (p - pN))
+            return sinf - x, mat[H_ + 2] * x
+        return sN, 0.0
+    lo, hi = 0, n - 1  # bisection: ps[lo] <= p < ps[hi]
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if ps[mid] <= p:
+            lo = mid
+        else:
+            hi = mid
+    slope = (ss[hi] - ss[lo]) / (ps[hi] - ps[lo])
+    return ss[lo] + slope * (p - ps[lo]), slope

@@ -10,7 +10,7 @@ import numpy as np
 
 from shellform.material import A_, B_, C_, LAW_, LAW_ELASTIC, LAW_SWIFT
 from shellform.material.hardening import flow_stress
-from shellform.material.hill79 import return_map
+from shellform.material.plane_stress import return_map
 
 _UNIAXIAL = (np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), np.zeros((2, 3)))  # s22 = s12 = 0
 _PLANE_STRAIN = (np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),  # e22 = 0, s12 = 0

@@ -18,7 +18,7 @@ import numpy as np
 from shellform.errors import InputError
 from shellform.material import E_, NU_
 from shellform.material import hencky
-from shellform.material.hill79 import _return_core, thickness_strain
+from shellform.material.plane_stress import return_core, thickness_strain
 from shellform import _jit as jit
 
 
@@ -34,7 +34,7 @@ def through_thickness_rule(nz: int) -> tuple[np.ndarray, np.ndarray]:
 def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, p_w, w):
     """One layer at section strain e = (E11, E22, 2 E12): stress s conjugate to e, tangent Dt,
     new plastic strain; returns (p_new, status, e33). w: scratch, rows 0 to 2 (16 each). ep_new and p_w hold
-    the layer's last solution on entry (the return map's warm start, hill79._return_core).
+    the layer's last solution on entry (the return map's warm start, plane_stress.return_core).
     Small strain: the return mapping on e. Finite strain: on the Hencky strain eps(e), then
     s = P^T T and Dt = P^T (dT/deps) P + L(T) (shellform.material.hencky). e33 is the layer's
     thickness strain, logarithmic when finite. elastic_tangent: dT/deps is the elastic C
@@ -46,7 +46,7 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, p_w, w):
             return p_n, -1, 0.0
     else:
         eps[:] = e
-    (t0, t1, t2, d00, d01, d02, d11, d12, d22, q0, q1, q2, p, st) = _return_core(
+    (t0, t1, t2, d00, d01, d02, d11, d12, d22, q0, q1, q2, p, st) = return_core(
         eps[0], eps[1], eps[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat, ep_new[0], ep_new[1], ep_new[2], p_w)
     ep_new[0], ep_new[1], ep_new[2] = q0, q1, q2
     nu = mat[NU_]

@@ -21,7 +21,7 @@ from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly import assumed_membrane
 from shellform.assembly.sheet_kernels import SheetKernels
-from shellform.material import hencky, hill79, section
+from shellform.material import hencky, plane_stress, section
 from shellform.material.update import section_update
 from shellform.nonlinear.assemble import CellArrayForms
 from shellform import _jit as jit
@@ -224,7 +224,7 @@ class SheetModel:
 
 @jit.njit
 def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
-    """Per cell: the thickness strain of every layer (hill79.thickness_strain) at strains
+    """Per cell: the thickness strain of every layer (plane_stress.thickness_strain) at strains
     e_m + zeta t k, weighted through the thickness and averaged over the quadrature points."""
     ncells, nqp = strain.shape[0], strain.shape[1]
     e33 = np.zeros(ncells)
@@ -233,7 +233,7 @@ def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
         for g in range(nqp):
             for k in range(zeta.size):
                 layer = strain[c, g, :3] + zeta[k] * thickness * strain[c, g, 3:]
-                acc += wz[k] * hill79.thickness_strain(layer, ep[c, g, k], mat)
+                acc += wz[k] * plane_stress.thickness_strain(layer, ep[c, g, k], mat)
         e33[c] = acc / nqp
     return e33
 

@@ -67,14 +67,14 @@ def peak_thinning(p) -> dict:
 
 
 def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
-    """fld.csv (per cell: initial centre, major and minor true strains, margin), fld.png and
-    cup_margin.png (the cup coloured by the margin); returns the smallest margin and where."""
+    """fld.csv (per cell: initial centre, major and minor true strains, margin to the scene's
+    forming-limit curve: the measured one where given, else Keeler-Brazier; fld.curves), fld.png
+    and cup_margin.png (the cup coloured by the margin); returns the curve's label, the smallest
+    margin and where."""
     from shellform.results import fld
     from shellform.results.tables import write_csv
 
-    mat = p.scene.material
-    t, n = mat.thickness, fld.hardening_exponent(mat)
-    curve = fld.keeler_brazier(t, n)
+    (curve, label), beside = fld.curves(p.scene.material)
     f = p.model.cell_fields()
     margin = fld.margins(f["major_strain"], f["minor_strain"], curve)
     centre = p.model.cell_coords.reshape(-1, 3, 3).mean(axis=1)[:, :2]
@@ -83,9 +83,8 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
     comm = p.model.mesh.comm
     rows = [r for part in comm.allgather(rows) for r in part]
     write_csv(outdir / "fld.csv", rows, ["x0_mm", "y0_mm", "major", "minor", "margin"])
-    label = f"Keeler-Brazier, t {t:g} mm, n {n:.3g}: FLC0 {fld.flc0(t, n):.3f}"
     fld.plot(outdir / "fld.png", f["major_strain"], f["minor_strain"], curve,
-             f"{title}: stroke {p.stroke:.1f} mm", label)
+             f"{title}: stroke {p.stroke:.1f} mm", label, beside)
     if png:
         picture(outdir / "cup_margin.png", p, f"{title}: margin to the forming-limit curve",
                 ("margin to the FLC", margin, (-0.1, 0.3), "RdYlGn"))

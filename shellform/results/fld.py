@@ -8,14 +8,26 @@ of thickness t (mm) and strain-hardening exponent n:
     right (minor > 0): slope +0.6 in engineering strain,   e1 = FLC0/100 + 0.6 e2
 
 It is a correlation for steels. For aluminium it overstates the limit (the sheet's own measured
-curve should be used); shellform draws it for every sheet and says which it is.
+curve should be used); shellform draws it for every sheet whose curve has a Hollomon-type n
+(Swift, power law) and says which it is.
+
+A measured forming-limit curve ([material] forming_limit_curve: a CSV of minor, major true
+strains, minor increasing) replaces it for the margin and the view (Keeler-Brazier is drawn
+beside it where it can be): linear between its points, and beyond its first and last point
+continued along its end segments (linear extrapolation; the view marks the measured range).
 
 The margin of an element is FLC(eps2) - eps1 in true major strain: negative above the curve
 (a split predicted), below 0.1 in the usual marginal zone.
 """
 
+from pathlib import Path
+
 import numpy as np
 from mpi4py import MPI
+
+from shellform.errors import InputError
+
+FIELD = "material.forming_limit_curve"
 
 
 def flc0(thickness_mm: float, n: float) -> float:
@@ -36,6 +48,59 @@ def keeler_brazier(thickness_mm: float, n: float):
     return curve
 
 
+def measured(rows):
+    """The curve eps1(eps2) through the measured points (minor, major), linear between them and
+    along the end segments beyond them; InputError naming material.forming_limit_curve where
+    the points are no curve (fewer than two, minor not increasing, major not positive)."""
+    t = np.asarray(rows, dtype=np.float64)
+    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 2:
+        raise InputError(FIELD, "needs at least two rows (minor true strain, major true strain)")
+    if not np.all(np.isfinite(t)):
+        raise InputError(FIELD, "holds a value that is not finite")
+    minor, major = t[:, 0].copy(), t[:, 1].copy()
+    bad = np.flatnonzero(np.diff(minor) <= 0.0)
+    if bad.size:
+        raise InputError(FIELD, f"the minor strain must increase: row {bad[0] + 2} ({minor[bad[0] + 1]}) follows "
+                                f"{minor[bad[0]]}")
+    if major.min() <= 0.0:
+        raise InputError(FIELD, f"the major strain must be positive, got {major.min()}")
+    s0 = (major[1] - major[0]) / (minor[1] - minor[0])
+    s1 = (major[-1] - major[-2]) / (minor[-1] - minor[-2])
+
+    def curve(e2):
+        e2 = np.asarray(e2, dtype=float)
+        inside = np.interp(e2, minor, major)
+        return np.where(e2 < minor[0], major[0] + s0 * (e2 - minor[0]),
+                        np.where(e2 > minor[-1], major[-1] + s1 * (e2 - minor[-1]), inside))
+
+    curve.range = (float(minor[0]), float(minor[-1]))
+    return curve
+
+
+def read_measured(path):
+    """The measured curve of a CSV file of rows minor, major true strain (an optional header)."""
+    from shellform.material.flow_curve import read_csv
+
+    return measured(read_csv(path, FIELD, "minor true strain, major true strain"))
+
+
+def curves(material):
+    """The scene material's forming-limit curves: (curve, label) of the one the margin uses
+    (the measured one where forming_limit_curve is given, else Keeler-Brazier) and (curve,
+    label) of Keeler-Brazier beside a measured one, or None (no n, or not measured)."""
+    kb = None
+    if material.hardening in ("swift", "power"):
+        t, n = material.thickness, hardening_exponent(material)
+        kb = keeler_brazier(t, n), f"Keeler-Brazier, t {t:g} mm, n {n:.3g}: FLC0 {flc0(t, n):.3f}"
+    if material.forming_limit_curve:
+        curve = read_measured(material.forming_limit_curve)
+        return (curve, f"measured, {Path(material.forming_limit_curve).name}: FLC0 {float(curve(0.0)):.3f}"), kb
+    if kb is None:
+        raise InputError(FIELD, f"the forming-limit view needs a measured curve for hardening = "
+                                f"{material.hardening!r} (Keeler-Brazier needs the n of a Swift or power law)")
+    return kb, None
+
+
 def hardening_exponent(material) -> float:
     """n of the Hollomon-type law: the Swift n; 1/N for the power law eps ~ sigma^N."""
     if material.hardening == "swift":
@@ -49,8 +114,9 @@ def margins(major, minor, curve) -> np.ndarray:
     return curve(minor) - np.asarray(major)
 
 
-def plot(path, major, minor, curve, title: str, label: str) -> None:
-    """The elements' (minor, major) over the curve and its 0.1 marginal zone (rank 0 gathers)."""
+def plot(path, major, minor, curve, title: str, label: str, beside=None) -> None:
+    """The elements' (minor, major) over the curve and its 0.1 marginal zone (rank 0 gathers);
+    beside: (curve, label) of another curve drawn for comparison (dashed)."""
     comm = MPI.COMM_WORLD
     major = np.concatenate(comm.gather(np.asarray(major), root=0) or [np.zeros(0)])
     minor = np.concatenate(comm.gather(np.asarray(minor), root=0) or [np.zeros(0)])
@@ -67,6 +133,10 @@ def plot(path, major, minor, curve, title: str, label: str) -> None:
     e2 = np.linspace(lo, hi, 200)
     ax.plot(e2, curve(e2), "r-", label=label)
     ax.plot(e2, curve(e2) - 0.1, "r:", label="marginal zone (0.1 below)")
+    if hasattr(curve, "range"):
+        ax.axvspan(*curve.range, color="r", alpha=0.05, label="measured range")
+    if beside is not None:
+        ax.plot(e2, beside[0](e2), "--", color="grey", label=beside[1])
     margin = margins(major, minor, curve)
     sc = ax.scatter(minor, major, c=margin, s=8, cmap="RdYlGn", vmin=-0.1, vmax=0.3)
     fig.colorbar(sc, ax=ax, label="margin to the curve (true major strain)")

@@ -15,7 +15,8 @@ from shellform import effects as registry
 from shellform.errors import InputError
 from shellform.mesh import outline
 from shellform.scene import machine
-from shellform.scene.schema import (CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING, MAY_BE_INFINITE,
+from shellform.scene.schema import (ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING,
+                                    MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS,
                                     MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, REGIONS, SIDES, SPREADS,
                                     SUPPORTS, TOOL_SHAPES, Scene, ToolsSpec, bounds)
 
@@ -168,21 +169,40 @@ def _validate_material(s: Scene) -> None:
     require(math.isfinite(mat.m) and mat.m >= 1, "material.m",
             f"must be >= 1 (convex yield function), got {mat.m}")
     _keys_of_effects(s, "material")
+    require(mat.yield_function in YIELD_FUNCTIONS, "material.yield_function",
+            f"must be one of {', '.join(YIELD_FUNCTIONS)}, got {mat.yield_function!r}")
+    require(math.isfinite(mat.rolling_direction), "material.rolling_direction",
+            f"must be finite (degrees), got {mat.rolling_direction}")
+    for name in ANISOTROPY_PARAMETERS + ("alpha",):
+        v = getattr(mat, name)
+        if name != "alpha":
+            require(math.isfinite(v) and v >= 0.0, f"material.{name}", f"must be > 0 (0: unset), got {v}")
+        require(not v or name in YIELD_PARAMETERS[mat.yield_function], f"material.{name}",
+                f"is no parameter of yield_function = {mat.yield_function!r} "
+                f"(its parameters: {', '.join(YIELD_PARAMETERS[mat.yield_function])})")
+    for name, default in (("r", 1.0), ("m", 2.0)):
+        require(mat.yield_function == "hill79" or getattr(mat, name) == default, f"material.{name}",
+                f"is Hill 1979's; yield_function = {mat.yield_function!r} takes its own parameters")
     require(mat.hardening in HARDENING, "material.hardening",
             f"must be one of {', '.join(HARDENING)}, got {mat.hardening!r}")
     plastic = "plasticity" in s.effects
     if plastic and mat.hardening == "none":
         raise InputError("material.hardening",
-                         "plasticity needs a hardening curve: 'power' (yield_stress, n) or 'swift' (K, eps0, n)")
-    for name in ("yield_stress", "n", "K", "eps0"):
+                         "plasticity needs a hardening curve: " + ", ".join(
+                             f"'{k}' ({', '.join(v)})" for k, v in CURVE_PARAMETERS.items() if v))
+    for name in ("yield_stress", "n", "K", "eps0", "Q", "beta", "swift_weight", "flow_curve", "extrapolation"):
         v = getattr(mat, name)
-        require(math.isfinite(v), f"material.{name}", f"must be finite, got {v}")
-        if v != 0.0:
+        require(isinstance(v, str) or math.isfinite(v), f"material.{name}", f"must be finite, got {v}")
+        if v != 0.0 and v != "":
             require(name in CURVE_PARAMETERS[mat.hardening], f"material.{name}",
                     f"is no parameter of hardening = {mat.hardening!r} "
                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")
     if plastic:
-        s.hill79()  # Hill79Material validates the curve and names the field
+        s.hill79()  # SheetMaterial validates the curve and names the field
+    if plastic and (mat.forming_limit_curve or (s.tools is not None and s.output.fld)):
+        from shellform.results import fld
+
+        fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n
 
 
 def _validate_loads(s: Scene) -> None:

@@ -133,6 +133,10 @@ def load(path: str | Path) -> Scene:
     geometry = data.get("geometry")
     if isinstance(geometry, dict) and isinstance(geometry.get("file"), str) and geometry["file"]:
         data["geometry"] = {**geometry, "file": str(path.parent / geometry["file"])}  # relative to the scene
+    material = data.get("material")
+    for key in ("flow_curve", "forming_limit_curve"):  # files relative to the scene
+        if isinstance(material, dict) and isinstance(material.get(key), str) and material[key]:
+            material = data["material"] = {**material, key: str(path.parent / material[key])}
     return from_dict(data)
 
 

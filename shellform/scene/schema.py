@@ -19,6 +19,7 @@ from shellform.mesh import outline
 
 __all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "SPREADS", "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
+           "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
            "Drawbead", "ToolsSpec", "Output", "Scene", "bounds"]
 
@@ -36,8 +37,18 @@ REGIONS = ("full", "quarter")  # rectangle
 CIRCLE_REGIONS = ("full", "half", "quarter")
 MESH_KINDS = ("structured", "unstructured")
 DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
-HARDENING = ("none", "power", "swift")
-CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n")}
+HARDENING = ("none", "power", "swift", "voce", "swift_voce", "table")
+ANISOTROPY_PARAMETERS = ("r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b", "a")  # 0: unset
+YIELD_PARAMETERS = {  # the [material] keys of each yield function (shellform.material.criteria.CRITERIA)
+    "hill79": ("r", "m"),
+    "hill48": ("r0", "r45", "r90", "sigma0", "sigma45", "sigma90", "sigma_b"),
+    "yld2000": ("alpha", "a", "r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b"),
+}
+YIELD_FUNCTIONS = tuple(YIELD_PARAMETERS)
+CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n"),
+                    "voce": ("yield_stress", "Q", "beta"),
+                    "swift_voce": ("K", "eps0", "n", "yield_stress", "Q", "beta", "swift_weight"),
+                    "table": ("flow_curve", "extrapolation")}
 
 
 @dataclass
@@ -72,13 +83,31 @@ class Material:
     E: float = 1.0
     nu: float = 0.3
     thickness: float = 0.01
-    hardening: str = "none"  # "none" (elastic), "power" (yield_stress, n) or "swift" (K, eps0, n)
-    yield_stress: float = 0.0  # power law: sigma_y (0: unset)
+    hardening: str = "none"  # one of HARDENING; its parameters: CURVE_PARAMETERS
+    yield_stress: float = 0.0  # power law: sigma_y; Voce: sigma0 (0: unset), MPa
     n: float = 0.0  # power law: n >= 1; Swift: n >= 0
-    K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset)
+    K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset), MPa
     eps0: float = 0.0  # Swift (0: unset)
+    Q: float = 0.0  # Voce: sigma_bar = sigma0 + Q (1 - exp(-beta p)), MPa
+    beta: float = 0.0  # Voce (0: unset)
+    swift_weight: float = 0.0  # Swift-Voce: w Swift + (1 - w) Voce, 0 < w < 1 (0: unset)
+    flow_curve: str = ""  # table: a CSV file of (plastic strain, true stress MPa), relative to the scene
+    extrapolation: str = ""  # table: beyond its last point, one of flow_curve.EXTRAPOLATIONS
+    forming_limit_curve: str = ""  # a CSV of (minor, major) true strains, relative to the scene (results/fld.py)
     r: float = 1.0  # Lankford coefficient of Hill 1979 (> 0; != 1 needs 'anisotropy')
     m: float = 2.0  # Hill 1979 exponent (>= 1; != 2 needs 'anisotropy')
+    yield_function: str = "hill79"  # one of YIELD_FUNCTIONS (shellform.material.criteria); others need 'anisotropy'
+    rolling_direction: float = 0.0  # degrees from the x axis to the rolling direction (needs 'anisotropy')
+    r0: float = 0.0  # hill48, yld2000: Lankford coefficients at 0, 45, 90 degrees to the rolling direction
+    r45: float = 0.0  # (0: unset)
+    r90: float = 0.0
+    r_b: float = 0.0  # yld2000: the balanced-biaxial strain ratio dep22/dep11
+    sigma0: float = 0.0  # hill48 (instead of r0, r45, r90), yld2000: uniaxial yield stresses at 0, 45, 90
+    sigma45: float = 0.0  # degrees and the balanced-biaxial one, MPa (only their ratios count; 0: unset)
+    sigma90: float = 0.0
+    sigma_b: float = 0.0
+    alpha: list[float] = field(default_factory=list, metadata={"items": "numbers"})  # yld2000: alpha1..alpha8
+    a: float = 0.0  # yld2000: the exponent (6 bcc, 8 fcc; >= 2)
 
 
 @dataclass
@@ -233,18 +262,29 @@ class Scene:
         return self.route != registry.LINEAR
 
     def hill79(self):
-        """The scene's shellform.material.Hill79Material: elastic (hardening "none") unless the
-        effect 'plasticity' is on. Its own validation names the field (material.yield_stress, ...)."""
-        from shellform.material import Hill79Material  # numba modules: imported only when needed
+        """The scene's shellform.material.SheetMaterial (its yield function, Hill 1979 by default):
+        elastic (hardening "none") unless the effect 'plasticity' is on. Its own validation names
+        the field (material.yield_stress, material.r0, ...)."""
+        from shellform.material import SheetMaterial  # numba modules: imported only when needed
 
         mat = self.material
         if "plasticity" not in self.effects:
-            return Hill79Material(mat.E, mat.nu, mat.r, mat.m)
+            return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
         unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
         # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
         n = unset(mat.n) if mat.hardening == "power" else mat.n
-        return Hill79Material(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
-                              unset(mat.K), unset(mat.eps0))
+        given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
+        if mat.alpha:
+            given["alpha"] = list(mat.alpha)
+        table = None
+        if mat.hardening == "table" and mat.flow_curve:
+            from shellform.material.flow_curve import read_csv
+
+            table = read_csv(mat.flow_curve)
+        return SheetMaterial(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
+                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction,
+                             unset(mat.Q), unset(mat.beta), unset(mat.swift_weight), table,
+                             mat.extrapolation or None)
 
 
 def bounds(s: Scene) -> tuple[float, float, float, float]:
