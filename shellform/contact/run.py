@@ -20,6 +20,10 @@ Writes into the output folder (forces and draw-in for the whole blank):
     cup.bp, cup_cells.bp     VTX time series at the reports: displacement and nodal thickness
                              strain; per cell the equivalent plastic strain and the major and
                              minor logarithmic surface strains
+    cup.pvd, vtu/            ([output] vtu) the same and more as a series a stock ParaView and
+                             pyvista open: the deformed sheet with its point and cell fields,
+                             and punch.pvd, die.pvd, blank_holder.pvd, the tools' surfaces
+                             (results/cup.py CupSeries, docs/results.md)
     cup.png                  the drawn cup coloured by thickness strain (serial runs)
     fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
                              Keeler-Brazier forming-limit curve, each cell's margin to it;
@@ -114,7 +118,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         curve, reports, resumed = _resume(p, s, outdir, comm)
         run_folder.resumed(outdir, s, scene_path, comm)
     setup_s = time.perf_counter() - t0
-    series = cup.CupSeries(p, outdir / "cup.bp") if s.output.vtx else None
+    series = cup.CupSeries(p, outdir, vtx=s.output.vtx, vtu=s.output.vtu, fld_margin=s.output.fld and p.model.plastic) \
+        if s.output.vtx or s.output.vtu else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
     saved_at = [time.monotonic()]  # when the last checkpoint was written
 

@@ -1,4 +1,4 @@
-"""The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX series, the
+"""The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX and VTU series, the
 force-stroke plot and the picture of the cup (used by shellform.contact.run).
 
 DX = draw-in of the blank edge on the axis y = 0 (initial x minus current x), DY the same on
@@ -96,33 +96,118 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
 
 
 class CupSeries:
-    """VTX time series: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the
-    cells' equivalent plastic strain and major and minor (logarithmic) surface strains."""
+    """The cup's time series at the reports.
+
+    vtx: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the cells'
+    equivalent plastic strain and major and minor (logarithmic) surface strains (VTX, on the
+    undeformed mesh, each rank its part).
+
+    vtu: cup.pvd, the sheet as a stock ParaView or ``pyvista.read`` opens it (results/vtu.py):
+    the modelled region (a quarter or a half is not mirrored) on its deformed mid-surface, with
+    the point fields displacement, thickness_strain, contact_state (DrawingProblem.CONTACT_STATES)
+    and contact_pressure, and the cell fields equivalent_plastic_strain, major_strain,
+    minor_strain and, where the forming-limit view is on, fld_margin; and punch.pvd, die.pvd,
+    blank_holder.pvd, each tool's surface at its position at the report (tools.surface_mesh
+    over the blank's plan extent). Rank 0 gathers the sheet and writes it with its nodes and
+    cells in the mesh's input order, so that the files do not depend on the number of ranks.
+    """
 
     CELL_FIELDS = ("equivalent_plastic_strain", "major_strain", "minor_strain")
+    TOOL_GRID = 96  # plan points per side of a tool's surface
 
-    def __init__(self, p, path: Path):
+    def __init__(self, p, outdir: Path, vtx: bool = True, vtu: bool = True, fld_margin: bool = False):
         mesh = p.model.mesh
-        self.p = p
-        self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
-        self.e33 = fem.Function(fem.functionspace(mesh, ("Lagrange", 1)), name="thickness_strain")
-        dg0 = fem.functionspace(mesh, ("DG", 0))
-        self.cells = [fem.Function(dg0, name=name) for name in self.CELL_FIELDS]
-        self.writers = [io.VTXWriter(mesh.comm, path, [self.disp, self.e33], engine="BP4"),
-                        io.VTXWriter(mesh.comm, path.with_name(path.stem + "_cells.bp"), self.cells, engine="BP4")]
+        self.p, self.outdir, self.writers, self.series = p, Path(outdir), [], {}
+        self.fld_curve = None
+        if fld_margin:
+            from shellform.results import fld
+
+            mat = p.scene.material
+            self.fld_curve = fld.keeler_brazier(mat.thickness, fld.hardening_exponent(mat))
+        if vtx:
+            self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
+            self.e33 = fem.Function(fem.functionspace(mesh, ("Lagrange", 1)), name="thickness_strain")
+            dg0 = fem.functionspace(mesh, ("DG", 0))
+            self.cells = [fem.Function(dg0, name=name) for name in self.CELL_FIELDS]
+            self.writers = [io.VTXWriter(mesh.comm, self.outdir / "cup.bp", [self.disp, self.e33], engine="BP4"),
+                            io.VTXWriter(mesh.comm, self.outdir / "cup_cells.bp", self.cells, engine="BP4")]
+        if vtu:
+            from shellform.results.vtu import PVDSeries
+
+            self.order = self._input_order()
+            names = ("cup", *p.tool_placements())  # on every rank: the placements reduce over them
+            if mesh.comm.rank == 0:
+                self.series = {name: PVDSeries(self.outdir, name) for name in names}
+
+    def _input_order(self):
+        """Per owned node and per owned cell their index in the mesh's input (the same on any
+        number of ranks), and each owned cell's nodes by that index."""
+        m = self.p.model
+        mesh, V = m.mesh, m.V
+        imap = V.dofmap.index_map
+        n_local = imap.size_local + imap.num_ghosts
+        dofs = V.dofmap.list
+        node = np.full(n_local, -1, dtype=np.int64)
+        node[dofs.ravel()] = mesh.geometry.input_global_indices[mesh.geometry.dofmaps[0].ravel()]
+        cells = np.asarray(mesh.topology.original_cell_index[: m.num_cells], dtype=np.int64)
+        return node[: imap.size_local], cells, node[dofs[: m.num_cells]]
 
     def write(self, stroke):
-        e33 = self.p.nodal_values()[2]
-        n = len(e33)  # the owned nodes
-        self.disp.x.array.reshape(-1, 3)[:n] = self.p.displacements()[:n]
-        self.e33.x.array[:n] = e33
-        fields = self.p.model.cell_fields()
-        for f in self.cells:
-            f.x.array[: self.p.model.num_cells] = fields[f.name]
-        for f in (self.disp, self.e33, *self.cells):
-            f.x.scatter_forward()
-        for w in self.writers:
-            w.write(stroke)
+        p = self.p
+        fields = p.model.cell_fields()
+        if self.writers:
+            e33 = p.nodal_values()[2]
+            n = len(e33)  # the owned nodes
+            self.disp.x.array.reshape(-1, 3)[:n] = p.displacements()[:n]
+            self.e33.x.array[:n] = e33
+            for f in self.cells:
+                f.x.array[: p.model.num_cells] = fields[f.name]
+            for f in (self.disp, self.e33, *self.cells):
+                f.x.scatter_forward()
+            for w in self.writers:
+                w.write(stroke)
+        if hasattr(self, "order"):
+            self._write_vtu(stroke, fields)
+
+    def _write_vtu(self, stroke, fields):
+        from shellform.contact.tools import surface_mesh
+
+        p = self.p
+        comm = p.model.mesh.comm
+        nodes, cells, triangles = self.order
+        _, x, e33 = p.nodal_values()
+        state, pressure = p.contact_nodes()
+        n = len(nodes)
+        cell_values = {k: fields[k] for k in self.CELL_FIELDS}
+        if self.fld_curve is not None:
+            from shellform.results import fld
+
+            cell_values["fld_margin"] = fld.margins(fields["major_strain"], fields["minor_strain"], self.fld_curve)
+        point_values = {"displacement": p.displacements()[:n], "thickness_strain": e33,
+                        "contact_state": state, "contact_pressure": pressure}
+        parts = comm.gather((nodes, x, point_values, cells, triangles, cell_values), root=0)
+        placements = p.tool_placements()
+        if comm.rank != 0:
+            return
+        node_ids = np.concatenate([q[0] for q in parts])
+        by_node = np.argsort(node_ids)
+        node_ids = node_ids[by_node]
+        by_cell = np.argsort(np.concatenate([q[3] for q in parts]))
+
+        def joined(i, key=None):
+            values = [q[i] if key is None else q[i][key] for q in parts]
+            return np.concatenate(values)[by_node if i < 3 else by_cell]
+
+        connectivity = np.searchsorted(node_ids, joined(4))
+        self.series["cup"].write(stroke, joined(1), connectivity,
+                                 {k: joined(2, k) for k in point_values}, {k: joined(5, k) for k in cell_values})
+        x0, x1, y0, y1 = p.blank_bounds()
+        t = p.scene.tools
+        span = t.stroke + max(t.punch_profile_radius, t.die_profile_radius)  # the walls, as deep as the stroke
+        for name, (tool, dz, above) in placements.items():
+            z_range = (dz - span, dz + span)
+            points, tris = surface_mesh(tool, dz, (x0, x1, y0, y1), z_range, above, self.TOOL_GRID)
+            self.series[name].write(stroke, points, tris)
 
     def close(self):
         for w in self.writers:
