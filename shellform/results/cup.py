@@ -214,7 +214,22 @@ class CupSeries:
             w.close()
 
 
-def plot_force(path: Path, rows: list[dict], title: str) -> None:
+def force_label(copies: int) -> str:
+    """The force axis's label: the whole cup's force, and how it was made from the modelled part."""
+    region = {4: "quarter", 2: "half"}.get(copies)
+    return "punch force on the whole cup (kN)" + (f"\n(the modelled {region}'s x {copies})" if region else "")
+
+
+def thickness_colours(e33) -> tuple[tuple[float, float], str, str]:
+    """(limits, colour map, label) of a thickness-strain picture: a diverging map on limits
+    symmetric about zero (+- the largest magnitude), white at an unchanged thickness."""
+    top = float(np.abs(e33).max(initial=0.0)) or 1.0
+    return (-top, top), "coolwarm", "thickness strain (white 0, symmetric limits)"
+
+
+def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> None:
+    """The punch force against the stroke. The force is the whole cup's (DrawingProblem's forces
+    are the modelled region's times its `copies`, 4 for a quarter), and the axis says so."""
     if MPI.COMM_WORLD.rank != 0 or not rows:
         return
     import matplotlib
@@ -225,7 +240,7 @@ def plot_force(path: Path, rows: list[dict], title: str) -> None:
     fig, ax = plt.subplots(figsize=(7, 4.5))
     ax.plot([r["stroke_mm"] for r in rows], [r["punch_force_kN"] for r in rows], "-")
     ax.set_xlabel("punch stroke (mm)")
-    ax.set_ylabel("punch force (kN)")
+    ax.set_ylabel(force_label(copies))
     ax.set_title(title, fontsize=10, parse_math=False)  # a scene's title is text, never TeX
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
@@ -236,7 +251,9 @@ def plot_force(path: Path, rows: list[dict], title: str) -> None:
 def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
     an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
-    strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only."""
+    strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only.
+    The thickness strain takes a diverging map on limits symmetric about zero (+-its largest
+    magnitude), so that white is an unchanged thickness, red thickening and blue thinning."""
     mesh = p.model.mesh
     if mesh.comm.size > 1:
         return
@@ -249,8 +266,8 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     e33 = np.zeros(x.shape[0])
     owned = p.nodal_values()[2]
     e33[: len(owned)] = owned
-    grid.point_data["thickness strain"] = e33
-    name, clim, cmap = "thickness strain", None, "coolwarm"
+    clim, cmap, name = thickness_colours(e33)
+    grid.point_data[name] = e33
     if cell_field is not None:
         name, values, clim, cmap = cell_field
         grid.cell_data[name] = values
@@ -302,7 +319,9 @@ def profiles(driver, X) -> dict:
 def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
     """What springback changed (shellform.contact.springback released the tools' forces into
     `released`): wall angle and flange edge along the transverse line, the diagonal's corner,
-    the unloading's plastic layers, the residual resultants; springback.csv and springback.png."""
+    the unloading's plastic layers, the residual resultants; springback.csv (both profiles) and
+    springback.png (the change along each line: sprung back minus drawn, in z and in the distance
+    from the centre, against the drawn distance)."""
     from shellform.results.tables import write_csv
 
     lines = SPRINGBACK_LINES
@@ -332,13 +351,14 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-        for ax, k in zip(axes, lines):
-            ax.plot(before[k][:, 1], before[k][:, 2], "k-", label="drawn (tools in place)")
-            ax.plot(after[k][:, 1], after[k][:, 2], "r--", label="sprung back")
-            ax.set_xlabel("distance from the centre (mm)")
-            ax.set_ylabel("z (mm)")
-            ax.set_aspect("equal")
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        for ax, k in zip(axes, lines):  # the change: on the profiles' scale it does not show
+            r = before[k][:, 1]
+            ax.plot(r, after[k][:, 2] - before[k][:, 2], "b-", label="z: vertical")
+            ax.plot(r, after[k][:, 1] - r, "r--", label="r: away from the centre")
+            ax.axhline(0.0, color="k", lw=0.5)
+            ax.set_xlabel("distance from the centre, drawn (mm)")
+            ax.set_ylabel("sprung back minus drawn (mm)")
             ax.set_title(f"{k} line", fontsize=9)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)
