@@ -48,7 +48,7 @@ def test_square_plate_scene(tmp_path):
     """D = 1, q = 1, a = 1: w_center is the coefficient w D/(q a^4) of the simply supported plate."""
     summary = run_scene("square_plate.toml", tmp_path)
     reference = plate.REFERENCE["simply_supported"]
-    assert reference == pytest.approx(0.00406235, abs=5e-9)  # validation.md, to its 8 digits
+    assert reference == pytest.approx(0.00406235, abs=5e-9)  # docs/references.md, to its 8 digits
     assert summary["cells"] == 288
     assert summary["w_center"] == pytest.approx(reference, rel=5e-4)
     assert (tmp_path / "nodal.bp").is_dir() and (tmp_path / "cells.bp").is_dir()
