@@ -144,3 +144,19 @@ def test_the_series_does_not_depend_on_the_ranks(tmp_path):
     _, punch = last_step(tmp_path / "two" / "punch.pvd")
     _, punch1 = last_step(tmp_path / "serial" / "punch.pvd")
     np.testing.assert_allclose(punch.points, punch1.points, atol=1e-9)
+
+
+def test_a_resumed_run_extends_the_series(tmp_path):
+    """small_cup drawn 1.5 mm (reports at 0.75 and 1.5 mm), then resumed to 3 mm: cup.pvd lists
+    the first run's steps and the resumed run's, each stroke once, and its last step is the
+    cup at 3 mm."""
+    first = small_cup().changed({"tools.stroke": 1.5})
+    run.run(first, tmp_path)
+    assert last_step(tmp_path / "cup.pvd")[0] == pytest.approx([0.75, 1.5])
+    s = small_cup()
+    summary = run.run(s, tmp_path, resume=True)
+    assert summary["resumed_from_stroke_mm"] == pytest.approx(1.5)
+    times, cup = last_step(tmp_path / "cup.pvd")
+    assert times == pytest.approx([0.75, 1.5, 3.0])
+    assert abs(-cup.points[:, 2].min() - s.tools.stroke) < s.material.thickness
+    assert last_step(tmp_path / "punch.pvd")[0] == pytest.approx([0.75, 1.5, 3.0])
