@@ -49,7 +49,8 @@ OUT_HELP = ("the output folder, created if missing; a run without --resume clear
 SET_HELP = ("change a key of the scene, as mesh.n=24, tools.stroke=20, process.report=[0.25, 0.5], "
             "output.png=false (a TOML value; repeat for several); checked as the scene file is")
 THREADS_HELP = ("at most this many threads for the element and material loops of each rank (sets "
-                "NUMBA_NUM_THREADS; default: the cores this process may use, shared by the ranks on a node)")
+                "SHELLFORM_THREADS; default: the cores this process may use, shared by the ranks on a node, at "
+                "most NUMBA_NUM_THREADS)")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -92,13 +93,14 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def limit_threads(n: int | None) -> None:
-    """Cap the element and material loops' threads (shellform.nonlinear.model.use_cores reads
-    NUMBA_NUM_THREADS when a model is built)."""
+    """Cap the element and material loops' threads: shellform.nonlinear.model.use_cores reads
+    SHELLFORM_THREADS when a model is built. (Not NUMBA_NUM_THREADS: numba re-reads it at each
+    compilation and refuses a change once its threads have started.)"""
     if n is None:
         return
     if n < 1:
         raise InputError("--threads", f"must be at least 1, got {n}")
-    os.environ["NUMBA_NUM_THREADS"] = str(n)
+    os.environ["SHELLFORM_THREADS"] = str(n)
 
 
 def _scene(args):

@@ -3,6 +3,7 @@ study, `shellform check` (the resolved scene and its estimate, nothing run), `--
 checked as the scene file is (errors name the key), `--threads`."""
 
 import json
+import os
 import tomllib
 from pathlib import Path
 
@@ -81,7 +82,7 @@ def test_settings_read_toml_values_and_else_text():
 @pytest.mark.timeout(120)
 def test_set_and_threads_reach_the_run(tmp_path, monkeypatch):
     """A run with -o, --set and --threads: the summary is the changed scene's, its threads the cap."""
-    monkeypatch.delenv("NUMBA_NUM_THREADS", raising=False)  # restored after the test
+    monkeypatch.delenv("SHELLFORM_THREADS", raising=False)  # restored after the test
     out = tmp_path / "levy"
     assert cli.main(["run", str(DEMOS / "levy_plate.toml"), "-o", str(out), "--threads", "1", "--set", "mesh.n=4",
                      "--set", "process.report=[0.5]", "--set", "output.vtx=false", "--set", "output.png=false",
@@ -93,10 +94,10 @@ def test_set_and_threads_reach_the_run(tmp_path, monkeypatch):
 
 
 def test_threads_cap_the_element_loops(monkeypatch, capsys):
-    monkeypatch.delenv("NUMBA_NUM_THREADS", raising=False)
+    monkeypatch.delenv("SHELLFORM_THREADS", raising=False)
     comm = MPI.COMM_WORLD
     free = use_cores(comm, 10**7)  # enough cells for every core
-    assert free == max(1, min(numba.config.NUMBA_NUM_THREADS, len(__import__("os").sched_getaffinity(0)) // comm.size))
+    assert free == max(1, min(numba.config.NUMBA_NUM_THREADS, len(os.sched_getaffinity(0)) // comm.size))
     cli.limit_threads(1)
     assert use_cores(comm, 10**7) == 1
     assert cli.main(["run", CUP, "-o", "unused", "--threads", "0"]) == 2

@@ -101,6 +101,9 @@ def test_the_cup_series_opens_in_pyvista_as_the_drawn_cup(tmp_path):
     np.testing.assert_allclose(cup.point_data["thickness_strain"].min(), summary["max_thickness_strain"], rtol=1e-12)
     assert set(np.unique(cup.point_data["contact_state"])) <= {0, 1, 2, 3, 4}
     assert (cup.point_data["contact_state"] == 1).any()  # nodes on the punch
+    free = cup.point_data["contact_state"] == 0
+    assert np.all(cup.point_data["contact_pressure"][free] == 0.0) and np.all(cup.point_data["contact_pressure"] >= 0)
+    assert cup.point_data["contact_pressure"][~free].max() > 0
     _, punch = last_step(tmp_path / "punch.pvd")
     assert punch.points[:, 2].min() == pytest.approx(t / 2 + s.tools.punch_gap - s.tools.stroke, abs=1e-9)
     _, die = last_step(tmp_path / "die.pvd")

@@ -191,12 +191,14 @@ class DrawingProblem:
     def contact_nodes(self) -> tuple[np.ndarray, np.ndarray]:
         """Owned nodes: the contact state, an index into CONTACT_STATES (free, on the punch, on
         the die, on the open holder's face, pinched between the die and the closed holder), and
-        the contact pressure (MPa): the normal force of the face the node lies on over the
-        node's tributary area in the initial blank."""
+        the contact pressure (MPa): the normal force of the face the node lies on (the die's on
+        a pinched node) over the node's tributary area in the initial blank."""
         d = self.driver
-        state = (d.state.tool.astype(np.int8) + 1)
+        state = d.state.tool.astype(np.int8) + 1
         state[d.pinched] = self.CONTACT_STATES.index("pinched")
-        return state, d.state.pressure / d.area
+        on_holder = state == self.CONTACT_STATES.index("holder")  # the open holder's face carries their force
+        force = np.where(on_holder, d.state.holder_face, d.state.pressure)
+        return state, force / d.area
 
     def tool_placements(self) -> dict:
         """The tools where they are now: name -> (tool, its z-shift from its initial position,
