@@ -115,6 +115,8 @@ def check(s) -> str:
     from shellform import scene
     from shellform.scene import machine
 
+    if s.geometry.file:  # absolute: the printed scene reads the same file from any folder
+        s = s.changed({"geometry.file": str(Path(s.geometry.file).resolve())})
     e = machine.estimate(s)
     plastic = f", {e['layers']} points through the thickness" if e["layers"] else ""
     return (scene.to_toml(s) + f"\n# valid: the {s.route} route, about {e['cells']:,} cells{plastic}; "

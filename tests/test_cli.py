@@ -102,3 +102,16 @@ def test_threads_cap_the_element_loops(monkeypatch, capsys):
     assert use_cores(comm, 10**7) == 1
     assert cli.main(["run", CUP, "-o", "unused", "--threads", "0"]) == 2
     assert "shellform: input error: --threads: must be at least 1, got 0" in capsys.readouterr().err
+
+
+def test_a_checked_scene_saved_elsewhere_reads_the_same_blank_file(capsys, tmp_path):
+    """check prints a file blank's path absolute: the printed scene, saved in another folder,
+    is the same scene."""
+    assert cli.main(["check", str(DEMOS / "disc_file_plate.toml")]) == 0
+    saved = tmp_path / "elsewhere" / "disc.toml"
+    saved.parent.mkdir()
+    saved.write_text(capsys.readouterr().out)
+    original = scene.load(DEMOS / "disc_file_plate.toml")
+    again = scene.load(saved)
+    assert Path(again.geometry.file) == Path(original.geometry.file).resolve()
+    assert again == original.changed({"geometry.file": again.geometry.file})
