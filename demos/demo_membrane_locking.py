@@ -32,6 +32,7 @@
 #     OK
 
 import argparse
+import sys
 
 import shellform  # noqa: F401  (DOLFINx runtime first)
 
@@ -41,7 +42,7 @@ parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--n", type=int, nargs="+", default=[16, 32])
 parser.add_argument("--thickness", type=float, default=1e-3)
 parser.add_argument("--factor", type=float, default=10.0)
-args = parser.parse_args()
+args = parser.parse_args([] if "ipykernel" in sys.modules else None)  # in a notebook: the defaults
 
 # ## Why a cubic locks
 #

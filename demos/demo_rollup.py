@@ -34,6 +34,7 @@
 #     OK
 
 import argparse
+import sys
 
 import shellform  # noqa: F401  (DOLFINx runtime first)
 
@@ -46,7 +47,7 @@ parser.add_argument("--n", type=int, default=48)
 parser.add_argument("--stations", type=int, default=8)
 parser.add_argument("--step", type=float, default=0.05)
 parser.add_argument("--tol", type=float, default=1e-3)
-args = parser.parse_args()
+args = parser.parse_args([] if "ipykernel" in sys.modules else None)  # in a notebook: the defaults
 
 # ## The model
 #

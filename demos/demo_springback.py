@@ -36,6 +36,7 @@
 #     OK
 
 import argparse
+import sys
 
 import shellform  # noqa: F401  (DOLFINx runtime first)
 
@@ -48,7 +49,7 @@ parser.add_argument("--n", type=int, default=16)
 parser.add_argument("--layers", type=int, default=9)
 parser.add_argument("--r", type=float, default=1.0)
 parser.add_argument("--m", type=float, default=2.0)
-args = parser.parse_args()
+args = parser.parse_args([] if "ipykernel" in sys.modules else None)  # in a notebook: the defaults
 
 # ## The section
 #

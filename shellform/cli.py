@@ -1,24 +1,20 @@
-"""The ``shellform`` command.
+"""The shellform command.
 
-    shellform run SCENE.toml --out DIR      solve a scene; write summary.json, VTX fields, a PNG
-                                            (--trace: a tool scene logs every contact iterate;
-                                            --resume: a tool scene continues from DIR's last
-                                            converged state; without it DIR is cleared of an
-                                            older run's files, or refused if another scene's)
-    shellform study NAME --out DIR          run a study: plate, shell, levy, rollup, plastic (accuracy
-                                            against time), strip (finite-strain plasticity against
-                                            closed forms), assembly, newton (benchmarks), cup-hard
-                                            (the square cup's hard cases), cup-mesh (its meshes),
-                                            cup-strain (before and after finite strains),
-                                            cup-paper (the paper's Figs. 5 to 8), numisheet
-                                            (the NUMISHEET'93 cups to 40 mm), numisheet-cost
-                                            (the aluminium cup's accuracy against time),
-                                            cup-benchmark (its speed at 900 to 10,000 cells),
-                                            outlines (blanks of any outline), locking (thin
-                                            roll-ups and a curved roof, membrane locking)
+    shellform run SCENE.toml -o DIR       solve a scene into DIR (summary.json, tables, fields,
+                                          pictures); --set KEY=VALUE changes a key of the scene,
+                                          --resume continues a tool scene from DIR's last
+                                          converged state, --threads N caps the element loops'
+                                          threads, --trace logs every contact iterate
+    shellform check SCENE.toml            check the scene as a run would, print it with every key
+                                          resolved and what its mesh will cost; run nothing
+    shellform study NAME -o DIR           run a study (shellform study --help lists them)
+
+Exit status: 0 done, 2 input error, 3 stopped early, 128 + the signal when Ctrl-C or SIGTERM
+stopped it. Scenes: docs/scenes.md; results: docs/results.md; studies: docs/checked.md.
 """
 
 import argparse
+import os
 import signal
 import sys
 from pathlib import Path
@@ -26,13 +22,39 @@ from pathlib import Path
 from shellform import __version__  # the package first: the DOLFINx runtime before any solver module
 from shellform.errors import InputError
 
+# name -> what it shows (docs/checked.md gives each one's run time)
+STUDIES = {
+    "plate": "Kirchhoff plate: convergence, error against time (with C0 interior penalty P2, P3)",
+    "shell": "the paper's shallow-shell block, Figs. 1-2",
+    "levy": "Levy's clamped plate in large deflection, error against time",
+    "rollup": "a strip rolled into a full circle by an end moment",
+    "plastic": "limit load and springback of an elastic-plastic cantilever",
+    "strip": "finite-strain plasticity: a strip pulled to a stretch of 1.5 against closed forms",
+    "assembly": "assembly benchmark",
+    "newton": "one Newton iteration of the plastic sheet, benchmark",
+    "cup-hard": "the square cup's five hard cases",
+    "cup-mesh": "the square cup on three meshes, error against time",
+    "cup-strain": "the square cup before and after finite strains",
+    "cup-paper": "the paper's Figs. 5 to 8 (after cup-mesh and cup-hard)",
+    "numisheet": "the NUMISHEET'93 cups to 40 mm",
+    "numisheet-cost": "the aluminium cup: 4 meshes x 2 steps, error against time",
+    "cup-benchmark": "the aluminium cup at 900 to 10,000 cells on 1 and 2 ranks: speed",
+    "outlines": "circle and triangle plates, error against time",
+    "locking": "membrane locking: thin roll-ups and a curved roof",
+    "cup-convergence": "the aluminium and the square cup on a sequence of meshes: observed orders, Richardson estimates",
+}
 
-STUDIES = ["plate", "shell", "levy", "rollup", "plastic", "strip", "assembly", "newton", "cup-hard", "cup-mesh",
-           "cup-strain", "cup-paper", "numisheet", "numisheet-cost", "cup-benchmark", "outlines", "locking",
-           "cup-convergence"]
+SCENE_HELP = "the scene's TOML file (docs/scenes.md)"
+OUT_HELP = ("the output folder, created if missing; a run without --resume clears it of an older run's files of "
+            "the same scene, and refuses it if it holds another scene's run")
+SET_HELP = ("change a key of the scene, as mesh.n=24, tools.stroke=20, process.report=[0.25, 0.5], "
+            "output.png=false (a TOML value; repeat for several); checked as the scene file is")
+THREADS_HELP = ("at most this many threads for the element and material loops of each rank (sets "
+                "SHELLFORM_THREADS; default: the cores this process may use, shared by the ranks on a node, at "
+                "most NUMBA_NUM_THREADS)")
 
 
-def main(argv=None) -> int:
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="shellform", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"shellform {__version__}")
@@ -41,35 +63,86 @@ def main(argv=None) -> int:
                            description="Solve a scene (docs/scenes.md) into --out: summary.json, tables, fields, "
                                        "pictures. Exit status 0 done, 2 input error, 3 stopped early, "
                                        "128 + the signal when Ctrl-C or SIGTERM stopped it (docs/reliability.md).")
-    p_run.add_argument("scene", type=Path, help="the scene's TOML file")
-    p_run.add_argument("--out", type=Path, required=True,
-                       help="the output folder, created if missing; a run without --resume clears it of an older "
-                            "run's files of the same scene, and refuses it if it holds another scene's run")
+    p_run.add_argument("scene", type=Path, help=SCENE_HELP)
+    p_run.add_argument("-o", "--out", type=Path, required=True, help=OUT_HELP)
+    p_run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings", help=SET_HELP)
     p_run.add_argument("--resume", action="store_true",
                        help="a tool scene: continue from the last converged state in --out, on any number of ranks, "
                             "with this scene's stroke (not shorter), steps, friction and holder force; "
                             "refused where anything else differs (docs/reliability.md)")
+    p_run.add_argument("--threads", type=int, metavar="N", help=THREADS_HELP)
     p_run.add_argument("--trace", action="store_true",
                        help="tool scenes: log every contact pass, Newton step and iterate (diagnosis)")
-    p_study = sub.add_parser("study", help="run a convergence study")
-    p_study.add_argument("name", choices=STUDIES, help="the study (see shellform --help)")
-    p_study.add_argument("--out", type=Path, required=True, help="the folder for the study's tables and plots")
+    p_check = sub.add_parser("check", help="check a scene and print it resolved, without running it",
+                             description="Check a scene as `shellform run` does (every key, the files it reads, "
+                                         "the memory its mesh needs), then print it with every key resolved (a "
+                                         "TOML document that `shellform run` accepts) and its estimated cells "
+                                         "and memory. Nothing is solved. Exit status 0 valid, 2 input error.")
+    p_check.add_argument("scene", type=Path, help=SCENE_HELP)
+    p_check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings", help=SET_HELP)
+    width = max(map(len, STUDIES))
+    p_study = sub.add_parser("study", help="run a study (convergence, accuracy against time, benchmarks)",
+                             formatter_class=argparse.RawDescriptionHelpFormatter,
+                             description="Run a study into --out: its tables, plots and log (docs/checked.md gives "
+                                         "each one's run time).\n\nstudies:\n"
+                                         + "\n".join(f"  {k:<{width}}  {v}" for k, v in STUDIES.items()))
+    p_study.add_argument("name", choices=list(STUDIES), metavar="NAME", help="the study (listed above)")
+    p_study.add_argument("-o", "--out", type=Path, required=True, help="the folder for the study's tables and plots")
+    p_study.add_argument("--threads", type=int, metavar="N", help=THREADS_HELP)
     p_study.add_argument("--quick", action="store_true", help="coarse levels only (for tests)")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def limit_threads(n: int | None) -> None:
+    """Cap the element and material loops' threads: shellform.nonlinear.model.use_cores reads
+    SHELLFORM_THREADS when a model is built. (Not NUMBA_NUM_THREADS: numba re-reads it at each
+    compilation and refuses a change once its threads have started.)"""
+    if n is None:
+        return
+    if n < 1:
+        raise InputError("--threads", f"must be at least 1, got {n}")
+    os.environ["SHELLFORM_THREADS"] = str(n)
+
+
+def _scene(args):
+    from shellform import scene
+
+    s = scene.load(args.scene)
+    return s.changed(scene.settings(args.settings)) if args.settings else s
+
+
+def check(s) -> str:
+    """The scene resolved (TOML) and what its mesh costs, as `shellform check` prints them."""
+    from shellform import scene
+    from shellform.scene import machine
+
+    if s.geometry.file:  # absolute: the printed scene reads the same file from any folder
+        s = s.changed({"geometry.file": str(Path(s.geometry.file).resolve())})
+    e = machine.estimate(s)
+    plastic = f", {e['layers']} points through the thickness" if e["layers"] else ""
+    return (scene.to_toml(s) + f"\n# valid: the {s.route} route, about {e['cells']:,} cells{plastic}; "
+            f"about {e['bytes'] / 1e9:.2g} GB of memory on one rank (this machine allows "
+            f"{e['available_bytes'] / 1e9:.3g} GB)\n")
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
 
     from shellform.nonlinear.interrupt import Interrupted
     from shellform.results.log import say  # every line below once per run, on rank 0
 
     try:
+        limit_threads(getattr(args, "threads", None))
         if args.command == "run":
-            from shellform import run, scene
+            from shellform import run
 
-            summary = run.run(scene.load(args.scene), args.out, scene_path=args.scene, trace=args.trace,
-                              resume=args.resume)
+            summary = run.run(_scene(args), args.out, scene_path=args.scene, trace=args.trace, resume=args.resume)
             say(summary.closing_line())
             if summary.stop_line():
                 say(summary.stop_line(), file=sys.stderr)
             return summary.exit_status()
+        elif args.command == "check":
+            say(check(_scene(args)).rstrip("\n"))
         else:
             import importlib
 

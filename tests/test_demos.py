@@ -48,7 +48,7 @@ def test_square_plate_scene(tmp_path):
     """D = 1, q = 1, a = 1: w_center is the coefficient w D/(q a^4) of the simply supported plate."""
     summary = run_scene("square_plate.toml", tmp_path)
     reference = plate.REFERENCE["simply_supported"]
-    assert reference == pytest.approx(0.00406235, abs=5e-9)  # validation.md, to its 8 digits
+    assert reference == pytest.approx(0.00406235, abs=5e-9)  # docs/references.md, to its 8 digits
     assert summary["cells"] == 288
     assert summary["w_center"] == pytest.approx(reference, rel=5e-4)
     assert (tmp_path / "nodal.bp").is_dir() and (tmp_path / "cells.bp").is_dir()
@@ -170,3 +170,25 @@ def test_clamped_disc_scene(tmp_path):
     w = summary["reports"][-1]["w"] / 0.01
     assert w == pytest.approx(0.97049, rel=1e-4)
     assert (tmp_path / "deformed.png").is_file()
+
+
+@pytest.mark.timeout(600)
+def test_a_demo_runs_as_a_notebook():
+    """demo_circular_plate.py read by jupytext (its light format) and executed cell by cell in a
+    Jupyter kernel, whose own arguments (-f kernel.json) the demo does not parse: it runs on its
+    defaults to the same table and verdict as the script."""
+    import jupytext
+    import nbclient
+
+    nb = jupytext.read(DEMOS / "demo_circular_plate.py")
+    assert sum(c.cell_type == "code" for c in nb.cells) > 3 and any(c.cell_type == "markdown" for c in nb.cells)
+    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(ROOT)}}).execute()
+    out = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.outputs
+                  if o.output_type == "stream")
+    errors = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs if o.output_type == "error"]
+    assert not errors, errors
+    assert re.search(r"^\s*level\s+cells\s+w_center\s+rel_error\s+rate\s+time_s\s*$", out, re.M), out
+    assert len(re.findall(r"^\s*\d+\s+\d+\s+0\.\d+\s+-?\d", out, re.M)) == 4, out  # the default levels 0..3
+    rate = float(re.search(r"observed rate (\d+\.\d+)", out).group(1))
+    assert rate == pytest.approx(2.0, abs=0.1)
+    assert out.rstrip().endswith("OK"), out

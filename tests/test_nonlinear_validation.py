@@ -1,6 +1,6 @@
 """Structural validation of the nonlinear sheet against closed forms and classical tables.
 
-- Levy's clamped plate in large deflection (validation.md section 2), his own edge conditions;
+- Levy's clamped plate in large deflection (docs/references.md section 2), his own edge conditions;
 - a strip rolled into a full circle by an end moment (section 3);
 - limit load and springback of an elastic-perfectly plastic cantilever (limit analysis);
 - effects: plasticity that stays elastic gives the elastic answer; the elastic path is cheaper.
@@ -28,7 +28,7 @@ def test_levy_clamped_plate():
 
 
 def test_levy_immovable_edges_are_stiffer():
-    """Edges held against sliding (validation.md's 'immovable') deflect less than Levy's."""
+    """Edges held against sliding (docs/references.md's 'immovable') deflect less than Levy's."""
     sliding = levy.solve(8, loads=[402.0])[-1]["w_over_h"]
     immovable = levy.solve(8, "clamped", loads=[402.0])[-1]["w_over_h"]
     assert immovable < sliding
@@ -85,7 +85,7 @@ def test_plasticity_that_stays_elastic_is_elastic():
 @pytest.mark.parametrize("r, m", [(3.0, 2.0), (1.5, 8.0), (3.0, 8.0)])
 def test_anisotropic_limit_load(r, m):
     """Strong anisotropy and a sharp yield surface: the limit load follows the plane-strain
-    yield stress of Hill 1979 (validation.md 4), and the run loads and unloads without a
+    yield stress of Hill 1979 (docs/references.md 4), and the run loads and unloads without a
     failed return mapping. (Unloading is not purely elastic here: the narrow plane-strain
     section of these yield surfaces lets the transverse stress re-yield, so no springback check.)"""
     row = plastic.solve(16, 9, r=r, m=m)

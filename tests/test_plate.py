@@ -1,4 +1,4 @@
-"""Kirchhoff square plate (validation.md section 1): convergence of the centre deflection.
+"""Kirchhoff square plate (docs/references.md section 1): convergence of the centre deflection.
 
 Quarter plate, nested meshes (uniform refinement), structured and unstructured (gmsh).
 """
@@ -45,7 +45,7 @@ def test_unmapped_element_is_wrong():
 
 
 def test_navier_reference_agrees_with_the_table():
-    """The simply supported reference summed here (Navier series) agrees with validation.md's
+    """The simply supported reference summed here (Navier series) agrees with docs/references.md's
     0.00406235 to its 8 digits, and with itself at twice the terms to 1e-14."""
     assert plate.REFERENCE["simply_supported"] == pytest.approx(0.00406235, abs=5e-9)
     assert plate.navier_centre(4001) == pytest.approx(plate.REFERENCE["simply_supported"], rel=1e-14)

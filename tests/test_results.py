@@ -49,3 +49,26 @@ def test_keeler_brazier_curve():
     for minor in (0.05, 0.2):
         assert np.expm1(curve(minor)) - np.expm1(e0) == pytest.approx(0.6 * np.expm1(minor), rel=1e-12)
     assert fld.margins(0.2, 0.0, curve) == pytest.approx(e0 - 0.2, rel=1e-14)
+
+
+def test_the_thickness_picture_is_white_at_zero():
+    """The thickness-strain colours: limits symmetric about zero (so white is an unchanged
+    thickness, not the middle of the range), and the label says so."""
+    import numpy as np
+
+    from shellform.results import cup
+
+    (lo, hi), cmap, label = cup.thickness_colours(np.array([-0.128, 0.0, 0.18, 0.02]))
+    assert (lo, hi) == (-0.18, 0.18) and cmap == "coolwarm"
+    assert "white 0" in label and "symmetric" in label
+    assert cup.thickness_colours(np.zeros(3))[0] == (-1.0, 1.0)  # an undeformed sheet: a valid range
+
+
+def test_the_force_axis_says_the_whole_cup():
+    """DrawingProblem reports the whole cup's force (the modelled region's times its copies):
+    the axis says whole cup, and from what."""
+    from shellform.results import cup
+
+    assert cup.force_label(4) == "punch force on the whole cup (kN)\n(the modelled quarter's x 4)"
+    assert cup.force_label(2).endswith("(the modelled half's x 2)")
+    assert cup.force_label(1) == "punch force on the whole cup (kN)"

@@ -188,3 +188,35 @@ class DrawingProblem:
             return 0
         loose = d.holder.under(d.positions()) & ~d.holder.pinched
         return d.model.mesh.comm.allreduce(int(loose.sum()), op=MPI.SUM)
+
+    # -- what the results show -----------------------------------------------------------------
+    CONTACT_STATES = ("free", "punch", "die", "holder", "pinched")  # contact_nodes()'s codes 0 to 4
+
+    def contact_nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Owned nodes: the contact state, an index into CONTACT_STATES (free, on the punch, on
+        the die, on the open holder's face, pinched between the die and the closed holder), and
+        the contact pressure (MPa): the normal force of the face the node lies on (the die's on
+        a pinched node) over the node's tributary area in the initial blank."""
+        d = self.driver
+        state = d.contact.tool.astype(np.int8) + 1
+        if d.holder is not None:
+            state[d.holder.pinched] = self.CONTACT_STATES.index("pinched")
+        on_holder = state == self.CONTACT_STATES.index("holder")  # the open holder's face carries their force
+        face = d.holder.face if d.holder is not None else 0.0
+        force = np.where(on_holder, face, d.contact.pressure)
+        return state, force / d.nodes.area
+
+    def tool_placements(self) -> dict:
+        """The tools where they are now: name -> (tool, its z-shift from its initial position,
+        whether it lies above the sheet). The punch has moved by its share of the stroke; the
+        holder's face rests on the sheet's highest top under it (holder_height), or lies at its
+        lift when open."""
+        d = self.driver
+        out = {name: (tool, float(d.lam * dz), name == "punch")
+               for name, tool, dz in zip(("punch", "die"), d.tools, d.travel)}
+        if d.holder is not None:
+            face = d.holder.tool
+            top = self.holder_height()
+            shift = self.holder_lift() if not np.isfinite(top) or not d.holder.closed else top - face.z_face
+            out["blank_holder"] = (face, float(max(shift, 0.0)), True)
+        return out

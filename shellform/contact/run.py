@@ -1,6 +1,6 @@
 """A deep-drawing scene from its TOML to results on disk: scene -> problem -> driver -> files.
 
-Writes into the output folder (forces and draw-in for the whole blank):
+Writes into the output folder (forces and draw-in for the whole blank, pictures included):
     summary.json             stroke_mm, draw_in_mm (DX, DY, DD) and punch_force_kN at every
                              reported stroke; max_thickness_strain and where; the sheet's
                              volume change (V - V0)/V0 (elastic only, with finite strains); increments,
@@ -20,13 +20,18 @@ Writes into the output folder (forces and draw-in for the whole blank):
     cup.bp, cup_cells.bp     VTX time series at the reports: displacement and nodal thickness
                              strain; per cell the equivalent plastic strain and the major and
                              minor logarithmic surface strains
-    cup.png                  the drawn cup coloured by thickness strain (serial runs)
+    cup.pvd, vtu/            ([output] vtu) the same and more as a series a stock ParaView and
+                             pyvista open: the deformed sheet with its point and cell fields,
+                             and punch.pvd, die.pvd, blank_holder.pvd, the tools' surfaces
+                             (results/cup.py CupSeries, docs/results.md)
+    cup.png                  the drawn cup coloured by thickness strain, white at zero (serial runs)
     fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
                              Keeler-Brazier forming-limit curve, each cell's margin to it;
                              cup_margin.png the cup coloured by that margin (results/fld.py)
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
-                             after the tools withdraw (contact/springback.py); summary.json:
-                             wall angle, flange edge, re-yield, residual resultants
+                             after the tools withdraw (contact/springback.py; the picture: after
+                             minus before); summary.json: wall angle, flange edge, re-yield,
+                             residual resultants
     checkpoint.npz           the last converged state (at every report, every output.checkpoint_every
                              seconds, at the end, at a stop: no convergence, Ctrl-C, SIGTERM),
                              any number of ranks, and the one before (checkpoint.previous.npz):
@@ -114,7 +119,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         curve, reports, resumed = _resume(p, s, outdir, comm)
         run_folder.resumed(outdir, s, scene_path, comm)
     setup_s = time.perf_counter() - t0
-    series = cup.CupSeries(p, outdir / "cup.bp") if s.output.vtx else None
+    series = cup.CupSeries(p, outdir, vtx=s.output.vtx, vtu=s.output.vtu, fld_margin=s.output.fld and p.model.plastic) \
+        if s.output.vtx or s.output.vtu else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
     saved_at = [time.monotonic()]  # when the last checkpoint was written
 
@@ -176,7 +182,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     d = p.driver
     for name, line in cup.thickness_lines(p).items():
         write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
-    cup.plot_force(outdir / "force_stroke.png", curve, s.title)
+    cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
     limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}

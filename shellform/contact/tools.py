@@ -247,3 +247,44 @@ def square_cup_tools(spec, thickness: float) -> dict:
         die=die,
         holder=BlankHolder(spec.die_half_width + rd, spec.die_corner_radius + rd, thickness / 2),
     )
+
+
+def surface_mesh(tool, dz: float, bounds, z_range, above: bool, n: int = 96):
+    """A triangulated surface of `tool` moved by dz along z, over the plan rectangle
+    bounds = (x0, x1, y0, y1), for pictures and ParaView: (points (k, 3), triangles (m, 3)).
+
+    Each point of an n x n plan grid takes the height where the tool's signed distance
+    ``gap(x, 0, dz)`` is zero, found by bisection on z in z_range = (z_lo, z_hi): the sheet's
+    side of a tool above it (above: punch, holder) is its lowest point, of a tool below it (die)
+    its highest; the gap is monotone in z along such a vertical line. Where no point of the line
+    lies on the tool (beside the punch's wall, over the die's opening) the height is the end of
+    the range away from the sheet (z_hi above, z_lo below), so that the walls show as steep
+    triangles one grid cell wide. Where the gap is infinite (the holder over the die's opening)
+    the tool has no face: those triangles and their points are left out.
+    """
+    x0, x1, y0, y1 = bounds
+    X, Y = np.meshgrid(np.linspace(x0, x1, n), np.linspace(y0, y1, n), indexing="xy")
+    xy = np.column_stack([X.ravel(), Y.ravel()])
+    z_lo, z_hi = map(float, z_range)
+
+    def gap_at(z):
+        return tool.gap(np.column_stack([xy, z]), 0.0, dz)[0]
+
+    lo, hi = np.full(len(xy), z_lo), np.full(len(xy), z_hi)
+    g_lo, g_hi = gap_at(lo), gap_at(hi)
+    face = np.isfinite(g_lo) & np.isfinite(g_hi)
+    crosses = face & ((g_lo > 0) != (g_hi > 0))
+    for _ in range(48):  # the range / 2^48: below any tolerance of the sheet
+        mid = 0.5 * (lo + hi)
+        clear = gap_at(mid) > 0
+        lo_side = clear if above else ~clear  # mid lies on z_lo's side of the surface
+        lo = np.where(lo_side, mid, lo)
+        hi = np.where(lo_side, hi, mid)
+    z = np.where(crosses, 0.5 * (lo + hi), z_hi if above else z_lo)
+    points = np.column_stack([xy, z])
+    k = np.arange(n * n).reshape(n, n)
+    a, b, c, d = k[:-1, :-1].ravel(), k[:-1, 1:].ravel(), k[1:, :-1].ravel(), k[1:, 1:].ravel()
+    triangles = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])
+    triangles = triangles[face[triangles].all(axis=1)]
+    used, triangles = np.unique(triangles, return_inverse=True)  # the points of the kept triangles only
+    return points[used], triangles.reshape(-1, 3)

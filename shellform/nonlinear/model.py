@@ -56,15 +56,18 @@ CELLS_PER_THREAD = 256  # below this many cells a thread costs more to start tha
 
 def use_cores(comm, num_cells: int) -> int:
     """Threads of the element and material loops on this rank: the cores this process may run
-    on, shared by the ranks on its node (at most NUMBA_NUM_THREADS), and no more than one per
-    CELLS_PER_THREAD cells."""
+    on, shared by the ranks on its node, at most NUMBA_NUM_THREADS and SHELLFORM_THREADS
+    (`shellform run --threads N` sets it; read when the model is built, and unlike
+    NUMBA_NUM_THREADS free to change after numba started its threads), and no more than one
+    per CELLS_PER_THREAD cells."""
     import os
 
     local = comm.Split_type(MPI.COMM_TYPE_SHARED)
     ranks = local.size
     local.Free()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    return max(1, min(numba.config.NUMBA_NUM_THREADS, cores // ranks, num_cells // CELLS_PER_THREAD))
+    cap = min(numba.config.NUMBA_NUM_THREADS, int(os.environ.get("SHELLFORM_THREADS") or numba.config.NUMBA_NUM_THREADS))
+    return max(1, min(cap, cores // ranks, num_cells // CELLS_PER_THREAD))
 
 
 class SheetModel:

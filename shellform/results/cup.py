@@ -1,4 +1,4 @@
-"""The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX series, the
+"""The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX and VTU series, the
 force-stroke plot and the picture of the cup (used by shellform.contact.run).
 
 DX = draw-in of the blank edge on the axis y = 0 (initial x minus current x), DY the same on
@@ -94,40 +94,140 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
 
 
 class CupSeries:
-    """VTX time series: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the
-    cells' equivalent plastic strain and major and minor (logarithmic) surface strains."""
+    """The cup's time series at the reports.
+
+    vtx: cup.bp the displacement and the nodal thickness strain, cup_cells.bp the cells'
+    equivalent plastic strain and major and minor (logarithmic) surface strains (VTX, on the
+    undeformed mesh, each rank its part).
+
+    vtu: cup.pvd, the sheet as a stock ParaView or ``pyvista.read`` opens it (results/vtu.py):
+    the modelled region (a quarter or a half is not mirrored) on its deformed mid-surface, with
+    the point fields displacement, thickness_strain, contact_state (DrawingProblem.CONTACT_STATES)
+    and contact_pressure, and the cell fields equivalent_plastic_strain, major_strain,
+    minor_strain and, where the forming-limit view is on, fld_margin; and punch.pvd, die.pvd,
+    blank_holder.pvd, each tool's surface at its position at the report (tools.surface_mesh
+    over the blank's plan extent). Rank 0 gathers the sheet and writes it with its nodes and
+    cells in the mesh's input order, so that the files do not depend on the number of ranks.
+    """
 
     CELL_FIELDS = ("equivalent_plastic_strain", "major_strain", "minor_strain")
+    TOOL_GRID = 96  # plan points per side of a tool's surface
 
-    def __init__(self, p, path: Path):
+    def __init__(self, p, outdir: Path, vtx: bool = True, vtu: bool = True, fld_margin: bool = False):
         mesh = p.model.mesh
-        self.p = p
-        self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
-        self.e33 = fem.Function(fem.functionspace(mesh, ("Lagrange", 1)), name="thickness_strain")
-        dg0 = fem.functionspace(mesh, ("DG", 0))
-        self.cells = [fem.Function(dg0, name=name) for name in self.CELL_FIELDS]
-        self.writers = [io.VTXWriter(mesh.comm, path, [self.disp, self.e33], engine="BP4"),
-                        io.VTXWriter(mesh.comm, path.with_name(path.stem + "_cells.bp"), self.cells, engine="BP4")]
+        self.p, self.outdir, self.writers, self.series = p, Path(outdir), [], {}
+        self.fld_curve = None
+        if fld_margin:
+            from shellform.results import fld
+
+            mat = p.scene.material
+            self.fld_curve = fld.keeler_brazier(mat.thickness, fld.hardening_exponent(mat))
+        if vtx:
+            self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
+            self.e33 = fem.Function(fem.functionspace(mesh, ("Lagrange", 1)), name="thickness_strain")
+            dg0 = fem.functionspace(mesh, ("DG", 0))
+            self.cells = [fem.Function(dg0, name=name) for name in self.CELL_FIELDS]
+            self.writers = [io.VTXWriter(mesh.comm, self.outdir / "cup.bp", [self.disp, self.e33], engine="BP4"),
+                            io.VTXWriter(mesh.comm, self.outdir / "cup_cells.bp", self.cells, engine="BP4")]
+        if vtu:
+            from shellform.results.vtu import PVDSeries
+
+            self.order = self._input_order()
+            names = ("cup", *p.tool_placements())  # on every rank: the placements reduce over them
+            if mesh.comm.rank == 0:
+                self.series = {name: PVDSeries(self.outdir, name) for name in names}
+
+    def _input_order(self):
+        """Per owned node and per owned cell their index in the mesh's input (the same on any
+        number of ranks), and each owned cell's nodes by that index."""
+        m = self.p.model
+        mesh, V = m.mesh, m.V
+        imap = V.dofmap.index_map
+        n_local = imap.size_local + imap.num_ghosts
+        dofs = V.dofmap.list
+        node = np.full(n_local, -1, dtype=np.int64)
+        node[dofs.ravel()] = mesh.geometry.input_global_indices[mesh.geometry.dofmaps[0].ravel()]
+        cells = np.asarray(mesh.topology.original_cell_index[: m.num_cells], dtype=np.int64)
+        return node[: imap.size_local], cells, node[dofs[: m.num_cells]]
 
     def write(self, stroke):
-        e33 = self.p.nodal_values()[2]
-        n = len(e33)  # the owned nodes
-        self.disp.x.array.reshape(-1, 3)[:n] = self.p.displacements()[:n]
-        self.e33.x.array[:n] = e33
-        fields = self.p.model.cell_fields()
-        for f in self.cells:
-            f.x.array[: self.p.model.num_cells] = fields[f.name]
-        for f in (self.disp, self.e33, *self.cells):
-            f.x.scatter_forward()
-        for w in self.writers:
-            w.write(stroke)
+        p = self.p
+        fields = p.model.cell_fields()
+        if self.writers:
+            e33 = p.nodal_values()[2]
+            n = len(e33)  # the owned nodes
+            self.disp.x.array.reshape(-1, 3)[:n] = p.displacements()[:n]
+            self.e33.x.array[:n] = e33
+            for f in self.cells:
+                f.x.array[: p.model.num_cells] = fields[f.name]
+            for f in (self.disp, self.e33, *self.cells):
+                f.x.scatter_forward()
+            for w in self.writers:
+                w.write(stroke)
+        if hasattr(self, "order"):
+            self._write_vtu(stroke, fields)
+
+    def _write_vtu(self, stroke, fields):
+        from shellform.contact.tools import surface_mesh
+
+        p = self.p
+        comm = p.model.mesh.comm
+        nodes, cells, triangles = self.order
+        _, x, e33 = p.nodal_values()
+        state, pressure = p.contact_nodes()
+        n = len(nodes)
+        cell_values = {k: fields[k] for k in self.CELL_FIELDS}
+        if self.fld_curve is not None:
+            from shellform.results import fld
+
+            cell_values["fld_margin"] = fld.margins(fields["major_strain"], fields["minor_strain"], self.fld_curve)
+        point_values = {"displacement": p.displacements()[:n], "thickness_strain": e33,
+                        "contact_state": state, "contact_pressure": pressure}
+        parts = comm.gather((nodes, x, point_values, cells, triangles, cell_values), root=0)
+        placements = p.tool_placements()
+        if comm.rank != 0:
+            return
+        node_ids = np.concatenate([q[0] for q in parts])
+        by_node = np.argsort(node_ids)
+        node_ids = node_ids[by_node]
+        by_cell = np.argsort(np.concatenate([q[3] for q in parts]))
+
+        def joined(i, key=None):
+            values = [q[i] if key is None else q[i][key] for q in parts]
+            return np.concatenate(values)[by_node if i < 3 else by_cell]
+
+        connectivity = np.searchsorted(node_ids, joined(4))
+        self.series["cup"].write(stroke, joined(1), connectivity,
+                                 {k: joined(2, k) for k in point_values}, {k: joined(5, k) for k in cell_values})
+        x0, x1, y0, y1 = p.blank_bounds()
+        t = p.scene.tools
+        span = t.stroke + max(t.punch_profile_radius, t.die_profile_radius)  # the walls, as deep as the stroke
+        for name, (tool, dz, above) in placements.items():
+            z_range = (dz - span, dz + span)
+            points, tris = surface_mesh(tool, dz, (x0, x1, y0, y1), z_range, above, self.TOOL_GRID)
+            self.series[name].write(stroke, points, tris)
 
     def close(self):
         for w in self.writers:
             w.close()
 
 
-def plot_force(path: Path, rows: list[dict], title: str) -> None:
+def force_label(copies: int) -> str:
+    """The force axis's label: the whole cup's force, and how it was made from the modelled part."""
+    region = {4: "quarter", 2: "half"}.get(copies)
+    return "punch force on the whole cup (kN)" + (f"\n(the modelled {region}'s x {copies})" if region else "")
+
+
+def thickness_colours(e33) -> tuple[tuple[float, float], str, str]:
+    """(limits, colour map, label) of a thickness-strain picture: a diverging map on limits
+    symmetric about zero (+- the largest magnitude), white at an unchanged thickness."""
+    top = float(np.abs(e33).max(initial=0.0)) or 1.0
+    return (-top, top), "coolwarm", "thickness strain (white 0, symmetric limits)"
+
+
+def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> None:
+    """The punch force against the stroke. The force is the whole cup's (DrawingProblem's forces
+    are the modelled region's times its `copies`, 4 for a quarter), and the axis says so."""
     if MPI.COMM_WORLD.rank != 0 or not rows:
         return
     import matplotlib
@@ -138,7 +238,7 @@ def plot_force(path: Path, rows: list[dict], title: str) -> None:
     fig, ax = plt.subplots(figsize=(7, 4.5))
     ax.plot([r["stroke_mm"] for r in rows], [r["punch_force_kN"] for r in rows], "-")
     ax.set_xlabel("punch stroke (mm)")
-    ax.set_ylabel("punch force (kN)")
+    ax.set_ylabel(force_label(copies))
     ax.set_title(title, fontsize=10, parse_math=False)  # a scene's title is text, never TeX
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
@@ -149,7 +249,9 @@ def plot_force(path: Path, rows: list[dict], title: str) -> None:
 def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
     an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
-    strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only."""
+    strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only.
+    The thickness strain takes a diverging map on limits symmetric about zero (+-its largest
+    magnitude), so that white is an unchanged thickness, red thickening and blue thinning."""
     mesh = p.model.mesh
     if mesh.comm.size > 1:
         return
@@ -162,8 +264,8 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     e33 = np.zeros(x.shape[0])
     owned = p.nodal_values()[2]
     e33[: len(owned)] = owned
-    grid.point_data["thickness strain"] = e33
-    name, clim, cmap = "thickness strain", None, "coolwarm"
+    clim, cmap, name = thickness_colours(e33)
+    grid.point_data[name] = e33
     if cell_field is not None:
         name, values, clim, cmap = cell_field
         grid.cell_data[name] = values
@@ -215,7 +317,9 @@ def profiles(X, u, comm) -> dict:
 def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
     """What springback changed (shellform.contact.springback released the tools' forces into
     `released`): wall angle and flange edge along the transverse line, the diagonal's corner,
-    the unloading's plastic layers, the residual resultants; springback.csv and springback.png."""
+    the unloading's plastic layers, the residual resultants; springback.csv (both profiles) and
+    springback.png (the change along each line: sprung back minus drawn, in z and in the distance
+    from the centre, against the drawn distance)."""
     from shellform.results.tables import write_csv
 
     lines = SPRINGBACK_LINES
@@ -245,13 +349,14 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-        for ax, k in zip(axes, lines):
-            ax.plot(before[k][:, 1], before[k][:, 2], "k-", label="drawn (tools in place)")
-            ax.plot(after[k][:, 1], after[k][:, 2], "r--", label="sprung back")
-            ax.set_xlabel("distance from the centre (mm)")
-            ax.set_ylabel("z (mm)")
-            ax.set_aspect("equal")
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+        for ax, k in zip(axes, lines):  # the change: on the profiles' scale it does not show
+            r = before[k][:, 1]
+            ax.plot(r, after[k][:, 2] - before[k][:, 2], "b-", label="z: vertical")
+            ax.plot(r, after[k][:, 1] - r, "r--", label="r: away from the centre")
+            ax.axhline(0.0, color="k", lw=0.5)
+            ax.set_xlabel("distance from the centre, drawn (mm)")
+            ax.set_ylabel("sprung back minus drawn (mm)")
             ax.set_title(f"{k} line", fontsize=9)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)

@@ -10,5 +10,5 @@ Every bad value raises shellform.errors.InputError naming its field. A scene is 
 """
 
 from shellform.scene.checks import validate
-from shellform.scene.read import changed, from_dict, load, to_dict
+from shellform.scene.read import changed, from_dict, load, settings, to_dict, to_toml
 from shellform.scene.schema import *  # noqa: F403  (the sections and their allowed names)

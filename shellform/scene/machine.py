@@ -20,10 +20,11 @@ def check_file(s) -> None:
     require(Path(s.geometry.file).is_file(), "geometry.file", f"no such file: {s.geometry.file}")
 
 
-def check_size(s) -> None:
-    """A mesh whose estimated memory exceeds what the machine allows is refused before it is built."""
+def estimate(s) -> dict:
+    """What the scene's mesh will cost on this machine, before it is built (the estimates of
+    shellform/mesh/budget.py): {"cells", "layers" (points through a plastic section's
+    thickness, 0 if elastic), "bytes" (peak memory, one rank), "available_bytes"}."""
     from shellform.mesh import budget
-    from shellform.scene.schema import Process
 
     g, m = s.geometry, s.mesh
     if g.shape == "file":
@@ -35,9 +36,22 @@ def check_size(s) -> None:
         cells = budget.gmsh_cells(outline.region_area(g), (x1 - x0) / m.n, m.refine)
     nonlinear = s.nonlinear or s.tools is not None
     layers = s.process.thickness_points if "plasticity" in s.effects else 0  # a plastic section's points
-    need, have = budget.estimated_bytes(cells, nonlinear, layers=layers), budget.available_bytes()
+    return {"cells": cells, "layers": layers, "nonlinear": nonlinear,
+            "bytes": budget.estimated_bytes(cells, nonlinear, layers=layers),
+            "available_bytes": budget.available_bytes()}
+
+
+def check_size(s) -> None:
+    """A mesh whose estimated memory exceeds what the machine allows is refused before it is built."""
+    from shellform.mesh import budget
+    from shellform.scene.schema import Process
+
+    e = estimate(s)
+    cells, layers, need, have = e["cells"], e["layers"], e["bytes"], e["available_bytes"]
+    m = s.mesh
     usual = min(layers, Process().thickness_points)
-    require(need <= have or budget.estimated_bytes(cells, nonlinear, layers=usual) > have, "process.thickness_points",
+    require(need <= have or budget.estimated_bytes(cells, e["nonlinear"], layers=usual) > have,
+            "process.thickness_points",
             f"{layers:,} points through the thickness on {cells:,} cells need about {need / 1e9:.3g} GB; "
             f"this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
     require(need <= have, "mesh.n", f"n = {m.n} (refine {m.refine}) makes about {cells:,} cells, which need about "

@@ -5,6 +5,7 @@ are checked when the Scene is made (shellform.scene.checks).
 """
 
 import copy
+import json
 import tomllib
 from dataclasses import asdict, fields
 from pathlib import Path
@@ -175,3 +176,56 @@ def changed(s: Scene, changes: dict) -> Scene:
             raise InputError(key, f"is no key of a scene's tables, got the change {key!r}")
         table[name] = value
     return from_dict(data)
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)  # inf and nan are TOML's too
+    if isinstance(value, str):
+        return json.dumps(value)  # a TOML basic string
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"no TOML value for {value!r}")
+
+
+def _is_tables(value) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)
+
+
+def _toml_table(name: str, table: dict, lines: list[str]) -> None:
+    """The table's keys, then its sub-tables ([name.key]) and arrays of tables ([[name.key]])."""
+    lines += [f"{k} = {_toml_value(v)}" for k, v in table.items() if not isinstance(v, dict) and not _is_tables(v)]
+    for k, v in table.items():
+        if isinstance(v, dict):
+            lines += ["", f"[{name}.{k}]" if name else f"[{k}]"]
+            _toml_table(f"{name}.{k}" if name else k, v, lines)
+        elif _is_tables(v):
+            for item in v:
+                lines += ["", f"[[{name}.{k}]]" if name else f"[[{k}]]"]
+                _toml_table(f"{name}.{k}" if name else k, item, lines)
+
+
+def to_toml(s: Scene) -> str:
+    """The scene with every key resolved (defaults included) as a TOML document: load() of it
+    gives the same scene."""
+    lines: list[str] = []
+    _toml_table("", to_dict(s), lines)
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def settings(texts) -> dict:
+    """The changes of command-line settings "section.key=value" (for Scene.changed): the value is
+    read as a TOML value (24, 0.5, true, [0.25, 0.5], "text"), else taken as a string."""
+    changes = {}
+    for text in texts:
+        key, eq, value = text.partition("=")
+        key = key.strip()
+        if not eq or not key:
+            raise InputError("--set", f"expects key=value (as mesh.n=24), got {text!r}")
+        try:
+            changes[key] = tomllib.loads(f"v = {value.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            changes[key] = value.strip()
+    return changes

@@ -1,4 +1,4 @@
-"""The paper's square-cup figures (model.md section 6, item 2): Figs. 5 to 8.
+"""The paper's square-cup figures (the paper's example 2): Figs. 5 to 8.
 
     shellform study cup-mesh --out docs/results/cup_mesh      # first: Figs. 5, 6 use its meshes
     shellform study cup-hard --out docs/results/cup_hard      # first: Fig. 8 uses its 4 t / 20 mm case

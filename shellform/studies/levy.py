@@ -1,4 +1,4 @@
-"""Levy's clamped square plate in large deflection (validation.md section 2).
+"""Levy's clamped square plate in large deflection (docs/references.md section 2).
 
 Quarter plate, a = 1, nu = 0.316, dead uniform pressure stepped through Levy's loads
 P = p a^4 / (E h^4); error of w_c/h against his table at every load, for nested meshes.

@@ -3,7 +3,7 @@
 Strip L x b clamped at x = -L/2, symmetry on the long sides (plane strain across the strip),
 small-deflection kinematics, tip deflection prescribed (displacement control). Limit analysis:
 the clamp section becomes a hinge at P_L = M_p b / L, with the plane-strain fully plastic
-moment M_p = s_ps t^2 / 4, s_ps the plane-strain yield stress of Hill 1979 (validation.md 4).
+moment M_p = s_ps t^2 / 4, s_ps the plane-strain yield stress of Hill 1979 (docs/references.md 4).
 Through the thickness the section sums layer stresses: its own fully plastic moment is
 M_p (4 sum w |zeta|), the number the discrete model can reach.
 
@@ -33,7 +33,7 @@ QUICK_LEVELS = ((8, 5), (16, 5))
 
 
 def plane_strain_yield(r=1.0, m=2.0):
-    """s1 at plane-strain yield (eps2 = 0), from validation.md 4: s2/s1 = (t-1)/(t+1)."""
+    """s1 at plane-strain yield (eps2 = 0), from docs/references.md 4: s2/s1 = (t-1)/(t+1)."""
     t = (1 + 2 * r) ** (1 / (m - 1))
     k = (t - 1) / (t + 1)
     return SY * (2 * (1 + r) / (abs(1 + k) ** m + (1 + 2 * r) * abs(1 - k) ** m)) ** (1 / m)

@@ -1,4 +1,4 @@
-"""A cantilever strip rolled up by an end moment into a full circle (validation.md section 3).
+"""A cantilever strip rolled up by an end moment into a full circle (docs/references.md section 3).
 
 Strip L x b clamped at x = -L/2, nu = 0, end moment M = lambda 2 pi EI / L per unit width
 at x = L/2 (the exact work M theta of the end fibre's rotation, shellform.nonlinear.loads).
