@@ -36,8 +36,9 @@ def test_run_takes_o_for_out_and_explains_scene_and_out(capsys):
 
 def test_study_help_has_one_line_per_study(capsys):
     lines = help_of(capsys, "study").splitlines()
+    width = max(map(len, cli.STUDIES))  # the names in one column
     for name, what in cli.STUDIES.items():
-        assert [ln for ln in lines if ln.split()[:1] == [name]] == [f"  {name:<14}  {what}"]
+        assert [ln for ln in lines if ln.split()[:1] == [name]] == [f"  {name:<{width}}  {what}"]
 
 
 def test_every_demo_scene_prints_as_toml_that_reads_back_the_same():

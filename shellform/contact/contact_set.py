@@ -1,4 +1,4 @@
-"""The contact set: which node lies on which rigid tool (model.md section 4, eqs. 24-29).
+"""The contact set: which node lies on which rigid tool (the paper's eqs. 24-29).
 
 A node on a tool is seen in the tool's normal frame (frames.py); its normal displacement is
 *known* (it follows the tool: the correction -gap closes the gap at the current iterate), its

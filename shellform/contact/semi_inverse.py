@@ -1,4 +1,4 @@
-"""The mixed semi-inverse contact algorithm (model.md section 4, the paper's eqs. 24-29): the
+"""The mixed semi-inverse contact algorithm (the paper's eqs. 24-29): the
 Newton driver composed with the contact's parts.
 
 The load factor lambda moves the punch by -lambda * stroke along z. In every increment the
