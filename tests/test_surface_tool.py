@@ -1,0 +1,165 @@
+"""Tools from CAD surfaces (shellform/contact/surface_tool.py): the NUMISHEET'93 aluminium cup's
+punch and die built in gmsh (OpenCASCADE) from the dimensions of demos/numisheet93_aluminium.toml,
+written to STEP and read back, against the analytic tools of the same scene (tools.py): gap,
+normal and shape operator at random points near every region of their surfaces, and on the
+seams between a fillet and the face it meets. The accuracy asked: 1e-6 mm in the gap, 1e-6 in
+the normal, 1e-5 of the largest curvature in H (measured: 3e-8 mm, 1e-7 and 2e-6 on the punch's
+nose corner, a torus onto which OCC projects iteratively; 1e-14 on the die's planes, cylinders and tori)."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shellform import scene
+from shellform.contact.surface_tool import SurfaceTool
+from shellform.contact.tools import square_cup_tools
+from shellform.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = scene.load(ROOT / "demos" / "numisheet93_aluminium.toml")
+T = SCENE.material.thickness
+SPEC = SCENE.tools
+ANALYTIC = square_cup_tools(SPEC, T)
+GAP, NORMAL, CURVATURE = 1e-6, 1e-6, 1e-5  # mm; -; times the largest |H| of the points
+RNG = np.random.default_rng(35)
+
+
+def _script():
+    spec = importlib.util.spec_from_file_location("cup_tools_step", ROOT / "scripts" / "cup_tools_step.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def cad(tmp_path_factory):
+    """The punch and the die written as STEP and read back, placed as the analytic ones."""
+    steps = _script()
+    folder = tmp_path_factory.mktemp("cad")
+    steps.write_step(steps.punch, folder / "punch.step", SPEC.punch_half_width, SPEC.punch_corner_radius,
+                     SPEC.punch_profile_radius)
+    steps.write_step(steps.die, folder / "die.step", SPEC.die_half_width, SPEC.die_corner_radius,
+                     SPEC.die_profile_radius)
+    return {"punch": SurfaceTool.from_file(folder / "punch.step", (0.0, 0.0, T / 2 + SPEC.punch_gap)),
+            "die": SurfaceTool.from_file(folder / "die.step", (0.0, 0.0, -T / 2)), "folder": folder}
+
+
+def _box(lo, hi, n=300):
+    return RNG.uniform(lo, hi, (n, 3))
+
+
+# regions of the punch (face at z = t/2; nose 8, plan corner 10, half-width 35) and the die (top at
+# -t/2, shoulder 8, opening 37 with plan corner 12): boxes of points around each, x, y >= 0 and < 0
+PUNCH_REGIONS = {
+    "flat face": ([-24.0, -24.0, -3.0], [24.0, 24.0, 0.4]),
+    "nose, straight": ([28.0, -20.0, -3.0], [40.0, 20.0, 8.0]),
+    "nose, plan corner": ([26.0, 26.0, -3.0], [38.0, 38.0, 8.0]),
+    "wall": ([35.5, -20.0, 10.0], [38.0, 20.0, 40.0]),
+    "wall, plan corner": ([-35.0, 28.0, 10.0], [-28.0, 35.0, 40.0]),
+}
+DIE_REGIONS = {
+    "flat top": ([46.0, -60.0, -0.4], [70.0, 60.0, 3.0]),
+    "shoulder, straight": ([35.0, -20.0, -8.0], [47.0, 20.0, 3.0]),
+    "shoulder, plan corner": ([-46.0, -46.0, -8.0], [-30.0, -30.0, 3.0]),
+    "wall": ([33.0, -20.0, -40.0], [36.8, 20.0, -10.0]),
+    "wall, plan corner": ([27.0, 27.0, -40.0], [34.0, 34.0, -10.0]),
+}
+
+
+def _near(tool, x, dz):
+    """The points within 3 mm of the analytic tool's surface, outside or at most 2 mm inside."""
+    g, _ = tool.gap(x, 0.0, dz)
+    return x[(g < 3.0) & (g > -2.0)]
+
+
+@pytest.mark.parametrize("name, regions, dz", [("punch", PUNCH_REGIONS, 0.0), ("punch", PUNCH_REGIONS, -12.5),
+                                                ("die", DIE_REGIONS, 0.0)])
+def test_gap_normal_shape_match_the_analytic_tools(cad, name, regions, dz):
+    """At random points near every region (the punch also moved down by 12.5 mm), within 1e-6 mm
+    in the gap, 1e-6 in the normal and 1e-5 of the largest curvature in H; an offset subtracts."""
+    analytic, tool = ANALYTIC[name], cad[name]
+    for region, (lo, hi) in regions.items():
+        lo, hi = np.add(lo, [0, 0, dz]), np.add(hi, [0, 0, dz])
+        x = _near(analytic, _box(lo, hi), dz)
+        assert len(x) > 50, region
+        g0, n0 = analytic.gap(x, 0.4, dz)
+        g1, n1 = tool.gap(x, 0.4, dz)
+        assert np.abs(g1 - g0).max() < GAP, region
+        assert np.abs(n1 - n0).max() < NORMAL, region
+        H0, H1 = analytic.shape(x, 0.4, dz), tool.shape(x, 0.4, dz)
+        assert np.abs(H1 - H0).max() < CURVATURE * max(np.abs(H0).max(), 1.0 / 8.0), region
+        assert np.allclose(H1, H1.transpose(0, 2, 1), atol=1e-12)
+        assert np.abs(np.einsum("pij,pj->pi", H1, n1)).max() < 1e-9  # H n = 0
+
+
+def _one_sided(tool, x, step, dz=0.0):
+    """H just beside x on both sides of a seam (x -/+ step)."""
+    return tool.shape(x - step, 0.0, dz), tool.shape(x + step, 0.0, dz)
+
+
+@pytest.mark.parametrize("name, seam, across", [
+    ("punch", lambda y, d: np.c_[np.full_like(y, 27.0), y, T / 2 - d], [1.0, 0.0, 0.0]),  # flat face | nose
+    ("punch", lambda z, d: np.c_[np.full_like(z, 35.0) + d, np.zeros_like(z), T / 2 + 8.0 + 0 * z],
+     [0.0, 0.0, 1.0]),  # nose | wall, on y = 0 at the nose's top
+    ("die", lambda y, d: np.c_[np.full_like(y, 45.0), y, -T / 2 + d], [1.0, 0.0, 0.0]),  # shoulder | flat top
+])
+def test_seams_take_one_side(cad, name, seam, across):
+    """Points whose closest point lies on a fillet's seam (the tangent edge between the fillet
+    and the face it meets): gap and normal are continuous there and match the analytic tool; H
+    is one of its two one-sided values (the face's or the fillet's)."""
+    analytic, tool = ANALYTIC[name], cad[name]
+    d = RNG.uniform(0.05, 2.0, 40)
+    x = seam(RNG.uniform(-15.0, 15.0, 40), d)
+    g0, n0 = analytic.gap(x, 0.0)
+    g1, n1 = tool.gap(x, 0.0)
+    assert np.abs(g1 - g0).max() < GAP and np.abs(n1 - n0).max() < NORMAL
+    a, b = _one_sided(analytic, x, 1e-7 * np.asarray(across))
+    assert np.abs(a - b).max() > 0.05  # a true jump: the two sides differ
+    H = tool.shape(x, 0.0)
+    side = np.minimum(np.abs(H - a).max(axis=(1, 2)), np.abs(H - b).max(axis=(1, 2)))
+    assert side.max() < 1e-5
+
+
+def test_a_model_built_in_this_process_equals_its_step_file(cad):
+    """The punch built by a Python function with gmsh, not written: the same gap as the STEP
+    file read back, within the accuracy of OCC's projection onto the nose's tori (STEP keeps the
+    exact surfaces: 0 on the planes and cylinders, 3e-8 mm on the tori)."""
+    steps = _script()
+    built = SurfaceTool.from_builder(lambda gmsh: steps.punch(gmsh, SPEC.punch_half_width, SPEC.punch_corner_radius,
+                                                              SPEC.punch_profile_radius),
+                                     (0.0, 0.0, T / 2))
+    x = _box([-40.0, -40.0, -3.0], [40.0, 40.0, 10.0], 200)
+    assert np.abs(built.gap(x)[0] - cad["punch"].gap(x)[0]).max() < GAP
+
+
+def test_inward_normals_turn_gap_and_normal(cad, tmp_path):
+    """normals = "inward" turns the faces: the gap and the normal change sign, H too."""
+    turned = SurfaceTool.from_file(cad["folder"] / "die.step", (0.0, 0.0, -T / 2), normals="inward")
+    x = _near(ANALYTIC["die"], _box(*DIE_REGIONS["shoulder, straight"]), 0.0)
+    g, n = cad["die"].gap(x)
+    gt, nt = turned.gap(x)
+    assert np.abs(gt + g).max() < 1e-12 and np.abs(nt + n).max() < 1e-12
+    assert np.abs(turned.shape(x) + cad["die"].shape(x)).max() < 1e-9
+
+
+def test_bad_files_are_named(tmp_path):
+    """A missing file, a file that is no CAD file by its name, a file OCC cannot read and a
+    file with no surface: each an InputError naming the field given."""
+    with pytest.raises(InputError, match="no such file") as err:
+        SurfaceTool.from_file(tmp_path / "none.step", field="tools.punch_file")
+    assert err.value.field == "tools.punch_file"
+    (tmp_path / "punch.stl").write_text("solid x\nendsolid x\n")
+    with pytest.raises(InputError, match="not a CAD file"):
+        SurfaceTool.from_file(tmp_path / "punch.stl", field="tools.punch_file")
+    (tmp_path / "junk.step").write_text("this is no STEP file\n")
+    with pytest.raises(InputError) as err:
+        SurfaceTool.from_file(tmp_path / "junk.step", field="tools.die_file")
+    assert err.value.field == "tools.die_file"
+    steps = _script()
+    steps.write_step(lambda gmsh: (gmsh.model.occ.addPoint(0, 0, 0), gmsh.model.occ.synchronize()),
+                     tmp_path / "point.step")
+    with pytest.raises(InputError, match="no surface|cannot read") as err:
+        SurfaceTool.from_file(tmp_path / "point.step", field="tools.die_file")
+    assert err.value.field == "tools.die_file"
