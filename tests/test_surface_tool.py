@@ -163,3 +163,78 @@ def test_bad_files_are_named(tmp_path):
     with pytest.raises(InputError, match="no surface|cannot read") as err:
         SurfaceTool.from_file(tmp_path / "point.step", field="tools.die_file")
     assert err.value.field == "tools.die_file"
+
+
+# -- the scene: [tools] shape = "cad" ------------------------------------------------------------
+CAD_SCENE = ROOT / "demos" / "numisheet93_aluminium_cad.toml"
+
+
+def test_cad_scene_reads_files_relative_to_its_folder():
+    s = scene.load(CAD_SCENE)
+    assert s.tools.shape == "cad"
+    assert Path(s.tools.punch_file) == ROOT / "demos" / "meshes" / "numisheet93" / "punch.step"
+    assert Path(s.tools.die_file).is_file()
+    with pytest.raises(InputError) as err:
+        s.changed({"tools.die_file": str(ROOT / "demos" / "meshes" / "none.step")})
+    assert err.value.field == "tools.die_file"
+    with pytest.raises(InputError) as err:
+        s.changed({"tools.punch_normals": "up"})
+    assert err.value.field == "tools.punch_normals"
+    with pytest.raises(InputError) as err:
+        s.changed({"tools.punch_translation": [0.0, 0.0]})
+    assert err.value.field == "tools.punch_translation"
+    with pytest.raises(InputError) as err:
+        s.changed({"geometry.lx": 80.0})  # half of it, 40, does not reach the holder at 45
+    assert err.value.field == "geometry.lx"
+
+
+@pytest.mark.parametrize("changes, field", [
+    ({"tools.die_normals": "inward"}, "tools.die_normals"),  # the die's normals point away from the sheet
+    ({"tools.punch_translation": [0.0, 0.0, 0.0]}, "tools.punch_translation"),  # the punch cuts the blank
+    ({"tools.die_translation": [0.0, 0.0, -0.6]}, "tools.die_translation"),  # the die's top below the sheet
+    ({"tools.holder_half_width": 41.0}, "tools.holder_half_width"),  # the holder over the die's shoulder
+])
+def test_cad_tools_that_do_not_fit_the_blank_are_named(changes, field):
+    """Before any computation: the tools checked against the blank's nodes (check_start)."""
+    from shellform.contact.problem import DrawingProblem
+
+    s = scene.load(CAD_SCENE).changed({"mesh.n": 4, **changes})
+    with pytest.raises(InputError) as err:
+        DrawingProblem.from_scene(s, verbose=False)
+    assert err.value.field == field
+
+
+def test_a_file_with_no_surface_is_named(tmp_path):
+    steps = _script()
+    steps.write_step(lambda gmsh: (gmsh.model.occ.addPoint(0, 0, 0), gmsh.model.occ.synchronize()),
+                     tmp_path / "point.step")
+    from shellform.contact.problem import DrawingProblem
+
+    s = scene.load(CAD_SCENE).changed({"mesh.n": 4, "tools.die_file": str(tmp_path / "point.step")})
+    with pytest.raises(InputError) as err:
+        DrawingProblem.from_scene(s, verbose=False)
+    assert err.value.field == "tools.die_file"
+
+
+def _drawn(path, n, stroke):
+    from shellform.contact.problem import DrawingProblem
+    from shellform.results.cup import draw_in
+
+    s = scene.load(path).changed({"mesh.n": n})
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(stroke / s.tools.stroke)
+    return {**draw_in(p), "force": p.punch_force(), "iterations": sum(h.iterations for h in p.driver.history),
+            "increments": len(p.driver.history), "balance": p.force_balance()}
+
+
+def test_the_cup_drawn_by_step_tools_equals_the_analytic_run():
+    """The aluminium cup on 8 x 8 x 2 triangles drawn 2 mm by the STEP punch and die and by the
+    analytic ones: draw-in and punch force within 0.5 %, iterations within 20 % (the issue's
+    check; measured: the same increments and iterations, the answers to 1e-8, docs/tools.md)."""
+    analytic = _drawn(ROOT / "demos" / "numisheet93_aluminium.toml", 8, 2.0)
+    cad = _drawn(CAD_SCENE, 8, 2.0)
+    for key in ("DX", "DY", "DD", "force"):
+        assert abs(cad[key] - analytic[key]) <= 5e-3 * abs(analytic[key]), key
+    assert abs(cad["iterations"] - analytic["iterations"]) <= 0.2 * analytic["iterations"]
+    assert analytic["force"] > 1000.0 and analytic["DX"] > 0.01  # the punch has drawn the sheet
+    assert cad["balance"] < 1e-6

@@ -10,7 +10,7 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Geometry, Loads, Material, MeshSpec,
+from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Geometry, Loads, Material, MeshSpec,
                                     Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
 
 _SECTIONS = {
@@ -104,6 +104,11 @@ def from_dict(data: dict) -> Scene:
             if key in tools:
                 raise InputError(f"tools.{key}", "is a key of square tools: round tools take punch_radius and "
                                  "die_radius")
+    if isinstance(tools, dict):
+        for key in ANALYTIC_TOOL_KEYS if tools.get("shape") == "cad" else CAD_TOOL_KEYS:
+            if key in tools:
+                raise InputError(f"tools.{key}", "is a key of analytic tools: shape = 'cad' takes punch_file, die_file "
+                                 "and their placements" if tools.get("shape") == "cad" else "is a key of shape = 'cad'")
     if "loads" in data:
         loads = dict(data["loads"]) if isinstance(data["loads"], dict) else data["loads"]
         if not isinstance(loads, dict):
@@ -133,6 +138,11 @@ def load(path: str | Path) -> Scene:
     geometry = data.get("geometry")
     if isinstance(geometry, dict) and isinstance(geometry.get("file"), str) and geometry["file"]:
         data["geometry"] = {**geometry, "file": str(path.parent / geometry["file"])}  # relative to the scene
+    tools = data.get("tools")
+    if isinstance(tools, dict):
+        for key in ("punch_file", "die_file"):
+            if isinstance(tools.get(key), str) and tools[key]:
+                tools[key] = str(path.parent / tools[key])  # relative to the scene
     return from_dict(data)
 
 
@@ -151,6 +161,9 @@ def to_dict(s: Scene) -> dict:
     if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
         for key in SQUARE_TOOL_KEYS:
             del data["tools"][key]
+    if s.tools is not None:  # the keys of the other kind of tools are not the scene's
+        for key in ANALYTIC_TOOL_KEYS if s.tools.shape == "cad" else CAD_TOOL_KEYS:
+            data["tools"].pop(key, None)
     return data
 
 
