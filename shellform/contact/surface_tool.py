@@ -65,6 +65,7 @@ from shellform.errors import InputError
 CAD_SUFFIXES = (".step", ".stp", ".STEP", ".STP", ".iges", ".igs", ".IGES", ".IGS", ".brep", ".BREP")
 MAX_CAD_BYTES = 200_000_000  # a tool's CAD file larger than this is refused
 READ_SECONDS = 60.0  # the longest the child may take to read a tool's file
+LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
 SAMPLES = 24  # points per parametric direction sampled on a face (per edge: along it) for the upper bounds
 BOUNDARY_SAMPLES = 400  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
 NORMALS = ("outward", "inward")
@@ -174,7 +175,7 @@ class SurfaceTool:
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
         self._bounds, self._filled, self._trims = {}, {}, {}
-        points, owner = [], []
+        points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
             b0, b1 = (np.asarray(v, dtype=float) for v in m.getParametrizationBounds(d, t))
@@ -191,12 +192,15 @@ class SurfaceTool:
                     continue
                 xyz = np.asarray(m.getValue(2, t, uv.ravel())).reshape(-1, 3)
             else:
-                xyz = np.asarray(m.getValue(1, t, b0[0] + s * (b1[0] - b0[0]))).reshape(-1, 3)
+                uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
+                xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
             points.append(xyz)
             owner.append(np.full(len(xyz), k))
+            params.append(uv)
         from scipy.spatial import cKDTree
 
         self._tree = cKDTree(np.vstack(points))
+        self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
 
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
@@ -212,16 +216,88 @@ class SurfaceTool:
         return c + shift, d, n, ent, par
 
     def _nearest(self, gmsh, y):
-        m = gmsh.model
-        npts = len(y)
-        upper = self._tree.query(y)[0] * (1 + 1e-9) + 1e-9 * self.size
+        """Closest points: first the local projection from the nearest sample (_local), where
+        it is sure; the other points by the candidates' projections (_candidates)."""
+        upper, sample = self._tree.query(y)
+        upper = upper * (1 + 1e-9) + 1e-9 * self.size
         lower = np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
                                + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)  # (points, entities)
+        c, dist, ent, par = np.zeros_like(y), np.full(len(y), np.inf), np.full(len(y), -1), np.zeros((len(y), 2))
+        done = self._local(gmsh.model, y, sample, lower, c, dist, ent, par)
+        rest = np.flatnonzero(~done)
+        if rest.size:  # a point found by the local projection bounds the distance and is a candidate
+            seed = (c[rest], dist[rest], ent[rest], par[rest])
+            upper = np.minimum(upper[rest], dist[rest] * (1 + 1e-9) + 1e-9 * self.size)
+            c[rest], dist[rest], ent[rest], par[rest] = self._candidates(gmsh.model, y[rest], upper, lower[rest], seed)
+        return c, dist, ent, par
+
+    def _local(self, m, y, sample, lower, c, dist, ent, par):
+        """Newton on the face of each point's nearest sample, from the sample's parameters:
+        min |X(u, v) - y|^2, the step -A^-1 g with g = J (X - y), A = J J^T + X_ij . (X - y).
+        Sure (True) where it converged inside the face and no other entity's bounding box lies
+        nearer than the point found; fills c, dist, ent, par there, and where it converged inside
+        the face but is not sure (a point of the surface, not known to be the nearest)."""
+        done = np.zeros(len(y), dtype=bool)
+        k0 = self._sample_entity[sample]
+        for k in np.unique(k0):
+            dim, f = self._ents[k]
+            if dim != 2:
+                continue
+            idx = np.flatnonzero(k0 == k)
+            uv = self._sample_param[sample[idx]].copy()
+            yk = y[idx]
+            ok = np.zeros(len(idx), dtype=bool)
+            for _ in range(LOCAL_ITERATIONS):
+                X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+                J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
+                S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+                r = X - yk
+                g = np.einsum("pai,pi->pa", J, r)
+                Sr = np.einsum("pki,pi->pk", S, r)
+                A = np.einsum("pai,pbi->pab", J, J)
+                A[:, 0, 0] += Sr[:, 0]
+                A[:, 1, 1] += Sr[:, 1]
+                A[:, 0, 1] += Sr[:, 2]
+                A[:, 1, 0] += Sr[:, 2]
+                det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+                good = (det > 0) & (A[:, 0, 0] > 0)
+                det = np.where(good, det, 1.0)
+                step = -np.stack([A[:, 1, 1] * g[:, 0] - A[:, 0, 1] * g[:, 1],
+                                  A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
+                step[~good] = 0.0
+                uv += step
+                ok = good & (np.linalg.norm(np.einsum("pai,pa->pi", J, step), axis=1) < 1e-13 * self.size)
+                if ok.all():
+                    break
+            b0, b1 = self._bounds[(2, f)]
+            tol = 1e-9 * (b1 - b0 + 1.0)
+            ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
+            if not self._filled[f]:
+                inside, sure = self._in_trim(f, uv)
+                ok &= inside & sure
+            X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+            d = np.linalg.norm(yk - X, axis=1)
+            rows = idx[ok]
+            c[rows], dist[rows], ent[rows], par[rows] = X[ok], d[ok], k, uv[ok]
+            others = lower[idx].copy()
+            others[:, k] = np.inf
+            done[idx[ok & (d <= others.min(axis=1))]] = True
+        return done
+
+    def _candidates(self, m, y, upper, lower, seed):
+        """The nearest of every entity's projection whose bounding box lies within `upper`, and
+        of the seed (c, dist, entity, parameters: the local projection's point, entity -1 where
+        there is none)."""
+        npts = len(y)
         cand = lower <= upper[:, None]
         nent = len(self._ents)
         D = np.full((npts, nent), np.inf)
         C = np.zeros((npts, nent, 3))
         P = np.zeros((npts, nent, 2))
+        seeded = np.flatnonzero(seed[2] >= 0)
+        k = seed[2][seeded]
+        C[seeded, k], D[seeded, k], P[seeded, k] = seed[0][seeded], seed[1][seeded], seed[3][seeded]
+        cand[seeded, k] = False
         unknown = np.zeros((npts, nent), dtype=bool)  # a trimmed face's projection, not checked yet
         for k, (d, t) in enumerate(self._ents):
             idx = np.flatnonzero(cand[:, k])
@@ -269,14 +345,15 @@ class SurfaceTool:
 
     def _trim(self, m, f, uv, inside):
         """A trimmed face's boundary in its parameters: its edges sampled every 1/BOUNDARY_SAMPLES
-        of the tool's size (at least 16 points an edge) as segments, a k-d tree of their points
-        and the margin within which the sampled boundary may differ from the true one (half the
-        longest segment plus twice the largest deviation of an edge's mid-parameter point from
-        its segment); None where that boundary does not classify the sampled parameters `uv` as
-        isInside does."""
+        of the tool's size (at least 16 points an edge) as segments; their midpoints in a k-d
+        tree with each segment's normal pointing into the face (isInside at a point just beside
+        the midpoint); the margin within which the sampled boundary may differ from the true one
+        (half the longest segment plus twice the largest deviation of an edge's mid-parameter
+        point from its segment). None where that classifies the sampled parameters `uv` other
+        than isInside does."""
         from scipy.spatial import cKDTree
 
-        segments, margin = [], 0.0
+        mids, normals, margin = [], [], 0.0
         for e in m.getAdjacencies(2, f)[1]:
             e = abs(int(e))
             x0, y0, z0, x1, y1, z1 = m.getBoundingBox(1, e)
@@ -286,33 +363,33 @@ class SurfaceTool:
             t = np.linspace(b0[0], b1[0], 2 * count + 1)
             q = np.asarray(m.reparametrizeOnSurface(1, e, t, f)).reshape(-1, 2)
             ends, mid = q[::2], q[1::2]
-            segments.append(np.stack([ends[:-1], ends[1:]], axis=1))
+            chord = ends[1:] - ends[:-1]
+            length = np.linalg.norm(chord, axis=1)
+            keep = length > 0
+            normal = np.c_[-chord[:, 1], chord[:, 0]][keep] / length[keep, None]
+            centre = 0.5 * (ends[:-1] + ends[1:])[keep]
+            beside = centre + 1e-3 * length[keep, None] * normal
+            into = np.array([m.isInside(2, f, q, True) > 0 for q in beside])
+            mids.append(centre)
+            normals.append(np.where(into[:, None], normal, -normal))
             sag = np.linalg.norm(mid - 0.5 * (ends[:-1] + ends[1:]), axis=1)
-            chord = np.linalg.norm(ends[1:] - ends[:-1], axis=1)
-            margin = max(margin, 0.5 * float(chord.max()) + 2.0 * float(sag.max()))
-        seg = np.concatenate(segments)
-        trim = (seg, cKDTree(seg.reshape(-1, 2)), margin * (1 + 1e-6) + 1e-9 * self.size)
+            margin = max(margin, 0.5 * float(length.max()) + 2.0 * float(sag.max()))
+        trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size)
         self._trims[f] = trim
         ins, sure = self._in_trim(f, uv)
         return trim if bool(np.all(ins[sure] == inside[sure])) else None
 
     def _in_trim(self, f, uv):
-        """(inside, sure) for parameters uv of trimmed face f: inside by the parity of the
-        boundary segments a ray along +u crosses, sure where uv lies farther from the sampled
-        boundary's points than the margin (_trim); isInside decides the others."""
+        """(inside, sure) for parameters uv of trimmed face f: inside where uv lies on the inner
+        side of its nearest boundary segment, sure where it lies farther from the sampled
+        boundary than the margin (_trim); isInside decides the others."""
         trim = self._trims.get(f)
         if trim is None:
             return np.zeros(len(uv), dtype=bool), np.zeros(len(uv), dtype=bool)
-        seg, tree, margin = trim
-        a, b = seg[None, :, 0], seg[None, :, 1]  # (1, M, 2)
-        inside = np.zeros(len(uv), dtype=bool)
-        for i in range(0, len(uv), 256):  # (points, segments) in blocks
-            u, v = uv[i:i + 256, None, 0], uv[i:i + 256, None, 1]
-            spans = (a[..., 1] <= v) != (b[..., 1] <= v)
-            dv = np.where(spans, b[..., 1] - a[..., 1], 1.0)
-            cross = spans & (a[..., 0] + (v - a[..., 1]) * (b[..., 0] - a[..., 0]) / dv > u)
-            inside[i:i + 256] = cross.sum(axis=1) % 2 == 1
-        return inside, tree.query(uv)[0] > margin
+        tree, normals, margin = trim
+        dist, i = tree.query(uv)
+        inside = np.einsum("pi,pi->p", uv - tree.data[i], normals[i]) > 0
+        return inside, dist > margin
 
     def _signed(self, gmsh, y, c, dist, ent, par):
         m = gmsh.model
