@@ -118,8 +118,14 @@ class SurfaceTool:
             self.edges = [t for _, t in gmsh.model.getEntities(1)]
             if not self.faces:
                 raise ValueError("the model holds no surface")
-            self._face_adjacent = {e: [f for f in gmsh.model.getAdjacencies(1, e)[0]] for e in self.edges}
+            self._face_adjacent = {e: sorted(set(int(f) for f in gmsh.model.getAdjacencies(1, e)[0]))
+                                   for e in self.edges}
             self._setup(gmsh)
+            self._index = {de: k for k, de in enumerate(self._ents)}
+            self._is_face = np.array([d == 2 for d, _ in self._ents])
+            self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
+                                                               for e in gmsh.model.getAdjacencies(2, f)[1]], dtype=int)
+                                for f in self.faces}
 
     # -- construction ------------------------------------------------------------------------
     @classmethod
@@ -232,19 +238,31 @@ class SurfaceTool:
         return c, dist, ent, par
 
     def _local(self, m, y, sample, lower, c, dist, ent, par):
-        """Newton on the face of each point's nearest sample, from the sample's parameters:
-        min |X(u, v) - y|^2, the step -A^-1 g with g = J (X - y), A = J J^T + X_ij . (X - y).
-        Sure (True) where it converged inside the face and no other entity's bounding box lies
-        nearer than the point found; fills c, dist, ent, par there, and where it converged inside
-        the face but is not sure (a point of the surface, not known to be the nearest)."""
-        done = np.zeros(len(y), dtype=bool)
+        """Newton on the face of each point's nearest sample (on both faces of a sample on an
+        edge), from the sample's parameters: min |X(u, v) - y|^2, the step -A^-1 g with g =
+        J (X - y), A = J J^T + X_ij . (X - y). Where it converges inside a face, that face and
+        its edges are known for the point (the nearest point of a face found inside it is nearer
+        than its edges); the nearest point found is sure (True) where no other entity's bounding
+        box lies nearer. Fills c, dist, ent, par with the nearest point found inside a face (sure
+        or not: a point of the surface, which bounds the distance)."""
+        npts, nent = len(y), len(self._ents)
         k0 = self._sample_entity[sample]
-        for k in np.unique(k0):
-            dim, f = self._ents[k]
-            if dim != 2:
-                continue
-            idx = np.flatnonzero(k0 == k)
-            uv = self._sample_param[sample[idx]].copy()
+        on_face = self._is_face[k0]
+        pts, ks, uvs = [np.flatnonzero(on_face)], [k0[on_face]], [self._sample_param[sample[on_face]]]
+        for k in np.unique(k0[~on_face]):
+            e = self._ents[k][1]
+            i = np.flatnonzero(k0 == k)
+            t = self._sample_param[sample[i], 0]
+            for f in self._face_adjacent[e]:
+                pts.append(i)
+                ks.append(np.full(len(i), self._index[(2, f)]))
+                uvs.append(np.asarray(m.reparametrizeOnSurface(1, e, t, f)).reshape(-1, 2))
+        pts, ks, uvs = np.concatenate(pts), np.concatenate(ks), np.vstack(uvs)
+        known = np.zeros((npts, nent), dtype=bool)
+        for k in np.unique(ks):
+            f = self._ents[k][1]
+            sel = ks == k
+            idx, uv = pts[sel], uvs[sel].copy()
             yk = y[idx]
             ok = np.zeros(len(idx), dtype=bool)
             for _ in range(LOCAL_ITERATIONS):
@@ -277,12 +295,13 @@ class SurfaceTool:
                 ok &= inside & sure
             X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
             d = np.linalg.norm(yk - X, axis=1)
-            rows = idx[ok]
-            c[rows], dist[rows], ent[rows], par[rows] = X[ok], d[ok], k, uv[ok]
-            others = lower[idx].copy()
-            others[:, k] = np.inf
-            done[idx[ok & (d <= others.min(axis=1))]] = True
-        return done
+            better = ok & (d < dist[idx])
+            rows = idx[better]
+            c[rows], dist[rows], ent[rows], par[rows] = X[better], d[better], k, uv[better]
+            known[idx[ok], k] = True
+            known[np.ix_(idx[ok], self._face_edges[k])] = True
+        others = np.where(known, np.inf, lower).min(axis=1)
+        return (ent >= 0) & (dist <= others)
 
     def _candidates(self, m, y, upper, lower, seed):
         """The nearest of every entity's projection whose bounding box lies within `upper`, and
@@ -346,11 +365,11 @@ class SurfaceTool:
     def _trim(self, m, f, uv, inside):
         """A trimmed face's boundary in its parameters: its edges sampled every 1/BOUNDARY_SAMPLES
         of the tool's size (at least 16 points an edge) as segments; their midpoints in a k-d
-        tree with each segment's normal pointing into the face (isInside at a point just beside
-        the midpoint); the margin within which the sampled boundary may differ from the true one
+        tree with each segment's normal pointing into the face (isInside at the points half a
+        segment to either side of the midpoint); the margin within which the sampled boundary may differ from the true one
         (half the longest segment plus twice the largest deviation of an edge's mid-parameter
-        point from its segment). None where that classifies the sampled parameters `uv` other
-        than isInside does."""
+        point from its segment). None where the sides are not told apart or where that
+        classifies the sampled parameters `uv` other than isInside does."""
         from scipy.spatial import cKDTree
 
         mids, normals, margin = [], [], 0.0
@@ -368,8 +387,11 @@ class SurfaceTool:
             keep = length > 0
             normal = np.c_[-chord[:, 1], chord[:, 0]][keep] / length[keep, None]
             centre = 0.5 * (ends[:-1] + ends[1:])[keep]
-            beside = centre + 1e-3 * length[keep, None] * normal
-            into = np.array([m.isInside(2, f, q, True) > 0 for q in beside])
+            step = 0.5 * length[keep, None] * normal  # OCC's classifier takes points within its tolerance as inside
+            into = np.array([m.isInside(2, f, q, True) > 0 for q in centre + step])
+            out = np.array([m.isInside(2, f, q, True) > 0 for q in centre - step])
+            if np.any(into == out):  # the boundary's sides not told apart
+                return None
             mids.append(centre)
             normals.append(np.where(into[:, None], normal, -normal))
             sag = np.linalg.norm(mid - 0.5 * (ends[:-1] + ends[1:]), axis=1)
