@@ -8,19 +8,23 @@ what the analytic tools give (tools.py): for points x,
                           unit normal pointing from the tool towards the point;
     shape(x, offset, dz)  H = dn/dx (n, 3, 3), the Hessian of the signed distance.
 
-The surface is evaluated, not meshed. For a point x the closest surface point c is the nearest
-of the candidates
+The surface is evaluated, not meshed (docs/tools.md). For a point x the closest surface point
+c is found in two steps:
 
-    faces   the orthogonal projection onto the face's underlying surface (getClosestPoint), kept
-            where it lies inside the trimmed face (its parametric bounds for a face that fills
-            them, isInside for a trimmed one);
-    edges   the projection onto each edge, its parameter clamped to the edge's range (the
-            closest point of a face whose projection falls outside it lies on its boundary);
+    local       Newton on the face of the nearest of points sampled on every face and edge (a
+                k-d tree; both faces of a sample on an edge), from the sample's parameters; a
+                point it finds inside its face is the face's nearest, and sure where no other
+                entity's bounding box lies nearer (the face's own edges are settled by it);
+    candidates  for the other points, the nearest of the projections onto every entity whose
+                bounding box lies within the best distance found so far: a face's orthogonal
+                projection onto its underlying surface (getClosestPoint, OCC's global one), kept
+                where it lies inside the trimmed face (its parametric bounds for a face that
+                fills them; for a trimmed one the inner side of its sampled boundary, isInside
+                within the sampling's margin); an edge's projection with its parameter clamped
+                to its range (the nearest point of a face whose projection falls outside it
+                lies on its boundary).
 
-only entities whose bounding box lies nearer than an upper bound of the distance are projected
-(the upper bound: the nearest of points sampled on every face and edge, a k-d tree). A face
-whose projection is not its nearest point (a second, non-global minimum of the distance inside
-the face) is not found: the projection is OCC's global one over the face's surface.
+A second, non-global minimum of the distance inside one face is not found.
 
 Signed distance and normal. The faces' normals (getNormal, oriented by OCC's face orientation:
 outward for the faces of a solid) point to the side of the sheet; ``normals = "inward"`` turns
@@ -47,9 +51,10 @@ analytic tools take one side of a region boundary.
 
 gmsh runs in this process, initialised once per process (every MPI rank evaluates its own
 points); each tool is a gmsh model of its own, made current while it is evaluated. A file is
-read first by a child process stopped after READ_SECONDS (a file that stalls or crashes OCC's
-reader does not stall or crash the run), then imported here with gmsh.model.occ.importShapes,
-which reads the shapes only (gmsh's open/merge would also merge a FILE.opt script beside it).
+read first by a child process (importing gmsh only, no MPI) stopped after READ_SECONDS (a file
+that stalls or crashes OCC's reader does not stall or crash the run), then imported here with
+gmsh.model.occ.importShapes, which reads the shapes only (gmsh's open/merge would also merge a
+FILE.opt script beside it).
 Lengths are in mm: OCC converts the file's unit to mm (Geometry.OCCTargetUnit).
 """
 
@@ -366,9 +371,9 @@ class SurfaceTool:
         """A trimmed face's boundary in its parameters: its edges sampled every 1/BOUNDARY_SAMPLES
         of the tool's size (at least 16 points an edge) as segments; their midpoints in a k-d
         tree with each segment's normal pointing into the face (isInside at the points half a
-        segment to either side of the midpoint); the margin within which the sampled boundary may differ from the true one
-        (half the longest segment plus twice the largest deviation of an edge's mid-parameter
-        point from its segment). None where the sides are not told apart or where that
+        segment to either side of the midpoint); the margin within which the sampled boundary
+        may differ from the true one (half the longest segment plus twice the largest deviation
+        of an edge's mid-parameter point from its segment). None where the sides are not told apart or where that
         classifies the sampled parameters `uv` other than isInside does."""
         from scipy.spatial import cKDTree
 
@@ -560,7 +565,7 @@ def probe(path: Path, field: str) -> dict:
                          f"{', '.join(CAD_SUFFIXES)}")
     if path.stat().st_size > MAX_CAD_BYTES:
         raise InputError(field, f"{path} is larger than {MAX_CAD_BYTES:,} bytes")
-    cmd = [sys.executable, "-P", str(Path(__file__).resolve()), str(path)]
+    cmd = [sys.executable, "-P", "-c", _CHILD, str(path)]
     try:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=READ_SECONDS, stdin=subprocess.DEVNULL)
     except subprocess.TimeoutExpired:
@@ -577,25 +582,23 @@ def probe(path: Path, field: str) -> dict:
     return result
 
 
-def _summary(path: str) -> dict:
-    import gmsh
-
-    gmsh.initialize(readConfigFiles=False, interruptible=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
-        gmsh.model.add("shellform_tool")
-        try:
-            gmsh.model.occ.importShapes(path)
-            gmsh.model.occ.synchronize()
-        except Exception as exc:  # noqa: BLE001
-            return {"error": str(exc)}
-        faces = gmsh.model.getEntities(2)
-        box = gmsh.model.getBoundingBox(-1, -1) if faces else [0.0] * 6
-        return {"faces": len(faces), "box": list(box)}
-    finally:
-        gmsh.finalize()
-
-
-if __name__ == "__main__":  # the child of probe: imports gmsh only
-    print("\n" + _MARK + json.dumps(_summary(sys.argv[1])), flush=True)
+# the child of probe: python -P -c _CHILD FILE. It imports gmsh only (not shellform, whose import
+# would start MPI in a child of an MPI rank) and prints one line, _MARK and JSON: the file's
+# faces and bounding box, or {"error": gmsh's message}.
+_CHILD = """
+import json, sys
+import gmsh
+gmsh.initialize(readConfigFiles=False, interruptible=False)
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
+gmsh.model.add("shellform_tool")
+try:
+    gmsh.model.occ.importShapes(sys.argv[1])
+    gmsh.model.occ.synchronize()
+    faces = gmsh.model.getEntities(2)
+    result = {"faces": len(faces), "box": list(gmsh.model.getBoundingBox(-1, -1)) if faces else [0.0] * 6}
+except Exception as exc:
+    result = {"error": str(exc)}
+gmsh.finalize()
+print("\\n" + MARK + json.dumps(result), flush=True)
+""".replace("MARK", repr(_MARK))

@@ -10,8 +10,9 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Geometry, Loads, Material, MeshSpec,
-                                    Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
+from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment,
+                                    Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
+                                    Surface, ToolsSpec)
 
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 from shellform import effects as registry
 from shellform.mesh import outline
 
-__all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS", "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
+__all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS",
+           "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
            "Drawbead", "ToolsSpec", "Output", "Scene", "bounds"]
@@ -159,7 +160,8 @@ class ToolsSpec:
     punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
     punch_file: str = ""  # cad: the punch's STEP, IGES or BREP file, relative to the scene's folder
     die_file: str = ""  # cad: the die's
-    punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])  # cad: mm, the file's frame -> the scene's
+    # cad: mm, moving the file's frame into the scene's
+    punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     die_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     punch_normals: str = "outward"  # cad: "outward" (the faces' normals point to the sheet) or "inward"
     die_normals: str = "outward"
