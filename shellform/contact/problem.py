@@ -14,6 +14,7 @@ from shellform import supports as named_supports
 from shellform.assembly.sheet_element import BS
 from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
+from shellform.contact.surface_tool import cad_cup_tools, check_start
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import blank
 from shellform.nonlinear.model import SheetModel
@@ -38,7 +39,9 @@ class DrawingProblem:
         model = SheetModel(rect.mesh, s.hill79().pack(), s.material.thickness, s.effects, pr.thickness_points)
         bcs = named_supports.boundary_conditions(model.V, model.components, rect, s.supports,
                                                  fixed=named_supports.sheet_fixed_components)
-        tools = square_cup_tools(t, s.material.thickness)
+        tools = (cad_cup_tools if t.shape == "cad" else square_cup_tools)(t, s.material.thickness)
+        if t.shape == "cad":
+            check_start(tools, rect.mesh.geometry.x, s.material.thickness / 2, comm, 1e-2 * s.material.thickness)
         symmetry = s.symmetry_copies
         controls = scene_controls(s)
         mu = t.friction if "friction" in s.effects else 0.0

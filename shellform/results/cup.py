@@ -42,6 +42,7 @@ LINES = {  # the thickness lines of a cup by its tools' shape: name -> nodes on 
                "transverse": lambda X, tol: np.abs(X[:, 1]) < tol},
     "round": {"0deg": lambda X, tol: np.abs(X[:, 1]) < tol, "90deg": lambda X, tol: np.abs(X[:, 0]) < tol},
 }
+LINES["cad"] = LINES["square"]  # a cup drawn by CAD tools: the square cup's lines
 
 
 def thickness_lines(p) -> dict[str, list[dict]]:

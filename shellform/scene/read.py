@@ -11,8 +11,9 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Geometry, Loads, Material, MeshSpec,
-                                    Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
+from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment,
+                                    Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
+                                    Surface, ToolsSpec)
 
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
@@ -105,6 +106,11 @@ def from_dict(data: dict) -> Scene:
             if key in tools:
                 raise InputError(f"tools.{key}", "is a key of square tools: round tools take punch_radius and "
                                  "die_radius")
+    if isinstance(tools, dict):
+        for key in ANALYTIC_TOOL_KEYS if tools.get("shape") == "cad" else CAD_TOOL_KEYS:
+            if key in tools:
+                raise InputError(f"tools.{key}", "is a key of analytic tools: shape = 'cad' takes punch_file, die_file "
+                                 "and their placements" if tools.get("shape") == "cad" else "is a key of shape = 'cad'")
     if "loads" in data:
         loads = dict(data["loads"]) if isinstance(data["loads"], dict) else data["loads"]
         if not isinstance(loads, dict):
@@ -138,6 +144,11 @@ def load(path: str | Path) -> Scene:
     for key in ("flow_curve", "forming_limit_curve"):  # files relative to the scene
         if isinstance(material, dict) and isinstance(material.get(key), str) and material[key]:
             material = data["material"] = {**material, key: str(path.parent / material[key])}
+    tools = data.get("tools")
+    if isinstance(tools, dict):
+        for key in ("punch_file", "die_file"):
+            if isinstance(tools.get(key), str) and tools[key]:
+                tools[key] = str(path.parent / tools[key])  # relative to the scene
     return from_dict(data)
 
 
@@ -156,6 +167,9 @@ def to_dict(s: Scene) -> dict:
     if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
         for key in SQUARE_TOOL_KEYS:
             del data["tools"][key]
+    if s.tools is not None:  # the keys of the other kind of tools are not the scene's
+        for key in ANALYTIC_TOOL_KEYS if s.tools.shape == "cad" else CAD_TOOL_KEYS:
+            data["tools"].pop(key, None)
     return data
 
 

@@ -17,14 +17,21 @@ from dataclasses import dataclass, field
 from shellform import effects as registry
 from shellform.mesh import outline
 
-__all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "SPREADS", "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
+__all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS",
+           "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
            "Drawbead", "ToolsSpec", "Output", "Scene", "bounds"]
 
-TOOL_SHAPES = ("square", "round")
+TOOL_SHAPES = ("square", "round", "cad")
 SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
+# the analytic tools' keys, which shape = "cad" does not take (its punch and die are files)
+ANALYTIC_TOOL_KEYS = (*SQUARE_TOOL_KEYS, "punch_profile_radius", "die_profile_radius", "punch_radius", "die_radius",
+                      "punch_gap")
+CAD_TOOL_KEYS = ("punch_file", "die_file", "punch_translation", "die_translation", "punch_normals", "die_normals",
+                 "holder_half_width", "holder_corner_radius")
+TOOL_NORMALS = ("outward", "inward")  # which way a CAD tool's faces' normals point: to the sheet, or away
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
 
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
@@ -166,9 +173,11 @@ class Drawbead:
 class ToolsSpec:
     """Rigid tools of cup deep drawing (shellform.contact.tools): square (NUMISHEET'93) or round.
     A round punch is the square one with plan corner radius = half-width = punch_radius (its
-    plan is a circle), a round die the same with die_radius."""
+    plan is a circle), a round die the same with die_radius. "cad": punch and die are the
+    surfaces of CAD files (shellform.contact.surface_tool), the holder the flat one over the
+    rounded square (holder_half_width, holder_corner_radius) and outside it."""
 
-    shape: str = "square"  # "square" or "round"
+    shape: str = "square"  # "square", "round" or "cad"
     punch_radius: float = 0.0  # round: the punch's radius (0: unset)
     die_radius: float = 0.0  # round: the die opening's radius (0: unset)
     punch_half_width: float = 35.0  # 70 mm square punch
@@ -178,6 +187,15 @@ class ToolsSpec:
     die_corner_radius: float = 12.0
     die_profile_radius: float = 5.0  # die shoulder radius
     punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
+    punch_file: str = ""  # cad: the punch's STEP, IGES or BREP file, relative to the scene's folder
+    die_file: str = ""  # cad: the die's
+    # cad: mm, moving the file's frame into the scene's
+    punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    die_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    punch_normals: str = "outward"  # cad: "outward" (the faces' normals point to the sheet) or "inward"
+    die_normals: str = "outward"
+    holder_half_width: float = 0.0  # cad: the holder's inner edge, a rounded square (where the die's flat top begins)
+    holder_corner_radius: float = 0.0
     blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
     friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
     stroke: float = 30.0  # punch travel, mm

@@ -1,0 +1,604 @@
+"""A rigid tool whose surface is a CAD model, evaluated by gmsh's OpenCASCADE kernel.
+
+The tool is the set of faces of an OCC model (a STEP, IGES or BREP file, or a model a Python
+function builds with gmsh.model.occ), placed by a translation and moved by dz along z. It gives
+what the analytic tools give (tools.py): for points x,
+
+    gap(x, offset, dz)    the signed distance to the surface minus offset (> 0 clear), and the
+                          unit normal pointing from the tool towards the point;
+    shape(x, offset, dz)  H = dn/dx (n, 3, 3), the Hessian of the signed distance.
+
+The surface is evaluated, not meshed (docs/tools.md). For a point x the closest surface point
+c is found in two steps:
+
+    local       Newton on the face of the nearest of points sampled on every face and edge (a
+                k-d tree; both faces of a sample on an edge), from the sample's parameters; a
+                point it finds inside its face is the face's nearest, and sure where no other
+                entity's bounding box lies nearer (the face's own edges are settled by it);
+    candidates  for the other points, the nearest of the projections onto every entity whose
+                bounding box lies within the best distance found so far: a face's orthogonal
+                projection onto its underlying surface (getClosestPoint, OCC's global one), kept
+                where it lies inside the trimmed face (its parametric bounds for a face that
+                fills them; for a trimmed one the inner side of its sampled boundary, isInside
+                within the sampling's margin); an edge's projection with its parameter clamped
+                to its range (the nearest point of a face whose projection falls outside it
+                lies on its boundary).
+
+A second, non-global minimum of the distance inside one face is not found.
+
+Signed distance and normal. The faces' normals (getNormal, oriented by OCC's face orientation:
+outward for the faces of a solid) point to the side of the sheet; ``normals = "inward"`` turns
+them all. With the closest point c on a face of normal n_c at c, the signed distance is
+d = (x - c) . n_c (x - c is parallel to n_c there) and the normal n = n_c. On an edge, d =
++/-|x - c| with the sign of (x - c) . (n_a + n_b), n_a, n_b the normals of the edge's faces at
+c, and n = (x - c) / d (the faces' mean normal where x lies on the edge).
+
+Shape operator. On a face, with X_u, X_v, X_uu, X_uv, X_vv the parametrisation's derivatives at
+c, J = [X_u X_v], G = J^T J and B_ij = -n . X_ij (B/G > 0 where the tool is convex), the surface's
+shape operator is H0 = J G^-1 B G^-1 J^T (tangential, symmetric), and the distance's Hessian at
+distance d from it is H = H0 (I + d H0)^-1: each principal curvature k becomes k / (1 + k d),
+the level surface's. On an edge between two faces that meet at an angle (a sharp edge), H =
+(I - n n^T - e e^T) / d, e the edge's tangent: the Hessian of the distance to a straight line
+(the edge's own curvature is left out).
+
+Seams. Between two faces that meet tangentially (a fillet's seam, G1) the normal is
+continuous, so gap and normal are smooth across the seam; H jumps there (a fillet's curvature
+is not that of the face it meets). A point whose closest point lies on the seam takes the face
+whose projection is nearest (within round-off, the one gmsh's isInside accepts; ties go to
+the lower face tag); reached through the edge (neither face accepts it), it takes the edge's
+first face that meets it tangentially. Either is one of the two one-sided values, as the
+analytic tools take one side of a region boundary.
+
+gmsh runs in this process, initialised once per process (every MPI rank evaluates its own
+points); each tool is a gmsh model of its own, made current while it is evaluated. A file is
+read first by a child process (importing gmsh only, no MPI) stopped after READ_SECONDS (a file
+that stalls or crashes OCC's reader does not stall or crash the run), then imported here with
+gmsh.model.occ.importShapes, which reads the shapes only (gmsh's open/merge would also merge a
+FILE.opt script beside it).
+Lengths are in mm: OCC converts the file's unit to mm (Geometry.OCCTargetUnit).
+"""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from shellform.errors import InputError
+
+CAD_SUFFIXES = (".step", ".stp", ".STEP", ".STP", ".iges", ".igs", ".IGES", ".IGS", ".brep", ".BREP")
+MAX_CAD_BYTES = 200_000_000  # a tool's CAD file larger than this is refused
+READ_SECONDS = 60.0  # the longest the child may take to read a tool's file
+LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
+SAMPLES = 24  # points per parametric direction sampled on a face (per edge: along it) for the upper bounds
+BOUNDARY_SAMPLES = 400  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
+NORMALS = ("outward", "inward")
+_MARK = "shellform-cad-read: "
+
+
+def _gmsh():
+    import gmsh
+
+    if not gmsh.isInitialized():
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.Verbosity", 0)
+    return gmsh
+
+
+class _Current:
+    """The tool's gmsh model made current; the previous current model restored afterwards."""
+
+    def __init__(self, name):
+        self.name = name
+
+    def __enter__(self):
+        gmsh = _gmsh()
+        self.previous = gmsh.model.getCurrent()
+        gmsh.model.setCurrent(self.name)
+        return gmsh
+
+    def __exit__(self, *exc):
+        import gmsh
+
+        if self.previous and self.previous != self.name:
+            gmsh.model.setCurrent(self.previous)
+
+
+class SurfaceTool:
+    """A rigid tool: the faces of the OCC model `model` (a gmsh model's name), placed by
+    `translation` (mm), its faces' normals pointing to the sheet (`normals` "outward") or away
+    from it ("inward": turned). Build it with from_file or from_builder."""
+
+    _count = 0
+
+    def __init__(self, model: str, translation=(0.0, 0.0, 0.0), normals: str = "outward"):
+        if normals not in NORMALS:
+            raise ValueError(f"normals must be one of {NORMALS}, got {normals!r}")
+        self.model, self.sign = model, 1.0 if normals == "outward" else -1.0
+        self.translation = np.asarray(translation, dtype=float).reshape(3)
+        with _Current(model) as gmsh:
+            self.faces = [t for _, t in gmsh.model.getEntities(2)]
+            self.edges = [t for _, t in gmsh.model.getEntities(1)]
+            if not self.faces:
+                raise ValueError("the model holds no surface")
+            self._face_adjacent = {e: sorted(set(int(f) for f in gmsh.model.getAdjacencies(1, e)[0]))
+                                   for e in self.edges}
+            self._setup(gmsh)
+            self._index = {de: k for k, de in enumerate(self._ents)}
+            self._is_face = np.array([d == 2 for d, _ in self._ents])
+            self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
+                                                               for e in gmsh.model.getAdjacencies(2, f)[1]], dtype=int)
+                                for f in self.faces}
+
+    # -- construction ------------------------------------------------------------------------
+    @classmethod
+    def _new_model(cls):
+        gmsh = _gmsh()
+        cls._count += 1
+        name = f"shellform_tool_{cls._count}"
+        previous = gmsh.model.getCurrent()
+        gmsh.model.add(name)
+        return gmsh, name, previous
+
+    @classmethod
+    def from_builder(cls, build, translation=(0.0, 0.0, 0.0), normals: str = "outward") -> "SurfaceTool":
+        """The tool that build(gmsh) makes with gmsh.model.occ in a fresh model (it need not
+        synchronize)."""
+        gmsh, name, previous = cls._new_model()
+        try:
+            build(gmsh)
+            gmsh.model.occ.synchronize()
+        finally:
+            if previous:
+                gmsh.model.setCurrent(previous)
+        return cls(name, translation, normals)
+
+    @classmethod
+    def from_file(cls, path, translation=(0.0, 0.0, 0.0), normals: str = "outward",
+                  field: str = "tools.file") -> "SurfaceTool":
+        """The tool of a STEP, IGES or BREP file (a bad file: InputError naming `field`)."""
+        path = Path(path)
+        probe(path, field)
+        gmsh, name, previous = cls._new_model()
+        try:
+            gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
+            gmsh.model.occ.importShapes(str(path))
+            gmsh.model.occ.synchronize()
+        except Exception as exc:  # noqa: BLE001  (gmsh raises plain Exceptions)
+            raise InputError(field, f"gmsh cannot read {path}: {exc}") from None
+        finally:
+            if previous:
+                gmsh.model.setCurrent(previous)
+        try:
+            return cls(name, translation, normals)
+        except ValueError as exc:
+            raise InputError(field, f"{path}: {exc}") from None
+
+    def _setup(self, gmsh):
+        """Bounding boxes, parametric bounds, whether each face fills its parametric bounds, and
+        the sampled points of the upper bounds."""
+        m = gmsh.model
+        self._ents = [(2, f) for f in self.faces] + [(1, e) for e in self.edges]
+        self._box = np.array([m.getBoundingBox(d, t) for d, t in self._ents]).reshape(-1, 2, 3)
+        lo, hi = self._box[:, 0].min(axis=0), self._box[:, 1].max(axis=0)
+        self.size = float(np.linalg.norm(hi - lo))
+        self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
+        self._bounds, self._filled, self._trims = {}, {}, {}
+        points, owner, params = [], [], []
+        s = np.linspace(0.0, 1.0, SAMPLES)
+        for k, (d, t) in enumerate(self._ents):
+            b0, b1 = (np.asarray(v, dtype=float) for v in m.getParametrizationBounds(d, t))
+            self._bounds[(d, t)] = (b0, b1)
+            if d == 2:
+                u, v = np.meshgrid(b0[0] + s * (b1[0] - b0[0]), b0[1] + s * (b1[1] - b0[1]))
+                uv = np.c_[u.ravel(), v.ravel()]
+                inside = np.array([m.isInside(2, t, q, True) > 0 for q in uv])
+                self._filled[t] = bool(inside.all())
+                if not self._filled[t]:
+                    self._trims[t] = self._trim(m, t, uv, inside)
+                uv = uv[inside]
+                if uv.size == 0:
+                    continue
+                xyz = np.asarray(m.getValue(2, t, uv.ravel())).reshape(-1, 3)
+            else:
+                uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
+                xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
+            points.append(xyz)
+            owner.append(np.full(len(xyz), k))
+            params.append(uv)
+        from scipy.spatial import cKDTree
+
+        self._tree = cKDTree(np.vstack(points))
+        self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
+
+    # -- evaluation --------------------------------------------------------------------------
+    def closest(self, x, dz: float = 0.0):
+        """For points x (n, 3): the closest surface points c (placed), the signed distances d,
+        the normals n, and per point the entity (dim, tag) it lies on with its parametric
+        coordinates (a face: (u, v); an edge: (t, 0))."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        shift = self.translation + np.array([0.0, 0.0, dz])
+        y = x - shift  # in the model's frame
+        with _Current(self.model) as gmsh:
+            c, dist, ent, par = self._nearest(gmsh, y)
+            d, n = self._signed(gmsh, y, c, dist, ent, par)
+        return c + shift, d, n, ent, par
+
+    def _nearest(self, gmsh, y):
+        """Closest points: first the local projection from the nearest sample (_local), where
+        it is sure; the other points by the candidates' projections (_candidates)."""
+        upper, sample = self._tree.query(y)
+        upper = upper * (1 + 1e-9) + 1e-9 * self.size
+        lower = np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
+                               + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)  # (points, entities)
+        c, dist, ent, par = np.zeros_like(y), np.full(len(y), np.inf), np.full(len(y), -1), np.zeros((len(y), 2))
+        done = self._local(gmsh.model, y, sample, lower, c, dist, ent, par)
+        rest = np.flatnonzero(~done)
+        if rest.size:  # a point found by the local projection bounds the distance and is a candidate
+            seed = (c[rest], dist[rest], ent[rest], par[rest])
+            upper = np.minimum(upper[rest], dist[rest] * (1 + 1e-9) + 1e-9 * self.size)
+            c[rest], dist[rest], ent[rest], par[rest] = self._candidates(gmsh.model, y[rest], upper, lower[rest], seed)
+        return c, dist, ent, par
+
+    def _local(self, m, y, sample, lower, c, dist, ent, par):
+        """Newton on the face of each point's nearest sample (on both faces of a sample on an
+        edge), from the sample's parameters: min |X(u, v) - y|^2, the step -A^-1 g with g =
+        J (X - y), A = J J^T + X_ij . (X - y). Where it converges inside a face, that face and
+        its edges are known for the point (the nearest point of a face found inside it is nearer
+        than its edges); the nearest point found is sure (True) where no other entity's bounding
+        box lies nearer. Fills c, dist, ent, par with the nearest point found inside a face (sure
+        or not: a point of the surface, which bounds the distance)."""
+        npts, nent = len(y), len(self._ents)
+        k0 = self._sample_entity[sample]
+        on_face = self._is_face[k0]
+        pts, ks, uvs = [np.flatnonzero(on_face)], [k0[on_face]], [self._sample_param[sample[on_face]]]
+        for k in np.unique(k0[~on_face]):
+            e = self._ents[k][1]
+            i = np.flatnonzero(k0 == k)
+            t = self._sample_param[sample[i], 0]
+            for f in self._face_adjacent[e]:
+                pts.append(i)
+                ks.append(np.full(len(i), self._index[(2, f)]))
+                uvs.append(np.asarray(m.reparametrizeOnSurface(1, e, t, f)).reshape(-1, 2))
+        pts, ks, uvs = np.concatenate(pts), np.concatenate(ks), np.vstack(uvs)
+        known = np.zeros((npts, nent), dtype=bool)
+        for k in np.unique(ks):
+            f = self._ents[k][1]
+            sel = ks == k
+            idx, uv = pts[sel], uvs[sel].copy()
+            yk = y[idx]
+            ok = np.zeros(len(idx), dtype=bool)
+            for _ in range(LOCAL_ITERATIONS):
+                X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+                J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
+                S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+                r = X - yk
+                g = np.einsum("pai,pi->pa", J, r)
+                Sr = np.einsum("pki,pi->pk", S, r)
+                A = np.einsum("pai,pbi->pab", J, J)
+                A[:, 0, 0] += Sr[:, 0]
+                A[:, 1, 1] += Sr[:, 1]
+                A[:, 0, 1] += Sr[:, 2]
+                A[:, 1, 0] += Sr[:, 2]
+                det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+                good = (det > 0) & (A[:, 0, 0] > 0)
+                det = np.where(good, det, 1.0)
+                step = -np.stack([A[:, 1, 1] * g[:, 0] - A[:, 0, 1] * g[:, 1],
+                                  A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
+                step[~good] = 0.0
+                uv += step
+                ok = good & (np.linalg.norm(np.einsum("pai,pa->pi", J, step), axis=1) < 1e-13 * self.size)
+                if ok.all():
+                    break
+            b0, b1 = self._bounds[(2, f)]
+            tol = 1e-9 * (b1 - b0 + 1.0)
+            ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
+            if not self._filled[f]:
+                inside, sure = self._in_trim(f, uv)
+                ok &= inside & sure
+            X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+            d = np.linalg.norm(yk - X, axis=1)
+            better = ok & (d < dist[idx])
+            rows = idx[better]
+            c[rows], dist[rows], ent[rows], par[rows] = X[better], d[better], k, uv[better]
+            known[idx[ok], k] = True
+            known[np.ix_(idx[ok], self._face_edges[k])] = True
+        others = np.where(known, np.inf, lower).min(axis=1)
+        return (ent >= 0) & (dist <= others)
+
+    def _candidates(self, m, y, upper, lower, seed):
+        """The nearest of every entity's projection whose bounding box lies within `upper`, and
+        of the seed (c, dist, entity, parameters: the local projection's point, entity -1 where
+        there is none)."""
+        npts = len(y)
+        cand = lower <= upper[:, None]
+        nent = len(self._ents)
+        D = np.full((npts, nent), np.inf)
+        C = np.zeros((npts, nent, 3))
+        P = np.zeros((npts, nent, 2))
+        seeded = np.flatnonzero(seed[2] >= 0)
+        k = seed[2][seeded]
+        C[seeded, k], D[seeded, k], P[seeded, k] = seed[0][seeded], seed[1][seeded], seed[3][seeded]
+        cand[seeded, k] = False
+        unknown = np.zeros((npts, nent), dtype=bool)  # a trimmed face's projection, not checked yet
+        for k, (d, t) in enumerate(self._ents):
+            idx = np.flatnonzero(cand[:, k])
+            if idx.size == 0:
+                continue
+            b0, b1 = self._bounds[(d, t)]
+            c, p = m.getClosestPoint(d, t, y[idx].ravel())
+            c = np.asarray(c).reshape(-1, 3)
+            if d == 1:
+                p = np.asarray(p, dtype=float)
+                q = np.clip(p, b0[0], b1[0])
+                moved = q != p
+                if moved.any():
+                    c[moved] = np.asarray(m.getValue(1, t, q[moved])).reshape(-1, 3)
+                P[idx, k, 0] = q
+            else:
+                p = np.asarray(p, dtype=float).reshape(-1, 2)
+                P[idx, k] = p
+                tol = 1e-9 * (b1 - b0 + 1.0)
+                within = np.all((p >= b0 - tol) & (p <= b1 + tol), axis=1)
+                if self._filled[t]:
+                    idx, c = idx[within], c[within]
+                else:
+                    idx, c, p = idx[within], c[within], p[within]
+                    inside, sure = self._in_trim(t, p)
+                    unknown[idx[~sure], k] = True
+                    keep = inside | ~sure
+                    idx, c = idx[keep], c[keep]
+            C[idx, k] = c
+            D[idx, k] = np.linalg.norm(y[idx] - c, axis=1)
+        # trimmed faces: check the nearest candidate of each point until a valid one is nearest
+        while True:
+            best = np.argmin(D, axis=1)
+            rows = np.flatnonzero(unknown[np.arange(npts), best])
+            if rows.size == 0:
+                break
+            for i in rows:
+                k = best[i]
+                unknown[i, k] = False
+                if m.isInside(2, self._ents[k][1], P[i, k], True) <= 0:
+                    D[i, k] = np.inf
+        best = np.argmin(D, axis=1)
+        r = np.arange(npts)
+        return C[r, best], D[r, best], best, P[r, best]
+
+    def _trim(self, m, f, uv, inside):
+        """A trimmed face's boundary in its parameters: its edges sampled every 1/BOUNDARY_SAMPLES
+        of the tool's size (at least 16 points an edge) as segments; their midpoints in a k-d
+        tree with each segment's normal pointing into the face (isInside at the points half a
+        segment to either side of the midpoint); the margin within which the sampled boundary
+        may differ from the true one (half the longest segment plus twice the largest deviation
+        of an edge's mid-parameter point from its segment). None where the sides are not told apart or where that
+        classifies the sampled parameters `uv` other than isInside does."""
+        from scipy.spatial import cKDTree
+
+        mids, normals, margin = [], [], 0.0
+        for e in m.getAdjacencies(2, f)[1]:
+            e = abs(int(e))
+            x0, y0, z0, x1, y1, z1 = m.getBoundingBox(1, e)
+            count = int(np.clip(np.hypot(np.hypot(x1 - x0, y1 - y0), z1 - z0) / self.size * BOUNDARY_SAMPLES,
+                                16, 4096))
+            b0, b1 = m.getParametrizationBounds(1, e)
+            t = np.linspace(b0[0], b1[0], 2 * count + 1)
+            q = np.asarray(m.reparametrizeOnSurface(1, e, t, f)).reshape(-1, 2)
+            ends, mid = q[::2], q[1::2]
+            chord = ends[1:] - ends[:-1]
+            length = np.linalg.norm(chord, axis=1)
+            keep = length > 0
+            normal = np.c_[-chord[:, 1], chord[:, 0]][keep] / length[keep, None]
+            centre = 0.5 * (ends[:-1] + ends[1:])[keep]
+            step = 0.5 * length[keep, None] * normal  # OCC's classifier takes points within its tolerance as inside
+            into = np.array([m.isInside(2, f, q, True) > 0 for q in centre + step])
+            out = np.array([m.isInside(2, f, q, True) > 0 for q in centre - step])
+            if np.any(into == out):  # the boundary's sides not told apart
+                return None
+            mids.append(centre)
+            normals.append(np.where(into[:, None], normal, -normal))
+            sag = np.linalg.norm(mid - 0.5 * (ends[:-1] + ends[1:]), axis=1)
+            margin = max(margin, 0.5 * float(length.max()) + 2.0 * float(sag.max()))
+        trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size)
+        self._trims[f] = trim
+        ins, sure = self._in_trim(f, uv)
+        return trim if bool(np.all(ins[sure] == inside[sure])) else None
+
+    def _in_trim(self, f, uv):
+        """(inside, sure) for parameters uv of trimmed face f: inside where uv lies on the inner
+        side of its nearest boundary segment, sure where it lies farther from the sampled
+        boundary than the margin (_trim); isInside decides the others."""
+        trim = self._trims.get(f)
+        if trim is None:
+            return np.zeros(len(uv), dtype=bool), np.zeros(len(uv), dtype=bool)
+        tree, normals, margin = trim
+        dist, i = tree.query(uv)
+        inside = np.einsum("pi,pi->p", uv - tree.data[i], normals[i]) > 0
+        return inside, dist > margin
+
+    def _signed(self, gmsh, y, c, dist, ent, par):
+        m = gmsh.model
+        n = np.zeros((len(y), 3))
+        d = dist.copy()
+        for k in np.unique(ent):
+            dim, t = self._ents[k]
+            rows = np.flatnonzero(ent == k)
+            if dim == 2:
+                nc = self.sign * np.asarray(m.getNormal(t, par[rows].ravel())).reshape(-1, 3)
+                n[rows] = nc
+                d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], nc)
+            else:
+                mean = self._edge_faces_normal(m, t, par[rows, 0])[0]
+                v = y[rows] - c[rows]
+                s = np.where(np.einsum("ij,ij->i", v, mean) < 0.0, -1.0, 1.0)
+                d[rows] = s * dist[rows]
+                far = dist[rows] > 1e-12 * self.size
+                n[rows] = np.where(far[:, None], s[:, None] * v / np.where(far, dist[rows], 1.0)[:, None], mean)
+        return d, n
+
+    def _edge_faces_normal(self, m, e, t):
+        """The mean of the (turned) normals of the faces meeting at edge e at its parameters t,
+        normalised, and the faces' normals (faces, points, 3)."""
+        normals = []
+        for f in self._face_adjacent[e]:
+            uv = np.asarray(m.reparametrizeOnSurface(1, e, t, f)).reshape(-1, 2)
+            normals.append(self.sign * np.asarray(m.getNormal(f, uv.ravel())).reshape(-1, 3))
+        normals = np.array(normals).reshape(-1, len(t), 3)
+        mean = normals.sum(axis=0)
+        mean /= np.maximum(np.linalg.norm(mean, axis=1), 1e-300)[:, None]
+        return mean, normals
+
+    def gap(self, x, offset=0.0, dz: float = 0.0):
+        """Signed distance minus offset (> 0 clear) and unit normal from the tool towards x."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        _, d, n, _, _ = self.closest(x, dz)
+        return d - np.broadcast_to(np.asarray(offset, dtype=float), d.shape), n + 0.0
+
+    def shape(self, x, offset=0.0, dz: float = 0.0):
+        """H = dn/dx (n, 3, 3) (module docstring): H0 (I + d H0)^-1 on a face, (I - n n^T -
+        e e^T) / d beside a sharp edge."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        c, d, n, ent, par = self.closest(x, dz)
+        H = np.zeros((len(x), 3, 3))
+        with _Current(self.model) as gmsh:
+            m = gmsh.model
+            for k in np.unique(ent):
+                dim, t = self._ents[k]
+                rows = np.flatnonzero(ent == k)
+                if dim == 2:
+                    H[rows] = self._face_hessian(m, t, par[rows], n[rows], d[rows])
+                    continue
+                _, faces = self._edge_faces_normal(m, t, par[rows, 0])
+                smooth = np.all(np.einsum("fpi,pi->fp", faces, faces[0]) > 1 - 1e-8, axis=0) if len(faces) else \
+                    np.zeros(len(rows), dtype=bool)
+                if smooth.any():  # a seam: the edge's first face
+                    f = self._face_adjacent[t][0]
+                    uv = np.asarray(m.reparametrizeOnSurface(1, t, par[rows[smooth], 0], f)).reshape(-1, 2)
+                    H[rows[smooth]] = self._face_hessian(m, f, uv, n[rows[smooth]], d[rows[smooth]])
+                sharp = rows[~smooth]
+                if sharp.size:
+                    e = np.asarray(m.getDerivative(1, t, par[sharp, 0])).reshape(-1, 3)
+                    e /= np.linalg.norm(e, axis=1)[:, None]
+                    dd = np.where(np.abs(d[sharp]) > 1e-12 * self.size, d[sharp], np.inf)
+                    P = np.eye(3) - n[sharp, :, None] * n[sharp, None, :] - e[:, :, None] * e[:, None, :]
+                    H[sharp] = P / dd[:, None, None]
+        return H + 0.0
+
+    def _face_hessian(self, m, f, uv, n, d):
+        """H0 (I + d H0)^-1 at the face's parameters uv, n the (turned) normals, d the distances."""
+        J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)  # rows X_u, X_v
+        S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)  # X_uu, X_vv, X_uv
+        B = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
+        B = np.stack([np.stack([B[:, 0], B[:, 2]], 1), np.stack([B[:, 2], B[:, 1]], 1)], 1)
+        G = np.einsum("pai,pbi->pab", J, J)
+        Gi = np.linalg.pinv(G)
+        A = np.einsum("pai,pab->pbi", J, Gi)  # G^-1 J^T as (p, 2, 3): rows the dual basis
+        H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
+        H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
+        return H0 @ np.linalg.inv(np.eye(3) + d[:, None, None] * H0)
+
+
+def cad_cup_tools(spec, thickness: float) -> dict:
+    """Punch, die and blank holder of a scene's [tools] with shape = "cad" around a sheet of that
+    thickness whose mid-surface is z = 0: the punch and the die from their files, placed by
+    their translations; the holder the flat analytic one (tools.BlankHolder) with its face on
+    the sheet's upper surface over the plan outside the rounded square (holder_half_width,
+    holder_corner_radius): it pinches the flange onto the die's flat top, which check_start
+    asks to lie on the sheet's lower surface there."""
+    from shellform.contact.tools import BlankHolder
+
+    return dict(
+        punch=SurfaceTool.from_file(spec.punch_file, spec.punch_translation, spec.punch_normals, "tools.punch_file"),
+        die=SurfaceTool.from_file(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file"),
+        holder=BlankHolder(spec.holder_half_width, spec.holder_corner_radius, thickness / 2),
+    )
+
+
+def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
+    """The CAD tools around the blank at the start (x: its nodes, half: their half thicknesses,
+    every rank its own): InputError naming the field where
+
+    - a tool's faces' normals point away from the sheet: every node lies behind the tool's
+      surface (tools.punch_normals, tools.die_normals);
+    - a tool overlaps the blank: a node penetrates it by more than `tolerance`
+      (tools.punch_translation, tools.die_translation);
+    - the die's top under the holder is not flat on the sheet's lower surface: the holder pinches
+      the flange onto it (tools.die_translation where it lies off the sheet by more than
+      `tolerance`, tools.holder_half_width where its normal is not +z: the holder's plan reaches
+      over the die's shoulder)."""
+    from mpi4py import MPI
+
+    x = np.asarray(x, dtype=float).reshape(-1, 3)
+    for name in ("punch", "die"):
+        g, _ = tools[name].gap(x, half, 0.0)
+        highest = comm.allreduce(float(g.max(initial=-np.inf)), op=MPI.MAX)
+        deepest = comm.allreduce(float(g.min(initial=np.inf)), op=MPI.MIN)
+        if highest < -tolerance:
+            raise InputError(f"tools.{name}_normals", f"the {name}'s faces' normals point away from the sheet: "
+                             "every node of the blank lies behind its surface (turn them with "
+                             f"{name}_normals = 'inward', or 'outward' if that was set)")
+        if deepest < -tolerance:
+            raise InputError(f"tools.{name}_translation", f"the {name} overlaps the blank at the start: a node "
+                             f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
+    under = np.isfinite(tools["holder"].gap(x, 0.0, 0.0)[0])
+    g, n = tools["die"].gap(x[under], half[under] if np.ndim(half) else half, 0.0)
+    off = comm.allreduce(float(np.abs(g).max(initial=0.0)), op=MPI.MAX)
+    tilt = comm.allreduce(float(np.abs(n[:, 2] - 1.0).max(initial=0.0)), op=MPI.MAX)
+    if tilt > 1e-9:
+        raise InputError("tools.holder_half_width", "the holder reaches over a part of the die that is not its flat "
+                         "top (the die's normal there is not +z): the holder's inner edge must lie on the flat top")
+    if off > tolerance:
+        raise InputError("tools.die_translation", f"the die's flat top under the holder lies {off:.4g} mm off the "
+                         "sheet's lower surface z = -t/2: the holder pinches the flange onto it")
+
+
+def probe(path: Path, field: str) -> dict:
+    """Check a tool's CAD file before it is imported here: it exists, is a CAD file by its
+    name, is not too large, and a child process stopped after READ_SECONDS reads it and finds
+    faces in it. Returns the child's summary (faces, bounding box). InputError naming `field`."""
+    if not path.is_file():
+        raise InputError(field, f"no such file: {path}")
+    if path.suffix not in CAD_SUFFIXES:
+        raise InputError(field, f"{path.name} is not a CAD file: a tool's file must end in one of "
+                         f"{', '.join(CAD_SUFFIXES)}")
+    if path.stat().st_size > MAX_CAD_BYTES:
+        raise InputError(field, f"{path} is larger than {MAX_CAD_BYTES:,} bytes")
+    cmd = [sys.executable, "-P", "-c", _CHILD, str(path)]
+    try:
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=READ_SECONDS, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise InputError(field, f"gmsh did not finish reading {path} within {READ_SECONDS:g} s") from None
+    lines = [ln for ln in done.stdout.splitlines() if ln.startswith(_MARK)]
+    if not lines:
+        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
+        raise InputError(field, f"gmsh stopped while reading {path} (exit status {done.returncode}): {tail[0]}")
+    result = json.loads(lines[-1][len(_MARK):])
+    if "error" in result:
+        raise InputError(field, f"gmsh cannot read {path}: {result['error']}")
+    if result["faces"] == 0:
+        raise InputError(field, f"{path} holds no surface (a tool is the faces of a CAD model)")
+    return result
+
+
+# the child of probe: python -P -c _CHILD FILE. It imports gmsh only (not shellform, whose import
+# would start MPI in a child of an MPI rank) and prints one line, _MARK and JSON: the file's
+# faces and bounding box, or {"error": gmsh's message}.
+_CHILD = """
+import json, sys
+import gmsh
+gmsh.initialize(readConfigFiles=False, interruptible=False)
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
+gmsh.model.add("shellform_tool")
+try:
+    gmsh.model.occ.importShapes(sys.argv[1])
+    gmsh.model.occ.synchronize()
+    faces = gmsh.model.getEntities(2)
+    result = {"faces": len(faces), "box": list(gmsh.model.getBoundingBox(-1, -1)) if faces else [0.0] * 6}
+except Exception as exc:
+    result = {"error": str(exc)}
+gmsh.finalize()
+print("\\n" + MARK + json.dumps(result), flush=True)
+""".replace("MARK", repr(_MARK))

@@ -1,0 +1,286 @@
+"""Tools from CAD surfaces (shellform/contact/surface_tool.py): the NUMISHEET'93 aluminium cup's
+punch and die built in gmsh (OpenCASCADE) from the dimensions of demos/numisheet93_aluminium.toml,
+written to STEP and read back, against the analytic tools of the same scene (tools.py): gap,
+normal and shape operator at random points near every region of their surfaces, and on the
+seams between a fillet and the face it meets. The accuracy asked: 1e-6 mm in the gap, 1e-6 in
+the normal, 1e-5 of the largest curvature in H (measured: 3e-8 mm, 1e-7 and 2e-6 on the punch's
+nose corner, a torus onto which OCC projects iteratively; 1e-14 on the die's planes, cylinders and tori)."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shellform import scene
+from shellform.contact.surface_tool import SurfaceTool
+from shellform.contact.tools import square_cup_tools
+from shellform.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = scene.load(ROOT / "demos" / "numisheet93_aluminium.toml")
+T = SCENE.material.thickness
+SPEC = SCENE.tools
+ANALYTIC = square_cup_tools(SPEC, T)
+GAP, NORMAL, CURVATURE = 1e-6, 1e-6, 1e-5  # mm; -; times the largest |H| of the points
+RNG = np.random.default_rng(35)
+
+
+def _script():
+    spec = importlib.util.spec_from_file_location("cup_tools_step", ROOT / "scripts" / "cup_tools_step.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def cad(tmp_path_factory):
+    """The punch and the die written as STEP and read back, placed as the analytic ones."""
+    steps = _script()
+    folder = tmp_path_factory.mktemp("cad")
+    steps.write_step(steps.punch, folder / "punch.step", SPEC.punch_half_width, SPEC.punch_corner_radius,
+                     SPEC.punch_profile_radius)
+    steps.write_step(steps.die, folder / "die.step", SPEC.die_half_width, SPEC.die_corner_radius,
+                     SPEC.die_profile_radius)
+    return {"punch": SurfaceTool.from_file(folder / "punch.step", (0.0, 0.0, T / 2 + SPEC.punch_gap)),
+            "die": SurfaceTool.from_file(folder / "die.step", (0.0, 0.0, -T / 2)), "folder": folder}
+
+
+def _box(lo, hi, n=300):
+    return RNG.uniform(lo, hi, (n, 3))
+
+
+# regions of the punch (face at z = t/2; nose 8, plan corner 10, half-width 35) and the die (top at
+# -t/2, shoulder 8, opening 37 with plan corner 12): boxes of points around each, x, y >= 0 and < 0
+PUNCH_REGIONS = {
+    "flat face": ([-24.0, -24.0, -3.0], [24.0, 24.0, 0.4]),
+    "nose, straight": ([28.0, -20.0, -3.0], [40.0, 20.0, 8.0]),
+    "nose, plan corner": ([26.0, 26.0, -3.0], [38.0, 38.0, 8.0]),
+    "wall": ([35.5, -20.0, 10.0], [38.0, 20.0, 40.0]),
+    "wall, plan corner": ([-35.0, 28.0, 10.0], [-28.0, 35.0, 40.0]),
+}
+DIE_REGIONS = {
+    "flat top": ([46.0, -60.0, -0.4], [70.0, 60.0, 3.0]),
+    "shoulder, straight": ([35.0, -20.0, -8.0], [47.0, 20.0, 3.0]),
+    "shoulder, plan corner": ([-46.0, -46.0, -8.0], [-30.0, -30.0, 3.0]),
+    "wall": ([33.0, -20.0, -40.0], [36.8, 20.0, -10.0]),
+    "wall, plan corner": ([27.0, 27.0, -40.0], [34.0, 34.0, -10.0]),
+}
+
+
+def _near(tool, x, dz):
+    """The points within 3 mm of the analytic tool's surface, outside or at most 2 mm inside."""
+    g, _ = tool.gap(x, 0.0, dz)
+    return x[(g < 3.0) & (g > -2.0)]
+
+
+@pytest.mark.parametrize("name, regions, dz", [("punch", PUNCH_REGIONS, 0.0), ("punch", PUNCH_REGIONS, -12.5),
+                                                ("die", DIE_REGIONS, 0.0)])
+def test_gap_normal_shape_match_the_analytic_tools(cad, name, regions, dz):
+    """At random points near every region (the punch also moved down by 12.5 mm), within 1e-6 mm
+    in the gap, 1e-6 in the normal and 1e-5 of the largest curvature in H; an offset subtracts."""
+    analytic, tool = ANALYTIC[name], cad[name]
+    for region, (lo, hi) in regions.items():
+        lo, hi = np.add(lo, [0, 0, dz]), np.add(hi, [0, 0, dz])
+        x = _near(analytic, _box(lo, hi), dz)
+        assert len(x) > 50, region
+        g0, n0 = analytic.gap(x, 0.4, dz)
+        g1, n1 = tool.gap(x, 0.4, dz)
+        assert np.abs(g1 - g0).max() < GAP, region
+        assert np.abs(n1 - n0).max() < NORMAL, region
+        H0, H1 = analytic.shape(x, 0.4, dz), tool.shape(x, 0.4, dz)
+        assert np.abs(H1 - H0).max() < CURVATURE * max(np.abs(H0).max(), 1.0 / 8.0), region
+        assert np.allclose(H1, H1.transpose(0, 2, 1), atol=1e-12)
+        assert np.abs(np.einsum("pij,pj->pi", H1, n1)).max() < 1e-9  # H n = 0
+
+
+def _one_sided(tool, x, step, dz=0.0):
+    """H just beside x on both sides of a seam (x -/+ step)."""
+    return tool.shape(x - step, 0.0, dz), tool.shape(x + step, 0.0, dz)
+
+
+@pytest.mark.parametrize("name, seam, across", [
+    ("punch", lambda y, d: np.c_[np.full_like(y, 27.0), y, T / 2 - d], [1.0, 0.0, 0.0]),  # flat face | nose
+    ("punch", lambda z, d: np.c_[np.full_like(z, 35.0) + d, np.zeros_like(z), T / 2 + 8.0 + 0 * z],
+     [0.0, 0.0, 1.0]),  # nose | wall, on y = 0 at the nose's top
+    ("die", lambda y, d: np.c_[np.full_like(y, 45.0), y, -T / 2 + d], [1.0, 0.0, 0.0]),  # shoulder | flat top
+])
+def test_seams_take_one_side(cad, name, seam, across):
+    """Points whose closest point lies on a fillet's seam (the tangent edge between the fillet
+    and the face it meets): gap and normal are continuous there and match the analytic tool; H
+    is one of its two one-sided values (the face's or the fillet's)."""
+    analytic, tool = ANALYTIC[name], cad[name]
+    d = RNG.uniform(0.05, 2.0, 40)
+    x = seam(RNG.uniform(-15.0, 15.0, 40), d)
+    g0, n0 = analytic.gap(x, 0.0)
+    g1, n1 = tool.gap(x, 0.0)
+    assert np.abs(g1 - g0).max() < GAP and np.abs(n1 - n0).max() < NORMAL
+    a, b = _one_sided(analytic, x, 1e-7 * np.asarray(across))
+    assert np.abs(a - b).max() > 0.05  # a true jump: the two sides differ
+    H = tool.shape(x, 0.0)
+    side = np.minimum(np.abs(H - a).max(axis=(1, 2)), np.abs(H - b).max(axis=(1, 2)))
+    assert side.max() < 1e-5
+
+
+def test_a_model_built_in_this_process_equals_its_step_file(cad):
+    """The punch built by a Python function with gmsh, not written: the same gap as the STEP
+    file read back, within the accuracy of OCC's projection onto the nose's tori (STEP keeps the
+    exact surfaces: 0 on the planes and cylinders, 3e-8 mm on the tori)."""
+    steps = _script()
+    built = SurfaceTool.from_builder(lambda gmsh: steps.punch(gmsh, SPEC.punch_half_width, SPEC.punch_corner_radius,
+                                                              SPEC.punch_profile_radius),
+                                     (0.0, 0.0, T / 2))
+    x = _box([-40.0, -40.0, -3.0], [40.0, 40.0, 10.0], 200)
+    assert np.abs(built.gap(x)[0] - cad["punch"].gap(x)[0]).max() < GAP
+
+
+def test_inward_normals_turn_gap_and_normal(cad, tmp_path):
+    """normals = "inward" turns the faces: the gap and the normal change sign, H too."""
+    turned = SurfaceTool.from_file(cad["folder"] / "die.step", (0.0, 0.0, -T / 2), normals="inward")
+    x = _near(ANALYTIC["die"], _box(*DIE_REGIONS["shoulder, straight"]), 0.0)
+    g, n = cad["die"].gap(x)
+    gt, nt = turned.gap(x)
+    assert np.abs(gt + g).max() < 1e-12 and np.abs(nt + n).max() < 1e-12
+    assert np.abs(turned.shape(x) + cad["die"].shape(x)).max() < 1e-9
+
+
+def test_bad_files_are_named(tmp_path):
+    """A missing file, a file that is no CAD file by its name, a file OCC cannot read and a
+    file with no surface: each an InputError naming the field given."""
+    with pytest.raises(InputError, match="no such file") as err:
+        SurfaceTool.from_file(tmp_path / "none.step", field="tools.punch_file")
+    assert err.value.field == "tools.punch_file"
+    (tmp_path / "punch.stl").write_text("solid x\nendsolid x\n")
+    with pytest.raises(InputError, match="not a CAD file"):
+        SurfaceTool.from_file(tmp_path / "punch.stl", field="tools.punch_file")
+    (tmp_path / "junk.step").write_text("this is no STEP file\n")
+    with pytest.raises(InputError) as err:
+        SurfaceTool.from_file(tmp_path / "junk.step", field="tools.die_file")
+    assert err.value.field == "tools.die_file"
+    steps = _script()
+    steps.write_step(lambda gmsh: (gmsh.model.occ.addPoint(0, 0, 0), gmsh.model.occ.synchronize()),
+                     tmp_path / "point.step")
+    with pytest.raises(InputError, match="no surface|cannot read") as err:
+        SurfaceTool.from_file(tmp_path / "point.step", field="tools.die_file")
+    assert err.value.field == "tools.die_file"
+
+
+# -- the scene: [tools] shape = "cad" ------------------------------------------------------------
+CAD_SCENE = ROOT / "demos" / "numisheet93_aluminium_cad.toml"
+
+
+def test_cad_scene_reads_files_relative_to_its_folder():
+    s = scene.load(CAD_SCENE)
+    assert s.tools.shape == "cad"
+    assert Path(s.tools.punch_file) == ROOT / "demos" / "meshes" / "numisheet93" / "punch.step"
+    assert Path(s.tools.die_file).is_file()
+    with pytest.raises(InputError) as err:
+        s.changed({"tools.die_file": str(ROOT / "demos" / "meshes" / "none.step")})
+    assert err.value.field == "tools.die_file"
+    with pytest.raises(InputError) as err:
+        s.changed({"tools.punch_normals": "up"})
+    assert err.value.field == "tools.punch_normals"
+    with pytest.raises(InputError) as err:
+        s.changed({"tools.punch_translation": [0.0, 0.0]})
+    assert err.value.field == "tools.punch_translation"
+    with pytest.raises(InputError) as err:
+        s.changed({"geometry.lx": 80.0})  # half of it, 40, does not reach the holder at 45
+    assert err.value.field == "geometry.lx"
+
+
+@pytest.mark.parametrize("changes, field", [
+    ({"tools.die_normals": "inward"}, "tools.die_normals"),  # the die's normals point away from the sheet
+    ({"tools.punch_translation": [0.0, 0.0, 0.0]}, "tools.punch_translation"),  # the punch cuts the blank
+    ({"tools.die_translation": [0.0, 0.0, -0.6]}, "tools.die_translation"),  # the die's top below the sheet
+    ({"tools.holder_half_width": 41.0}, "tools.holder_half_width"),  # the holder over the die's shoulder
+])
+def test_cad_tools_that_do_not_fit_the_blank_are_named(changes, field):
+    """Before any computation: the tools checked against the blank's nodes (check_start)."""
+    from shellform.contact.problem import DrawingProblem
+
+    s = scene.load(CAD_SCENE).changed({"mesh.n": 4, **changes})
+    with pytest.raises(InputError) as err:
+        DrawingProblem.from_scene(s, verbose=False)
+    assert err.value.field == field
+
+
+def test_a_file_with_no_surface_is_named(tmp_path):
+    steps = _script()
+    steps.write_step(lambda gmsh: (gmsh.model.occ.addPoint(0, 0, 0), gmsh.model.occ.synchronize()),
+                     tmp_path / "point.step")
+    from shellform.contact.problem import DrawingProblem
+
+    s = scene.load(CAD_SCENE).changed({"mesh.n": 4, "tools.die_file": str(tmp_path / "point.step")})
+    with pytest.raises(InputError) as err:
+        DrawingProblem.from_scene(s, verbose=False)
+    assert err.value.field == "tools.die_file"
+
+
+def _drawn(path, n, stroke):
+    from shellform.contact.problem import DrawingProblem
+    from shellform.results.cup import draw_in, peak_thinning
+
+    s = scene.load(path).changed({"mesh.n": n})
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(stroke / s.tools.stroke)
+    return {**draw_in(p), "force": p.punch_force(), "thinning": peak_thinning(p)["max_thickness_strain"],
+            "iterations": sum(h.iterations for h in p.driver.history),
+            "increments": len(p.driver.history), "balance": p.force_balance()}
+
+
+def test_the_cup_drawn_by_step_tools_equals_the_analytic_run():
+    """The aluminium cup on 8 x 8 x 2 triangles drawn 2 mm by the STEP punch and die and by the
+    analytic ones: draw-in, punch force and peak thinning within 0.5 %, iterations within 20 % (the issue's
+    check; measured: the same increments and iterations, the answers to 1e-8, docs/tools.md)."""
+    analytic = _drawn(ROOT / "demos" / "numisheet93_aluminium.toml", 8, 2.0)
+    cad = _drawn(CAD_SCENE, 8, 2.0)
+    for key in ("DX", "DY", "DD", "force", "thinning"):
+        assert abs(cad[key] - analytic[key]) <= 5e-3 * abs(analytic[key]), key
+    assert abs(cad["iterations"] - analytic["iterations"]) <= 0.2 * analytic["iterations"]
+    assert analytic["force"] > 1000.0 and analytic["DX"] > 0.01  # the punch has drawn the sheet
+    assert cad["balance"] < 1e-6
+
+
+MPI_SCRIPT = """
+import json, shellform
+from mpi4py import MPI
+from shellform import scene
+from shellform.contact.problem import DrawingProblem
+from shellform.results.cup import draw_in
+s = scene.load(SCENE).changed({"mesh.n": 8})
+p = DrawingProblem.from_scene(s, verbose=False)
+p.driver.run(2.0 / s.tools.stroke)
+force, d = p.punch_force(), draw_in(p)
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps({"force": force, "DX": d["DX"],
+                                  "iterations": sum(h.iterations for h in p.driver.history)}))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.mpi
+def test_step_tools_on_two_ranks(tmp_path):
+    """Every rank reads the files (its own child process first: one that imports gmsh only,
+    not MPI) and evaluates its own nodes: the cup drawn 2 mm on n = 8 by two ranks gives the
+    serial run's iterations, force and draw-in to 1e-6 (measured: 37 iterations, the force to
+    1.4e-8; about 15 s)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    from shellform.studies.common import mpiexec
+
+    if mpiexec() is None:
+        pytest.skip("no mpiexec")
+    script = tmp_path / "run.py"
+    script.write_text(MPI_SCRIPT.replace("SCENE", repr(str(CAD_SCENE))))
+    out = subprocess.run([mpiexec(), "-n", "2", sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=600, env=dict(os.environ, OMP_NUM_THREADS="1"))
+    assert out.returncode == 0, out.stderr[-2000:]
+    line = [ln for ln in out.stdout.splitlines() if ln.startswith("RESULT ")][-1]
+    parallel = json.loads(line[len("RESULT "):])
+    serial = _drawn(CAD_SCENE, 8, 2.0)
+    assert parallel["iterations"] == serial["iterations"]
+    assert parallel["force"] == pytest.approx(serial["force"], rel=1e-6)
+    assert parallel["DX"] == pytest.approx(serial["DX"], rel=1e-6)
