@@ -90,6 +90,8 @@ def _parser() -> argparse.ArgumentParser:
     p_study.add_argument("-o", "--out", type=Path, required=True, help="the folder for the study's tables and plots")
     p_study.add_argument("--threads", type=int, metavar="N", help=THREADS_HELP)
     p_study.add_argument("--quick", action="store_true", help="coarse levels only (for tests)")
+    p_study.add_argument("--levels", type=int, nargs="+", metavar="N",
+                         help="the mesh levels (n of an n x n quarter) of a study that has levels, instead of its own")
     return parser
 
 
@@ -148,6 +150,12 @@ def main(argv=None) -> int:
 
             study = importlib.import_module(f"shellform.studies.{args.name.replace('-', '_')}")
             kwargs = {"levels": study.QUICK_LEVELS} if args.quick and hasattr(study, "QUICK_LEVELS") else {}
+            if args.levels:
+                import inspect
+
+                if "levels" not in inspect.signature(study.run).parameters:
+                    raise InputError("--levels", f"the study {args.name} has no mesh levels")
+                kwargs["levels"] = tuple(args.levels)
             study.run(args.out, **kwargs)
     except InputError as err:
         say(f"shellform: input error: {err}", file=sys.stderr)

@@ -116,3 +116,9 @@ def test_a_checked_scene_saved_elsewhere_reads_the_same_blank_file(capsys, tmp_p
     again = scene.load(saved)
     assert Path(again.geometry.file) == Path(original.geometry.file).resolve()
     assert again == original.changed({"geometry.file": again.geometry.file})
+
+
+def test_levels_of_a_study_without_levels_is_an_input_error(capsys, tmp_path):
+    """--levels reaches a study that has mesh levels; one without them names the option."""
+    assert cli.main(["study", "assembly", "--out", str(tmp_path), "--levels", "4", "8"]) == 2
+    assert "input error: --levels: the study assembly has no mesh levels" in capsys.readouterr().err
