@@ -192,3 +192,13 @@ def test_a_demo_runs_as_a_notebook():
     rate = float(re.search(r"observed rate (\d+\.\d+)", out).group(1))
     assert rate == pytest.approx(2.0, abs=0.1)
     assert out.rstrip().endswith("OK"), out
+
+
+def test_square_cup_demo():
+    """The literate cup: its parts named, a row per stop with the draw-in growing, more on the side
+    than at the corner, and the z-balance closed (the demo asserts both and prints OK)."""
+    out = run_demo("demo_square_cup.py", "--n", "6", "--stroke", "6")
+    assert "parts: SheetNodes, ContactSet, PinchingHolder, CoulombFriction" in out, out
+    rows = re.findall(r"^\s+(\d+\.\d)\s+(\d+\.\d+)\s+(\d+\.\d+)\s+(\d+\.\d+)\s+(-\d+\.\d+)\s+\d+\s+\d+\s*$", out, re.M)
+    assert [float(r[0]) for r in rows] == [1.2, 2.4, 3.6, 4.8, 6.0], out
+    assert out.rstrip().endswith("OK"), out
