@@ -20,3 +20,32 @@ try:
     import dolfinx_solver  # noqa: F401
 except ImportError:  # DOLFINx installed another way
     pass
+
+DOLFINX = "0.11"  # the DOLFINx minor version shellform is written for
+# DOLFINx's own distribution names (the PyPI wheel, conda-forge's); mpi4py, petsc4py, ufl, basix
+# and ffcx come with it and are not declared in pyproject.toml, since the wheel bundles them
+DISTRIBUTIONS = ("dolfinx-solver-real", "fenics-dolfinx")
+
+
+def dolfinx_version() -> str | None:
+    """The installed DOLFINx's version from its distribution's metadata (without importing it);
+    None where no known distribution is installed (a DOLFINx built from source, Debian's)."""
+    from importlib import metadata
+
+    for name in DISTRIBUTIONS:
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            continue
+    return None
+
+
+def check_dolfinx(version: str | None) -> None:
+    """Refuse a DOLFINx of another minor version, naming what is installed and what to do."""
+    if version is not None and not (version == DOLFINX or version.startswith(DOLFINX + ".")):
+        raise ImportError(f"shellform needs DOLFINx {DOLFINX}.x, and DOLFINx {version} is installed: install "
+                          f"the wheel (pip install -e '.[wheel]', or `make venv`) or a DOLFINx {DOLFINX} from "
+                          "conda-forge (fenics-dolfinx) into this environment")
+
+
+check_dolfinx(dolfinx_version())

@@ -6,6 +6,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -56,3 +58,23 @@ def test_the_fast_lane_the_slow_lane_and_a_timeout():
     assert len(lanes["test-slow"]) == 1 and "-m slow" in lanes["test-slow"][0]
     steps = [line for line in (ROOT / ".ci" / "run").read_text().splitlines() if line.startswith("make")]
     assert steps == ["make test", "make test-slow"]
+
+
+def test_dolfinx_of_another_version_is_refused_with_what_to_do():
+    """shellform checks the installed DOLFINx's version on import, from its distribution's
+    metadata (the wheel's here), and refuses another minor version naming both and the fix."""
+    from shellform import _env
+
+    assert _env.dolfinx_version().startswith("0.11")
+    _env.check_dolfinx("0.11.0.post0")
+    _env.check_dolfinx(None)  # a DOLFINx without known metadata (built from source): not refused
+    with pytest.raises(ImportError, match=r"needs DOLFINx 0\.11\.x, and DOLFINx 0\.10\.0 is installed: install"):
+        _env.check_dolfinx("0.10.0")
+    with pytest.raises(ImportError, match="0.110"):
+        _env.check_dolfinx("0.110")
+
+
+def test_the_build_asks_for_a_setuptools_that_knows_license_expressions():
+    """license = "MIT" (PEP 639) needs setuptools 77 (68 and 76 fail with --no-build-isolation)."""
+    build = tomllib.loads((ROOT / "pyproject.toml").read_text())["build-system"]["requires"]
+    assert build == ["setuptools>=77"]

@@ -58,6 +58,8 @@ class DrawingSummary(Summary):
 
     def closing_line(self) -> str:
         last = self["draw_in_mm"][-1] if self["draw_in_mm"] else {}
+        draw_in = ", ".join(f"{k} {v:.3f}" for k, v in last.items() if k != "stroke_mm")
+        force = self["punch_force_kN"][-1]["force"] if self.get("punch_force_kN") else float("nan")
         return (f"shellform: {self['title']}: {self['cells']} cells, stroke {self['stroke_mm']:.2f} mm, "
-                f"draw-in {last}, max thickness strain {self['max_thickness_strain']:.4f}, "
-                f"{self['wall_time_s']['total']:.1f} s; results in {self.outdir}")
+                f"draw-in (mm) {draw_in}, punch force {force:.2f} kN, largest thinning (thickness strain) "
+                f"{self['max_thickness_strain']:.4f}, {self['wall_time_s']['total']:.1f} s; results in {self.outdir}")
