@@ -10,15 +10,22 @@ class Terminal(io.StringIO):
         return True
 
 
-def test_progress_rewrites_one_line_on_a_terminal_and_keeps_notes():
+def test_progress_rewrites_one_line_on_a_terminal_and_keeps_notes(monkeypatch):
+    """One line rewritten in place, as wide as the terminal (80 columns: 79 characters, so that
+    no increment wraps onto a new line); the time left from the progress since the first
+    increment, once three are done."""
+    monkeypatch.setenv("COLUMNS", "80")
     out = Terminal()
     p = Progress("stroke", 1.0, " mm", 30.0, stream=out)
+    p.increment(0.1, 1, 8, "increment   1 ...")
     p.increment(0.25, 10, 80, "increment  10 ...")
     p.increment(0.5, 20, 170, "increment  20 ...")
     text = out.getvalue()
-    assert text.count("\r") == 2 and "\n" not in text  # one line, rewritten
-    assert "stroke 15 of 30 mm: 20 increments, 170 iterations" in text.split("\r")[-1]
-    assert "s left" in text.split("\r")[-1]
+    assert text.count("\r") == 3 and "\n" not in text  # one line, rewritten
+    lines = text.split("\r")[1:]
+    assert all(len(line) == 79 for line in lines)
+    assert "s left" not in lines[0]  # under three increments: no estimate yet
+    assert "stroke 15 of 30 mm: 20 increments, 170 iterations" in lines[-1] and "s left" in lines[-1]
     p.close()
     assert out.getvalue().endswith("\n")
 
@@ -29,6 +36,9 @@ def test_progress_in_a_log_keeps_the_plain_increment_lines():
     p.increment(0.5, 3, 12, "increment   3  lambda 0.5")
     p.note("  cut back: ...")
     assert log.getvalue() == "increment   3  lambda 0.5\n  cut back: ...\n"
+    log = io.StringIO()  # a tool scene's log: the stroke too
+    Progress("stroke", 1.0, " mm", 30.0, stream=log).increment(0.5, 3, 12, "increment   3  lambda 0.5")
+    assert log.getvalue() == "increment   3  lambda 0.5  (stroke 15 mm)\n"
 
 
 def test_keeler_brazier_curve():

@@ -5,6 +5,7 @@ rewritten in place (load factor or stroke, increments, iterations, time used and
 the time left); to a file or pipe the driver's plain line per increment, which logs keep.
 """
 
+import shutil
 import sys
 import time
 
@@ -26,24 +27,37 @@ class Progress:
         self.stream = stream if stream is not None else sys.stdout
         self.tty = MPI.COMM_WORLD.rank == 0 and self.stream.isatty()
         self.start = time.perf_counter()
+        self._first = None  # (time, progress) at the first increment: the estimate starts there
         self._open = False  # an in-place line is on screen
 
     def line(self, lam: float, increments: int, iterations: int) -> str:
-        used = time.perf_counter() - self.start
+        """The in-place line. The time left is extrapolated from the progress since the first
+        increment (the time before it, compiling and setting up, says nothing of the rest),
+        once three increments are done."""
+        now = time.perf_counter()
+        used = now - self.start
         done = abs(lam) / self.total if self.total else 1.0
-        left = f", about {used * (1 - done) / done:.0f} s left" if 0 < done < 1 else ""
+        if self._first is None:
+            self._first = (now, done)
+        t0, d0 = self._first
+        left = ""
+        if 0 < done < 1 and increments >= 3 and done > d0:
+            left = f", about {(now - t0) * (1 - done) / (done - d0):.0f} s left"
         return (f"{self.label} {self.scale * lam:.4g} of {self.scale * self.total:.4g}{self.unit}: "
                 f"{increments} increments, {iterations} iterations, {used:.0f} s{left}")
 
     def increment(self, lam: float, increments: int, iterations: int, detail: str) -> None:
-        """After a converged increment: the in-place line on a terminal, else `detail`."""
+        """After a converged increment: the in-place line on a terminal (fitted to its width),
+        else `detail`, with the progress in the run's unit where it is not the load factor."""
         if self.tty:
-            text = self.line(lam, increments, iterations)
-            self.stream.write("\r" + text.ljust(100))
+            width = max(shutil.get_terminal_size((80, 24)).columns - 1, 20)
+            text = self.line(lam, increments, iterations)[:width]
+            self.stream.write("\r" + text.ljust(width))
             self.stream.flush()
             self._open = True
         else:
-            self._print(detail)
+            where = f"  ({self.label} {self.scale * lam:.4g}{self.unit})" if self.unit else ""
+            self._print(detail + where)
 
     def note(self, message: str) -> None:
         """A line that stays (a cut-back, a stop): below the in-place line on a terminal."""
