@@ -408,3 +408,21 @@ def test_sheet_model_says_an_infinite_thickness_must_be_finite():
 @pytest.mark.parametrize("value", [-1.0, float("inf"), float("nan")])
 def test_checkpoint_interval_names_its_field(value):
     assert_names_field({"output": {"checkpoint_every": value}}, "output.checkpoint_every")
+
+
+DEMOS = Path(__file__).resolve().parents[1] / "demos"
+
+
+def test_an_implausible_modulus_is_warned_about_naming_the_field():
+    """E in GPa with the stresses in MPa (E = 206 for a steel) is valid input but no metal: a
+    warning names material.E with the ratio; the demo scenes' materials give none."""
+    import warnings
+
+    from shellform.scene.checks import PlausibilityWarning
+
+    with pytest.warns(PlausibilityWarning, match=r"material\.E: E / initial yield stress = 1\.31, where"):
+        scene.load(DEMOS / "square_cup.toml").changed({"material.E": 206.0})
+    for name in ("square_cup.toml", "numisheet93_aluminium.toml", "numisheet93_steel.toml", "round_cup.toml"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", PlausibilityWarning)
+            scene.load(DEMOS / name)

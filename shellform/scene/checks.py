@@ -198,11 +198,32 @@ def _validate_material(s: Scene) -> None:
                     f"is no parameter of hardening = {mat.hardening!r} "
                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")
     if plastic:
-        s.hill79()  # SheetMaterial validates the curve and names the field
+        _plausible_stiffness(s.hill79())  # SheetMaterial validates the curve and names the field
     if plastic and (mat.forming_limit_curve or (s.tools is not None and s.output.fld)):
         from shellform.results import fld
 
         fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n
+
+
+E_OVER_YIELD = (100.0, 5000.0)  # E / initial yield stress of a sheet metal: about 300 (aluminium) to 2000
+
+
+class PlausibilityWarning(UserWarning):
+    """A value that is valid but unlikely for a sheet metal (a unit mixed up)."""
+
+
+def _plausible_stiffness(material) -> None:
+    """Warn, naming material.E, where E over the initial yield stress lies outside E_OVER_YIELD:
+    E in GPa with the stresses in MPa (E = 206 for a steel) gives about 1, not 1000."""
+    import warnings
+
+    from shellform.material.hardening import flow_stress
+
+    ratio = material.E / flow_stress(0.0, material.pack())[0]
+    if not E_OVER_YIELD[0] <= ratio <= E_OVER_YIELD[1]:
+        warnings.warn(PlausibilityWarning(
+            f"material.E: E / initial yield stress = {ratio:.3g}, where a sheet metal's lies between about 300 and "
+            f"2000: are E and the stresses in the same unit (MPa with lengths in mm)?"), stacklevel=2)
 
 
 def _validate_loads(s: Scene) -> None:
