@@ -3,6 +3,7 @@ both nonlinear routes, and the summary each route returns, which knows its closi
 exit status; the command line's --version."""
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -132,3 +133,48 @@ def test_version(capsys):
         cli.main(["--version"])
     assert stop.value.code == 0
     assert capsys.readouterr().out.strip() == f"shellform {shellform.__version__}"
+
+
+def test_named_probes_and_extremes_of_a_nonlinear_scene(tmp_path):
+    """[[output.probe]] names vertices whose (u, v, w) every report gives; `extremes` gives the
+    largest u, v, w and where. Levy's clamped plate (quarter, 6 x 6) to 10 % of its load: the
+    largest w is the centre's; on the clamped, sliding edge y = 0.5 w is zero and u, along it, is not."""
+    from shellform.nonlinear.run import run as run_sheet
+
+    s = scene.load(ROOT / "demos" / "levy_plate.toml").changed({
+        "mesh.n": 6, "process.path": [0.1], "process.report": [], "output.vtx": False, "output.png": False,
+        "output.probe": [{"name": "centre", "x": 0.0, "y": 0.0}, {"name": "edge", "x": 0.25, "y": 0.5},
+                         {"name": "inside", "x": 0.25, "y": 0.25}]})
+    summary = run_sheet(s, tmp_path)
+    last = summary["reports"][-1]
+    assert set(last["probes"]) == {"centre", "edge", "inside"}
+    assert last["probes"]["centre"]["w"] == last["w"] and last["w"] > 0
+    assert last["probes"]["edge"]["w"] == 0.0 and last["probes"]["edge"]["u"] != 0.0
+    assert 0 < last["probes"]["inside"]["w"] < last["w"]
+    assert last["extremes"]["w"] == {"value": last["w"], "at_initial_xy": [0.0, 0.0]}
+    assert abs(last["extremes"]["u"]["value"]) >= abs(last["probes"]["edge"]["u"])
+
+
+@pytest.mark.parametrize("probe, changes, field, message", [
+    ({"name": "tip", "x": 2.0, "y": 0.0}, {}, "output.probe[0]", "outside the blank's bounds"),
+    ({"name": "", "x": 0.0, "y": 0.0}, {}, "output.probe[0].name", "non-empty"),
+    ({"name": "a", "x": 0.1234, "y": 0.0}, {}, "output.probe[0]", "no mesh vertex at (0.1234, 0.0)"),
+])
+def test_a_bad_probe_is_named(tmp_path, probe, changes, field, message):
+    """A probe outside the blank or without a name is refused with the scene; one between the
+    vertices before any step."""
+    from shellform.errors import InputError
+    from shellform.nonlinear.run import run as run_sheet
+
+    with pytest.raises(InputError, match=rf"^{re.escape(field)}: .*{re.escape(message)}"):
+        s = scene.load(ROOT / "demos" / "levy_plate.toml").changed({
+            "mesh.n": 4, "output.vtx": False, "output.png": False, "output.probe": [probe], **changes})
+        run_sheet(s, tmp_path)
+    assert not (tmp_path / "summary.json").exists()
+
+
+def test_probes_belong_to_nonlinear_sheet_scenes():
+    from shellform.errors import InputError
+
+    with pytest.raises(InputError, match=r"^output\.probe\[0\]: probes are reported by nonlinear sheet scenes"):
+        scene.load(ROOT / "demos" / "square_cup.toml").changed({"output.probe": [{"name": "c", "x": 0.0, "y": 0.0}]})

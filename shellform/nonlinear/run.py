@@ -2,8 +2,9 @@
 
 Writes into the output folder:
     summary.json       per reported load factor, at the end of every stage of the path and at a stop:
-                       centre displacement, peak equivalent plastic strain and thickness
-                       strain; increments, Newton iterations, time split
+                       the displacement at the origin and at each [[output.probe]], the largest
+                       u, v, w and where, peak equivalent plastic strain and thickness strain;
+                       increments, Newton iterations, time split
     increments.csv     every increment: load factor, step, iterations, residuals, plastic layers
     nodal.bp, cells.bp the final state for ParaView (displacement, slopes; plastic and thickness
                        strain per cell)
@@ -17,9 +18,11 @@ Writes into the output folder:
 import time
 from pathlib import Path
 
+import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from shellform.errors import InputError
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
@@ -44,12 +47,40 @@ def cell_functions(p: SheetProblem) -> dict:
 
 
 def _record(p: SheetProblem, s: Scene) -> dict:
+    """A report: the load factor, (u, v, w) at the origin and at each probe, the extremes of
+    u, v, w and where, the peak plastic strain and thinning."""
     fields = p.model.cell_fields()
     comm = p.model.mesh.comm
     peq = comm.allreduce(float(fields["equivalent_plastic_strain"].max(initial=0.0)), op=MPI.MAX)
     e33 = comm.allreduce(float(fields["thickness_strain"].min(initial=0.0)), op=MPI.MIN)
     return {"load_factor": p.driver.lam, **{k: p.value(k, 0.0, 0.0) for k in ("u", "v", "w")},
-            "max_equivalent_plastic_strain": peq, "min_thickness_strain": e33}
+            "probes": {probe.name: probe_values(p, probe, i) for i, probe in enumerate(s.output.probe)},
+            "extremes": extremes(p), "max_equivalent_plastic_strain": peq, "min_thickness_strain": e33}
+
+
+def probe_values(p: SheetProblem, probe, i: int) -> dict:
+    """(u, v, w) at a probe's vertex; an input error naming output.probe[i] where none is there."""
+    try:
+        return {k: p.value(k, probe.x, probe.y) for k in ("u", "v", "w")}
+    except InputError:
+        raise InputError(f"output.probe[{i}]", f"no mesh vertex at ({probe.x}, {probe.y})") from None
+
+
+def extremes(p: SheetProblem) -> dict:
+    """For u, v and w: the value of largest magnitude over the blank and the initial (x, y) of its
+    vertex, all ranks."""
+    comm = p.model.mesh.comm
+    n = p.model.V.dofmap.index_map.size_local
+    X = p.model.V.tabulate_dof_coordinates()[:n, :2]
+    q = p.driver.q.x.array.reshape(-1, len(p.model.components))[:n]
+    out = {}
+    for name in ("u", "v", "w"):
+        values = q[:, p.model.components.index(name)]
+        i = int(np.argmax(np.abs(values))) if n else -1
+        mine = (abs(float(values[i])), float(values[i]), X[i].tolist()) if i >= 0 else (-1.0, 0.0, [np.nan, np.nan])
+        _, value, xy = max(comm.allgather(mine), key=lambda c: c[0])
+        out[name] = {"value": value, "at_initial_xy": xy}
+    return out
 
 
 def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSummary:
@@ -59,6 +90,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
     run_folder.start(outdir, s, scene_path, comm=comm)
     t0 = time.perf_counter()
     p = SheetProblem.from_scene(s, comm, checkpoint_dir=outdir)
+    for i, probe in enumerate(s.output.probe):  # each at a vertex: named before any step
+        probe_values(p, probe, i)
     p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     setup_s = time.perf_counter() - t0
     reports, stopped, signum = [], None, 0

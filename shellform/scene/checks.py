@@ -94,6 +94,7 @@ def validate(s: Scene) -> None:
     _validate_process(s)
     every = s.output.checkpoint_every
     require(math.isfinite(every) and every >= 0, "output.checkpoint_every", f"must be finite and >= 0, got {every}")
+    _validate_probes(s)
     _validate_tools(s)
     machine.check_size(s)  # first: a count too large for memory is named with the memory it needs
     n = s.process.thickness_points
@@ -203,6 +204,27 @@ def _validate_material(s: Scene) -> None:
         from shellform.results import fld
 
         fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n
+
+
+def _validate_probes(s: Scene) -> None:
+    """Probes: a nonlinear sheet scene's, each named once, at finite coordinates within the blank's
+    bounds (that a vertex lies there is checked on the mesh, before stepping)."""
+    names = set()
+    for i, probe in enumerate(s.output.probe):
+        field_ = f"output.probe[{i}]"
+        require(s.nonlinear and s.tools is None, field_, "probes are reported by nonlinear sheet scenes (the "
+                "tool scenes report draw-in, force and thinning)")
+        require(isinstance(probe.name, str) and probe.name.strip() != "", f"{field_}.name", "must be a non-empty name")
+        require(probe.name not in names, f"{field_}.name", f"{probe.name!r} names another probe too")
+        names.add(probe.name)
+        for c in ("x", "y"):
+            require(isinstance(getattr(probe, c), (int, float)) and math.isfinite(getattr(probe, c)),
+                    f"{field_}.{c}", f"must be a finite number, got {getattr(probe, c)!r}")
+        if s.geometry.shape != "file":
+            x0, x1, y0, y1 = bounds(s)
+            tol = 1e-9 * max(x1 - x0, y1 - y0)
+            require(x0 - tol <= probe.x <= x1 + tol and y0 - tol <= probe.y <= y1 + tol, field_,
+                    f"({probe.x}, {probe.y}) lies outside the blank's bounds x in [{x0}, {x1}], y in [{y0}, {y1}]")
 
 
 E_OVER_YIELD = (100.0, 5000.0)  # E / initial yield stress of a sheet metal: about 300 (aluminium) to 2000

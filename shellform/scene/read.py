@@ -11,7 +11,7 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment,
+from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Probe,
                                     Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
                                     Surface, ToolsSpec)
 
@@ -96,9 +96,15 @@ def from_dict(data: dict) -> Scene:
     if isinstance(tools, dict) and "drawbead" in tools:  # [[tools.drawbead]]: an array of tables
         beads = _records(Drawbead, tools["drawbead"], "tools.drawbead")
         data = {**data, "tools": {k: v for k, v in tools.items() if k != "drawbead"}}
+    probes, output = None, data.get("output")
+    if isinstance(output, dict) and "probe" in output:  # [[output.probe]]: an array of tables
+        probes = _records(Probe, output["probe"], "output.probe")
+        data = {**data, "output": {k: v for k, v in output.items() if k != "probe"}}
     kwargs = {name: _record(cls, data[name], name) for name, cls in _SECTIONS.items() if name in data}
     if beads is not None:
         kwargs["tools"].drawbead = beads
+    if probes is not None:
+        kwargs["output"].probe = probes
     if "supports" in data:
         kwargs["supports"] = _supports(data["supports"])
     if isinstance(tools, dict) and tools.get("shape") == "round":
@@ -164,6 +170,7 @@ def to_dict(s: Scene) -> dict:
             data[name] = {f.name: copy.deepcopy(getattr(section, f.name)) for f in fields(section)}
     if s.tools is not None:
         data["tools"]["drawbead"] = [asdict(b) for b in s.tools.drawbead]
+    data["output"]["probe"] = [asdict(p) for p in s.output.probe]
     if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
         for key in SQUARE_TOOL_KEYS:
             del data["tools"][key]

@@ -22,7 +22,7 @@ __all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KE
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
-           "Drawbead", "ToolsSpec", "Output", "Scene", "bounds"]
+           "Drawbead", "ToolsSpec", "Probe", "Output", "Scene", "bounds"]
 
 TOOL_SHAPES = ("square", "round", "cad")
 SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
@@ -209,12 +209,23 @@ class ToolsSpec:
 
 
 @dataclass
+class Probe:
+    """A named vertex of the blank whose displacement (u, v, w) a nonlinear sheet scene reports
+    at every report (summary.json's `probes`): a roof's free-edge midpoint, a strip's tip."""
+
+    name: str = ""
+    x: float = 0.0
+    y: float = 0.0
+
+
+@dataclass
 class Output:
     vtx: bool = True
     vtu: bool = True  # tool scenes: cup.pvd and the tools' .pvd series (results/cup.py CupSeries)
     png: bool = True
     fld: bool = True  # tool scenes with plasticity: the forming-limit view (results/fld.py)
     checkpoint_every: float = 60.0  # tool scenes: seconds of wall time between checkpoints (0: at reports only)
+    probe: list[Probe] = field(default_factory=list, metadata={"items": "tables"})  # [[output.probe]]
 
 
 @dataclass
