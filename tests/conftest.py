@@ -18,3 +18,30 @@ def rotation():
         return np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K
 
     return turn
+
+
+@pytest.fixture
+def turned_states(rotation):
+    """turned_states(p): the sheet problem p's state (resultants, plastic strains, equivalent
+    plastic strain, thickness stretch) evaluated as it is and turned rigidly by 100 degrees about
+    an inclined axis: [state as it is, state turned]."""
+    from dolfinx import fem
+
+    def states(p):
+        model = p.model
+        x = model.V.tabulate_dof_coordinates()[:, :2]
+        vals = p.driver.q.x.array.reshape(-1, 9).copy()
+        pos = np.column_stack([x, np.zeros(len(x))]) + vals[:, :3]
+        grad = vals[:, 3:].reshape(-1, 3, 2) + np.eye(3, 2)
+        q = fem.Function(model.V)
+        out = []
+        for rot in (np.eye(3), rotation([1.0, -2.0, 0.7], 100.0)):
+            turned = np.zeros_like(vals)
+            turned[:, :3] = pos @ rot.T - np.column_stack([x, np.zeros(len(x))])
+            turned[:, 3:] = (np.einsum("ij,njk->nik", rot, grad) - np.eye(3, 2)).reshape(-1, 6)
+            q.x.array[:] = turned.ravel()
+            model.evaluate(q)
+            out.append([a.copy() for a in (model.resultants, model.ep, model.p, model.stretch)])
+        return out
+
+    return states

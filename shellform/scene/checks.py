@@ -2,51 +2,25 @@
 bad value raises shellform.errors.InputError naming its field, e.g.
 ``material.thickness: must be > 0, got -1.0``, before any computation. The effects are checked
 by their registry (shellform.effects.check), what depends on the machine (files, memory) by
-shellform.scene.machine.
+shellform.scene.machine, the [tools] table by shellform.scene.tool_checks.
 """
 
 import math
 from dataclasses import fields
 from pathlib import Path
 
-import numpy as np
-
 from shellform import effects as registry
 from shellform.errors import InputError
 from shellform.mesh import outline
 from shellform.scene import machine
+from shellform.scene.rules import keys_of_effects, require, sheet_effects
+from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING,
-                                    MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS,
-                                    MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, REGIONS, SIDES, SPREADS,
-                                    SUPPORTS, TOOL_NORMALS, TOOL_SHAPES, CAD_TOOL_KEYS, Scene, ToolsSpec, bounds)
+                                    MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
+                                    NONLINEAR_SUPPORTS, REGIONS, SIDES, SUPPORTS, Scene, bounds)
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
-
-def _sheet_effects() -> tuple[str, ...]:
-    """The effects that select the nonlinear sheet."""
-    return tuple(n for n, e in registry.EFFECTS.items() if e.route == registry.SHEET)
-
-
-def _keys_of_effects(s: Scene, section: str) -> None:
-    """The keys of `section` that take a meaning only with an effect (shellform.effects, Effect.keys)
-    keep their defaults unless that effect is on. (A whole table, as [tools] of 'contact', is
-    checked with its table.)"""
-    for e in registry.EFFECTS.values():
-        for key in e.keys:
-            table, _, name = key.partition(".")
-            if e.name in s.effects or table != section or not name or getattr(s, table) is None:
-                continue
-            value, default = getattr(getattr(s, table), name), getattr(type(getattr(s, table))(), name)
-            require(value == default, key, f"{value!r} takes a meaning only with the effect {e.name!r}: switch it "
-                    f"on, or leave the default {default!r}")
-
-
-def require(cond, name, message):
-    """Raise InputError(name, message) unless cond."""
-    if not cond:
-        raise InputError(name, message)
-
 
 def validate(s: Scene) -> None:
     """Raise InputError naming the first bad field of s."""
@@ -57,7 +31,7 @@ def validate(s: Scene) -> None:
     for name in ("R1", "R2"):
         v = getattr(s.surface, name)
         require(v != 0 and not math.isnan(v), f"surface.{name}", f"must be non-zero (inf for flat), got {v}")
-    _keys_of_effects(s, "surface")
+    keys_of_effects(s, "surface")
     for name in ("R1", "R2"):
         if math.isfinite(getattr(s.surface, name)):
             require(not s.surface.z0, f"surface.{name}", "give either z0 or the radii R1, R2, not both")
@@ -84,7 +58,7 @@ def validate(s: Scene) -> None:
                 f"the blank has no boundary group {group!r}; its groups: {', '.join(groups)}")
         require(v in SUPPORTS, f"supports.{group}", f"unknown support {v!r}; known supports: {', '.join(SUPPORTS)}")
         require(v not in NONLINEAR_SUPPORTS or s.nonlinear, f"supports.{group}", f"{v!r} is a support of the "
-                f"nonlinear sheet: needs one of the effects {', '.join(_sheet_effects())}")
+                f"nonlinear sheet: needs one of the effects {', '.join(sheet_effects())}")
     for group in outline.symmetry_lines(s.geometry):
         v = s.supports.get(group, "free")
         require(v in MIRROR_SUPPORTS, f"supports.{group}",
@@ -95,7 +69,7 @@ def validate(s: Scene) -> None:
     every = s.output.checkpoint_every
     require(math.isfinite(every) and every >= 0, "output.checkpoint_every", f"must be finite and >= 0, got {every}")
     _validate_probes(s)
-    _validate_tools(s)
+    validate_tools(s)
     machine.check_size(s)  # first: a count too large for memory is named with the memory it needs
     n = s.process.thickness_points
     require(n <= MAX_THICKNESS_POINTS, "process.thickness_points",
@@ -169,7 +143,7 @@ def _validate_material(s: Scene) -> None:
     require(math.isfinite(mat.r) and mat.r > 0, "material.r", f"must be > 0, got {mat.r}")
     require(math.isfinite(mat.m) and mat.m >= 1, "material.m",
             f"must be >= 1 (convex yield function), got {mat.m}")
-    _keys_of_effects(s, "material")
+    keys_of_effects(s, "material")
     require(mat.yield_function in YIELD_FUNCTIONS, "material.yield_function",
             f"must be one of {', '.join(YIELD_FUNCTIONS)}, got {mat.yield_function!r}")
     require(math.isfinite(mat.rolling_direction), "material.rolling_direction",
@@ -269,7 +243,7 @@ def _validate_loads(s: Scene) -> None:
         require(mo.side in SIDES, f"loads.moment[{i}].side", f"must be one of {', '.join(SIDES)}, got {mo.side!r}")
         require(math.isfinite(mo.m), f"loads.moment[{i}].m", f"must be finite, got {mo.m}")
         require(s.nonlinear, f"loads.moment[{i}]", "edge moments are loads of the nonlinear sheet: "
-                f"need one of the effects {', '.join(_sheet_effects())}")
+                f"need one of the effects {', '.join(sheet_effects())}")
         require(g.shape == "rectangle", f"loads.moment[{i}]", "edge moments act on the sides of a rectangle")
 
 
@@ -295,134 +269,3 @@ def _validate_process(s: Scene) -> None:
     for v in pr.report:
         require(math.isfinite(v) and lo <= v <= hi, "process.report",
                 f"{v} lies outside the load factors [{lo}, {hi}] that process.path covers")
-
-
-def _validate_drawbead(bead, name: str, flat: float, corner: float) -> None:
-    """A drawbead: a polyline of at least two distinct points, all on the die's flat top (outside
-    its opening and shoulder, where the holder pinches the flange), and forces >= 0."""
-    from shellform.contact.tools import rounded_square_sdf
-
-    pts = bead.points
-    require(len(pts) >= 2, f"{name}.points", f"needs at least two points [x, y], got {len(pts)}")
-    require(all(math.isfinite(c) for p in pts for c in p), f"{name}.points", "must be finite")
-    for a, b in zip(pts[:-1], pts[1:]):
-        require(a != b, f"{name}.points", f"two consecutive points coincide: {a}")
-    for key in ("restraint", "uplift"):
-        v = getattr(bead, key)
-        require(v >= 0, f"{name}.{key}", f"must be >= 0 (N/mm), got {v}")
-    require(bead.restraint > 0 or bead.uplift > 0, name, "a drawbead with no restraint and no uplift does nothing")
-    p = np.asarray(pts, dtype=float)
-    along = np.linspace(0.0, 1.0, 21)[:, None, None]
-    samples = (p[:-1] + along * (p[1:] - p[:-1])).reshape(-1, 2)  # 21 points on every segment
-    distance, _, _ = rounded_square_sdf(samples[:, 0], samples[:, 1], flat, corner)
-    require(bool(np.all(distance >= 0)), f"{name}.points",
-            f"must lie on the die's flat top, outside its opening and shoulder (the rounded square of "
-            f"half-width {flat}, where the holder begins); "
-            f"{samples[int(np.argmin(distance))].tolist()} lies within it")
-
-
-def _validate_tools(s: Scene) -> None:
-    """The [tools] table and the effects 'contact' and 'friction' (after the material: the
-    clearance is checked against the thickness)."""
-    t = s.tools
-    if t is None:
-        require("contact" not in s.effects, "tools", "the effect 'contact' needs a [tools] table")
-        return
-    require("contact" in s.effects, "effects", "a [tools] table needs the effect 'contact'")
-    _keys_of_effects(s, "tools")
-    require(t.shape in TOOL_SHAPES, "tools.shape", f"must be one of {TOOL_SHAPES}, got {t.shape!r}")
-    require(t.holder_spread in SPREADS, "tools.holder_spread", f"must be one of {SPREADS}, got {t.holder_spread!r}")
-    for name in ("blank_holder_force", "friction", "stroke"):
-        v = getattr(t, name)
-        require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{name}", f"must be finite, got {v}")
-    require(t.stroke > 0, "tools.stroke", f"must be > 0, got {t.stroke}")
-    for name in ("blank_holder_force", "friction"):
-        require(getattr(t, name) >= 0, f"tools.{name}", f"must be >= 0, got {getattr(t, name)}")
-    if t.shape == "cad":
-        flat, corner = _validate_cad_tools(t), t.holder_corner_radius
-    else:
-        flat, corner = _validate_analytic_tools(s, t), t.die_corner_radius + t.die_profile_radius
-    g = s.geometry
-    what = "holder_half_width" if t.shape == "cad" else "die_half_width + die_profile_radius"
-    if g.shape == "rectangle":
-        side = "lx" if g.lx <= g.ly else "ly"
-        require(min(g.lx, g.ly) / 2 > flat, f"geometry.{side}",
-                f"the blank does not reach the blank holder and the die's flat top: half its size "
-                f"{getattr(g, side) / 2} must exceed {what} = {flat}")
-    elif g.shape == "circle":
-        require(g.radius > flat, "geometry.radius",
-                f"the blank does not reach the blank holder and the die's flat top: its radius {g.radius} "
-                f"must exceed {what} = {flat}")
-    require(t.friction > 0 or "friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
-    require(bool(t.drawbead) or "drawbeads" not in s.effects, "tools.drawbead",
-            "the effect 'drawbeads' needs at least one [[tools.drawbead]]")
-    for i, bead in enumerate(t.drawbead):
-        _validate_drawbead(bead, f"tools.drawbead[{i}]", flat, corner)
-    if g.shape == "rectangle":
-        outer = ("right", "top") if g.region == "quarter" else SIDES
-    else:  # an outline's edges are free or symmetry lines
-        outer = tuple(k for k, v in s.supports.items() if v != "symmetry")
-    for side in outer:
-        v = s.supports.get(side, "free")
-        require(v == "free", f"supports.{side}",
-                f"the tools hold the blank: its outer edges must be 'free', got {v!r}")
-
-
-def _validate_analytic_tools(s: Scene, t) -> float:
-    """Square and round tools' dimensions; returns the half-width where the die's flat top
-    (and the holder) begins."""
-    if t.shape == "round":
-        for name in ("punch_radius", "die_radius"):
-            require(getattr(t, name) > 0, f"tools.{name}", f"round tools need {name} > 0, got {getattr(t, name)}")
-    else:
-        for name in ("punch_radius", "die_radius"):
-            require(getattr(t, name) == 0, f"tools.{name}", "is a key of shape = 'round' (square tools: "
-                    "punch_half_width, punch_corner_radius, die_half_width, die_corner_radius)")
-    for f in fields(ToolsSpec):
-        v = getattr(t, f.name)
-        if f.name not in ("holder_spread", "shape", "drawbead", *CAD_TOOL_KEYS):
-            require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
-    for name in ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "stroke"):
-        v = getattr(t, name)
-        require(v > 0, f"tools.{name}", f"must be > 0, got {v}")
-    for name in ("punch_corner_radius", "die_corner_radius", "blank_holder_force", "friction"):
-        v = getattr(t, name)
-        require(v >= 0, f"tools.{name}", f"must be >= 0, got {v}")
-    require(t.punch_profile_radius <= t.punch_corner_radius <= t.punch_half_width, "tools.punch_corner_radius",
-            f"must lie between punch_profile_radius ({t.punch_profile_radius}) and punch_half_width "
-            f"({t.punch_half_width}), got {t.punch_corner_radius}")
-    require(t.die_corner_radius <= t.die_half_width, "tools.die_corner_radius",
-            f"must be <= die_half_width ({t.die_half_width}), got {t.die_corner_radius}")
-    require(t.punch_half_width < t.die_half_width, "tools.punch_half_width",
-            f"the punch must fit in the die opening: must be < die_half_width ({t.die_half_width}), "
-            f"got {t.punch_half_width}")
-    thickness = s.material.thickness
-    require(t.die_half_width - t.punch_half_width >= thickness, "tools.die_half_width",
-            f"the clearance die_half_width - punch_half_width = {t.die_half_width - t.punch_half_width} "
-            f"is smaller than the thickness {thickness}: the sheet cannot pass")
-    require(t.punch_gap >= 0, "tools.punch_gap",
-            f"must be >= 0 (the punch would overlap the blank), got {t.punch_gap}")
-    return t.die_half_width + t.die_profile_radius
-
-
-def _validate_cad_tools(t) -> float:
-    """CAD tools: their files exist (what they hold is checked when they are read:
-    shellform.contact.surface_tool), their placements and the holder's inner edge; returns
-    holder_half_width."""
-    for name in ("punch_file", "die_file"):
-        v = getattr(t, name)
-        require(bool(v), f"tools.{name}", "shape = 'cad' needs the tool's STEP, IGES or BREP file")
-        require(Path(v).is_file(), f"tools.{name}", f"no such file: {v}")
-    for name in ("punch_translation", "die_translation"):
-        v = getattr(t, name)
-        require(len(v) == 3 and all(math.isfinite(c) for c in v), f"tools.{name}",
-                f"must be three finite numbers [x, y, z] (mm), got {v}")
-    for name in ("punch_normals", "die_normals"):
-        require(getattr(t, name) in TOOL_NORMALS, f"tools.{name}",
-                f"must be one of {TOOL_NORMALS}, got {getattr(t, name)!r}")
-    require(math.isfinite(t.holder_half_width) and t.holder_half_width > 0, "tools.holder_half_width",
-            f"shape = 'cad' needs the holder's inner edge (where the die's flat top begins) > 0, got "
-            f"{t.holder_half_width}")
-    require(math.isfinite(t.holder_corner_radius) and 0 <= t.holder_corner_radius <= t.holder_half_width,
-            "tools.holder_corner_radius", f"must lie in [0, holder_half_width], got {t.holder_corner_radius}")
-    return t.holder_half_width
