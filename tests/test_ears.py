@@ -1,0 +1,84 @@
+"""The round cup's rim: its ear profile (angle, radial draw-in, height) and the ears of a planar
+anisotropic sheet (Hill 1948) on demos/round_cup.toml's tools (docs/cup.md, "Ears")."""
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shellform import cli, scene
+from shellform.contact.problem import DrawingProblem
+from shellform.results import cup
+
+DEMOS = Path(__file__).resolve().parents[1] / "demos"
+
+
+def round_cup(tmp_path, stroke: float, n: int, r0: float, r45: float, r90: float, name="cup") -> Path:
+    """demos/round_cup.toml with Hill 1948 (r0, r45, r90; rolling direction along x), n elements
+    along the radius, the given stroke, and no series or pictures; the scene's path."""
+    text = (DEMOS / "round_cup.toml").read_text()
+    for pattern, new in ((r"stroke = 30\.0", f"stroke = {stroke}"), (r"\nn = 12\n", f"\nn = {n}\n"),
+                         (r"\nr = 0\.41\nm = 2\.0\n", f'\nyield_function = "hill48"\nr0 = {r0}\nr45 = {r45}\nr90 = {r90}\n')):
+        text, count = re.subn(pattern, new, text)
+        assert count == 1, pattern
+    text += "\n[output]\nvtx = false\nvtu = false\npng = false\nfld = false\n"
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return path
+
+
+def test_rim_interpolates_the_draw_in_along_the_angle():
+    rows = np.array([[0.0, 1.0, 0.0], [30.0, 2.0, 0.1], [60.0, 5.0, 0.2], [90.0, 3.0, 0.3]])
+    d = cup.rim_draw_in(rows)
+    assert d == {"rim_0deg": 1.0, "rim_45deg": pytest.approx(3.5, rel=1e-15), "rim_90deg": 3.0}
+    assert np.isnan(cup.rim_draw_in(rows[1:], angles=(0.0,))["rim_0deg"])  # not on the rim: no value
+
+
+def test_round_cup_writes_its_rim(tmp_path):
+    """A coarse round cup (74 cells) drawn 4 mm through `shellform run`: rim.csv holds every node
+    of the blank's outer edge (those at the blank's radius, counted here from the mesh) from 0 to
+    90 degrees, rim.png is drawn, and summary.json's draw-in at 0, 45 and 90 degrees are the
+    rim's, equal to DX and DY (the same nodes, on the axes) and to DD (its node lies at 45 degrees
+    on this mesh). Through the public API, the profile is hypot(X, Y) - hypot(x, y) and z of the
+    nodes at the blank's radius."""
+    path = round_cup(tmp_path, 4.0, 6, 2.0, 1.0, 2.0)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(path), "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped"] is None and summary["stroke_mm"] == pytest.approx(4.0)
+    rows = np.loadtxt(out / "rim.csv", delimiter=",", skiprows=1)
+    assert (out / "rim.csv").read_text().splitlines()[0] == "angle_deg,draw_in_mm,z_mm"
+    assert (out / "rim.png").stat().st_size > 10_000
+
+    s = scene.load(path)
+    p = DrawingProblem.from_scene(s, verbose=False)
+    X, x, _ = p.nodal_values()
+    R = s.geometry.radius
+    at_radius = np.abs(np.hypot(X[:, 0], X[:, 1]) - R) < 1e-9 * R
+    assert p.rim().sum() == at_radius.sum() == len(rows) > 8
+    assert np.array_equal(p.rim(), at_radius)
+    theta = np.degrees(np.arctan2(X[at_radius, 1], X[at_radius, 0]))
+    assert np.allclose(rows[:, 0], np.sort(theta), atol=1e-5)  # the CSV's 6 digits
+    assert rows[0, 0] == 0.0 and rows[-1, 0] == pytest.approx(90.0, abs=1e-9)
+    assert np.all(np.diff(rows[:, 0]) > 0)
+
+    for last in (summary["draw_in_mm"][-1], summary["reports"][-1]["draw_in_mm"]):
+        assert last["rim_0deg"] == pytest.approx(last["DX"], rel=1e-12)
+        assert last["rim_90deg"] == pytest.approx(last["DY"], rel=1e-12)
+        assert last["rim_45deg"] == pytest.approx(last["DD"], rel=1e-9)
+        assert last["rim_0deg"] == pytest.approx(rows[0, 1], rel=1e-5)
+    rim = summary["rim"]
+    assert rim["least_draw_in_mm"] == pytest.approx(rows[:, 1].min(), rel=1e-5)
+    assert rim["most_draw_in_mm"] == pytest.approx(rows[:, 1].max(), rel=1e-5)
+    assert rim["z_spread_mm"] == pytest.approx(np.ptp(rows[:, 2]), abs=1e-6)
+
+    for target in (0.5, 1.0):  # the same draw, stopping at the scene's report, through the API
+        p.driver.run(target)
+    X, x, _ = p.nodal_values()
+    order = np.argsort(theta)
+    profile = cup.rim(p)
+    expected = np.column_stack([theta, R - np.hypot(x[at_radius, 0], x[at_radius, 1]), x[at_radius, 2]])[order]
+    assert np.allclose(profile, expected, rtol=0, atol=1e-12)
+    assert np.allclose(profile[:, 1:], rows[:, 1:], rtol=1e-5, atol=1e-8)  # the CLI's run, to its CSV digits
