@@ -9,9 +9,9 @@ position from the x axis, its radial draw-in R - r (initial minus current radius
 height z (the mid-surface's, the flat blank at z = 0); rim_0deg, rim_45deg, rim_90deg are the
 draw-in interpolated along the rim at those angles. An ear is where the rim is drawn in least
 (a minimum of R - r: the flange's edge stays out, and once drawn off the holder that material
-stands highest in the wall), a trough where it is drawn in most. A square cup's thickness lines are the diagonal x = y and the
-transverse centre line y = 0; a round cup's the rolling (0 deg, y = 0) and transverse (90 deg,
-x = 0) lines.
+stands highest in the wall), a trough where it is drawn in most. A square cup's thickness lines
+are the diagonal x = y and the transverse centre line y = 0; a round cup's the rolling (0 deg,
+y = 0) and transverse (90 deg, x = 0) lines.
 """
 
 from pathlib import Path
