@@ -128,3 +128,26 @@ def test_hill48_round_cup_ears_follow_delta_r():
         z45 = np.interp(45.0, rows[:, 0], rows[:, 2])
         assert sign * ((rows[0, 2] + rows[-1, 2]) / 2 - z45) > 10 * np.ptp(rims["c"][:, 2]), (name, rows)
         assert np.corrcoef(rows[:, 1], rows[:, 2])[0, 1] < -0.9, (name, rows)
+
+
+@pytest.mark.slow
+def test_numisheet_steel_with_three_r_values_draws_in_less_where_r_across_is_higher():
+    """The NUMISHEET'93 mild steel (demos/numisheet93_steel.toml, mesh.n = 8) to 15 mm. With
+    the averaged r (Hill 1979, r 1.77) the structured quarter mesh is symmetric about x = y
+    and DX = DY to rounding; with Hill 1948 from r0 / r45 / r90 = 1.79 / 1.51 / 2.27 (rolling
+    direction along x) the flange on the x axis, compressed along y where r90 is the highest r,
+    extends radially more than it thickens, and is drawn in less than the flange on the y axis
+    (compressed along x, r0 = 1.79): DX < DY by more than 1 % (DX - DY = -0.135 mm, 2.6 % of DY,
+    here; -0.139 mm, 2.6 %, on the 16 x 16 demo mesh, docs/cup.md)."""
+    base = scene.load(DEMOS / "numisheet93_steel.toml").changed({"mesh.n": 8, "process.report": []})
+    out = {}
+    for name, changes in {"hill79": {}, "hill48": {"material.r": 1.0, "material.yield_function": "hill48",
+                                                   "material.r0": 1.79, "material.r45": 1.51,
+                                                   "material.r90": 2.27}}.items():
+        p = DrawingProblem.from_scene(base.changed(changes), verbose=False)
+        p.driver.run(15.0 / base.tools.stroke)
+        assert p.stroke == pytest.approx(15.0)
+        out[name] = cup.draw_in(p)
+    assert out["hill79"]["DX"] == pytest.approx(out["hill79"]["DY"], rel=1e-9)
+    d = out["hill48"]
+    assert d["DY"] - d["DX"] > 0.01 * d["DY"], out
