@@ -8,6 +8,7 @@ blank (times 4).
 from dataclasses import dataclass
 
 import numpy as np
+from dolfinx import fem
 from mpi4py import MPI
 
 from shellform import supports as named_supports
@@ -174,6 +175,19 @@ class DrawingProblem:
         d = self.driver
         e33 = np.log(2 * d.nodes.half_thickness / self.model.thickness)
         return d.nodes.X[: d.n_owned, :2], d.positions(), e33
+
+    def rim(self) -> np.ndarray:
+        """Owned nodes on the blank's outer edge: those of the boundary groups the scene leaves
+        free (the tools hold the blank there; a quarter's symmetry lines are not its edge), as a
+        boolean mask over the owned nodes of nodal_values()."""
+        V, n = self.model.V, self.driver.n_owned
+        on = np.zeros(n, dtype=bool)
+        fdim = self.rect.facet_tags.dim
+        for group in self.rect.groups:
+            if self.scene.supports.get(group, "free") == "free":
+                nodes = fem.locate_dofs_topological(V, fdim, self.rect.facets(group))
+                on[nodes[nodes < n]] = True
+        return on
 
     def in_contact(self) -> dict:
         """Nodes on the punch, on the die (of which pinched by the holder), on the open holder's

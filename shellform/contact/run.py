@@ -17,6 +17,11 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
     thickness_diagonal.csv   initial distance from the centre along x = y, thickness strain
     thickness_transverse.csv the same along the transverse centre line y = 0 (round tools:
                              thickness_0deg.csv along y = 0, thickness_90deg.csv along x = 0)
+    rim.csv, rim.png         (round tools) the rim's ear profile: per node of the blank's outer
+                             edge its initial angle from x, radial draw-in and height z;
+                             summary.json: rim_0deg, rim_45deg, rim_90deg in draw_in_mm at each
+                             report, and "rim": the least and most draw-in, their angles, the
+                             spread of z (results/cup.py)
     cup.bp, cup_cells.bp     VTX time series at the reports: displacement and nodal thickness
                              strain; per cell the equivalent plastic strain and the major and
                              minor logarithmic surface strains
@@ -182,6 +187,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     d = p.driver
     for name, line in cup.thickness_lines(p).items():
         write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
+    rim = cup.write_rim(outdir, p, s.title) if s.tools.shape == "round" else None
     cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
@@ -203,7 +209,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
         "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],
         **{k: v for k, v in reports[-1].items() if k not in ("stroke_mm", "draw_in_mm", "punch_force_kN")},
-        "reports": reports, **limits, "springback": sprung,
+        "reports": reports, **limits, "springback": sprung, **({"rim": rim} if rim else {}),
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "element_evaluations": {"run": d.evaluations, "reused": d.reused, "tangents": d.tangents},

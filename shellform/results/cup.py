@@ -3,9 +3,15 @@ force-stroke plot and the picture of the cup (used by shellform.contact.run).
 
 DX = draw-in of the blank edge on the axis y = 0 (initial x minus current x), DY the same on
 x = 0, DD along the diagonal at the edge's node farthest along x + y (the square blank's corner;
-initial minus current radius). A square cup's thickness lines are the diagonal x = y and the
-transverse centre line y = 0; a round cup's the rolling (0 deg, y = 0) and transverse (90 deg,
-x = 0) lines.
+initial minus current radius). A round cup's rim (the nodes of the blank's outer edge,
+DrawingProblem.rim) gives its ear profile: per node its angle theta = atan2(Y, X) of its initial
+position from the x axis, its radial draw-in R - r (initial minus current radius in plan) and its
+height z (the mid-surface's, the flat blank at z = 0); rim_0deg, rim_45deg, rim_90deg are the
+draw-in interpolated along the rim at those angles. An ear is where the rim is drawn in least
+(a minimum of R - r: the flange's edge stays out, and once drawn off the holder that material
+stands highest in the wall), a trough where it is drawn in most. A square cup's thickness lines
+are the diagonal x = y and the transverse centre line y = 0; a round cup's the rolling (0 deg,
+y = 0) and transverse (90 deg, x = 0) lines.
 """
 
 from pathlib import Path
@@ -33,8 +39,69 @@ def draw_in(p) -> dict:
 
     (X0, x0), (X1, x1) = at(hx, 0.0), at(0.0, hy)
     corner = int(np.argmax(X[:, 0] + X[:, 1]))
-    return {"DX": float(X0[0] - x0[0]), "DY": float(X1[1] - x1[1]),
-            "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
+    out = {"DX": float(X0[0] - x0[0]), "DY": float(X1[1] - x1[1]),
+           "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
+    if p.scene.tools.shape == "round":
+        out.update(rim_draw_in(rim(p)))
+    return out
+
+
+RIM_ANGLES = (0.0, 45.0, 90.0)  # the round cup's draw-in in summary.json: rim_0deg, rim_45deg, rim_90deg
+
+
+def rim(p) -> np.ndarray:
+    """The rim's ear profile, rows (angle_deg, draw_in_mm, z_mm) by angle, gathered on every
+    rank: theta = atan2(Y, X) of the node's initial position (degrees from the x axis), the
+    radial draw-in hypot(X, Y) - hypot(x, y) and the current height z of the rim's nodes."""
+    X, x, _ = p.nodal_values()
+    on = p.rim()
+    X, x = X[on], x[on]
+    rows = np.column_stack([np.degrees(np.arctan2(X[:, 1], X[:, 0])),
+                            np.hypot(X[:, 0], X[:, 1]) - np.hypot(x[:, 0], x[:, 1]), x[:, 2]])
+    rows, = _gather(p.model.mesh.comm, rows)
+    return rows[np.argsort(rows[:, 0], kind="stable")]
+
+
+def rim_draw_in(rows: np.ndarray, angles=RIM_ANGLES) -> dict:
+    """The rim's draw-in at the given angles (degrees), linear between its nodes along the
+    angle: {"rim_0deg": ..., ...} (nan at an angle the rim does not reach)."""
+    return {f"rim_{a:g}deg": float(np.interp(a, rows[:, 0], rows[:, 1], left=np.nan, right=np.nan))
+            for a in angles}
+
+
+def write_rim(outdir: Path, p, title: str) -> dict:
+    """rim.csv (angle_deg, draw_in_mm, z_mm per rim node, by angle) and rim.png (the draw-in and
+    the height against the angle); returns the profile's extremes for summary.json: the least and
+    the most draw-in (the highest ear and the deepest trough) and their angles, and the spread
+    of z."""
+    from shellform.results.tables import write_csv
+
+    rows = rim(p)
+    write_csv(outdir / "rim.csv", [{"angle_deg": a, "draw_in_mm": d, "z_mm": z} for a, d, z in rows],
+              ["angle_deg", "draw_in_mm", "z_mm"])
+    lo, hi = int(np.argmin(rows[:, 1])), int(np.argmax(rows[:, 1]))
+    out = {"least_draw_in_mm": float(rows[lo, 1]), "least_at_deg": float(rows[lo, 0]),
+           "most_draw_in_mm": float(rows[hi, 1]), "most_at_deg": float(rows[hi, 0]),
+           "z_spread_mm": float(np.ptp(rows[:, 2]))}
+    if p.model.mesh.comm.rank == 0:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, (ax, az) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+        ax.plot(rows[:, 0], rows[:, 1], "o-", ms=3)
+        ax.set_ylabel("radial draw-in R - r (mm)\n(least: an ear)")
+        az.plot(rows[:, 0], rows[:, 2], "o-", ms=3)
+        az.set_ylabel("rim height z (mm)")
+        az.set_xlabel("angle from the x axis, initial (degrees)")
+        for a in (ax, az):
+            a.grid(alpha=0.3)
+        ax.set_title(f"{title}: the rim at stroke {p.stroke:.1f} mm", fontsize=10, parse_math=False)
+        fig.tight_layout()
+        fig.savefig(outdir / "rim.png", dpi=120)
+        plt.close(fig)
+    return out
 
 
 LINES = {  # the thickness lines of a cup by its tools' shape: name -> nodes on it
