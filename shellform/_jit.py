@@ -54,6 +54,13 @@ def cache_dir() -> Path:
 _CACHE_DIR = str(cache_dir())
 
 
+def compiled() -> bool:
+    """Whether this version's numba functions were compiled on this machine before (its cache
+    folder holds something): a run without them compiles first, about a minute."""
+    folder = Path(_CACHE_DIR)
+    return folder.is_dir() and any(folder.iterdir())
+
+
 def _cpu_key() -> str:
     """This CPU's model and features, as -march=native sees them (LLVM's host description)."""
     h = hashlib.sha256(binding.get_host_cpu_name().encode())

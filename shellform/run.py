@@ -23,6 +23,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from shellform import effects
+from shellform import _jit as jit
 from shellform.errors import InputError
 from shellform.results import run_folder
 from shellform.results.summary import Summary
@@ -56,6 +57,11 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     way = route(s)
     if resume and way != "tools":
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
+    if way != "shell" and not jit.compiled():
+        from shellform.results.log import say
+
+        say("shellform: compiling the element and material kernels (once per machine and version, about a "
+            "minute)")
     if s.nonlinear and "plasticity" in s.effects:
         from shellform.results.log import say
 

@@ -178,3 +178,18 @@ def test_probes_belong_to_nonlinear_sheet_scenes():
 
     with pytest.raises(InputError, match=r"^output\.probe\[0\]: probes are reported by nonlinear sheet scenes"):
         scene.load(ROOT / "demos" / "square_cup.toml").changed({"output.probe": [{"name": "c", "x": 0.0, "y": 0.0}]})
+
+
+def test_a_first_run_says_it_compiles(tmp_path, capsys, monkeypatch):
+    """Where this version's numba cache is empty (a first run on a machine), a nonlinear run
+    says that it compiles its kernels before the silence of compiling; with the cache, nothing."""
+    from shellform import _jit
+
+    s = scene.load(ROOT / "demos" / "levy_plate.toml").changed({
+        "mesh.n": 2, "process.path": [0.01], "process.report": [], "output.vtx": False, "output.png": False})
+    monkeypatch.setattr(_jit, "_CACHE_DIR", str(tmp_path / "empty"))
+    run.run(s, tmp_path / "a")
+    assert "compiling the element and material kernels (once per machine" in capsys.readouterr().out
+    monkeypatch.undo()
+    run.run(s, tmp_path / "b")
+    assert "compiling" not in capsys.readouterr().out
