@@ -106,6 +106,24 @@ class _Current:
             gmsh.model.setCurrent(self.previous)
 
 
+class _Projections:
+    """Points y (in a tool's model frame) with their closest points c, distances dist, signed
+    distances d, normals n, entities (indices into the tool's entities) and parameters, and
+    lower bounds of their distances to every entity (points, entities)."""
+
+    def __init__(self, y, c, dist, d, n, ent, par, bound):
+        from scipy.spatial import cKDTree
+
+        self.y, self.c, self.dist, self.d, self.n, self.ent, self.par, self.bound = y, c, dist, d, n, ent, par, bound
+        self.tree = cKDTree(y)
+
+    def nearest(self, y):
+        """The nearest remembered point of each of y (its index) and the distance to it (0
+        exactly where the point is given again)."""
+        delta, ref = self.tree.query(y)
+        return ref, delta
+
+
 class SurfaceTool:
     """A rigid tool: the faces of the OCC model `model` (a gmsh model's name), placed by
     `translation` (mm), its faces' normals pointing to the sheet (`normals` "outward") or away
@@ -126,6 +144,8 @@ class SurfaceTool:
             self._face_adjacent = {e: sorted(set(int(f) for f in gmsh.model.getAdjacencies(1, e)[0]))
                                    for e in self.edges}
             self._setup(gmsh)
+            self._last = None  # the last call's points and their closest points (_Projections)
+            self.counts = {"repeated": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
             self._index = {de: k for k, de in enumerate(self._ents)}
             self._is_face = np.array([d == 2 for d, _ in self._ents])
             self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
@@ -217,39 +237,121 @@ class SurfaceTool:
     def closest(self, x, dz: float = 0.0):
         """For points x (n, 3): the closest surface points c (placed), the signed distances d,
         the normals n, and per point the entity (dim, tag) it lies on with its parametric
-        coordinates (a face: (u, v); an edge: (t, 0))."""
+        coordinates (a face: (u, v); an edge: (t, 0)).
+
+        The last call's points are remembered with their closest points (_Projections): a point
+        given again (in the model's frame: the same x and dz) takes its last answer; a point
+        near a remembered one starts from that one's face and parameters (_warm); the others
+        are searched (_search)."""
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         shift = self.translation + np.array([0.0, 0.0, dz])
         y = x - shift  # in the model's frame
+        npts = len(y)
+        c, dist, ent, par = np.zeros_like(y), np.full(npts, np.inf), np.full(npts, -1), np.zeros((npts, 2))
+        d, n, bound = np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, len(self._ents)))
+        last, todo = self._last if npts else None, np.ones(npts, dtype=bool)
+        if last is not None:
+            ref, delta = last.nearest(y)
+            same = np.flatnonzero(delta == 0.0)
+            c[same], dist[same], ent[same], par[same] = last.c[ref[same]], last.dist[ref[same]], \
+                last.ent[ref[same]], last.par[ref[same]]
+            d[same], n[same], bound[same] = last.d[ref[same]], last.n[ref[same]], last.bound[ref[same]]
+            todo[same] = False
+            self.counts["repeated"] += same.size
+            if same.size == npts:  # every point given again: the remembered points stay
+                return c + shift, d, n, ent, par
         with _Current(self.model) as gmsh:
-            c, dist, ent, par = self._nearest(gmsh, y)
-            d, n = self._signed(gmsh, y, c, dist, ent, par)
-        return c + shift, d, n, ent, par
+            m = gmsh.model
+            new = np.flatnonzero(todo)
+            if last is not None:
+                warm = np.flatnonzero(todo & self._is_face[np.maximum(last.ent[ref], 0)] & (last.ent[ref] >= 0))
+                if warm.size:
+                    sure = self._warm(m, y, warm, last, ref[warm], delta[warm], c, dist, ent, par, bound)
+                    todo[warm[sure]] = False
+                    self.counts["warm"] += int(sure.sum())
+            rest = np.flatnonzero(todo)
+            self.counts["searched"] += rest.size
+            if rest.size:
+                c[rest], dist[rest], ent[rest], par[rest], bound[rest] = self._search(m, y[rest])
+            d[new], n[new] = self._signed(gmsh, y[new], c[new], dist[new], ent[new], par[new])
+        if npts:
+            self._last = _Projections(y, c, dist, d, n, ent, par, bound)
+        return c + shift, d.copy(), n.copy(), ent.copy(), par.copy()
 
-    def _nearest(self, gmsh, y):
+    def _lower(self, y):
+        """The distance of points y to every entity's bounding box (points, entities): a lower
+        bound of their distance to the entity."""
+        return np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
+                              + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)
+
+    def _search(self, m, y):
         """Closest points: first the local projection from the nearest sample (_local), where
-        it is sure; the other points by the candidates' projections (_candidates)."""
+        it is sure; the other points by the candidates' projections (_candidates). Also returns
+        lower bounds of every point's distance to every entity (points, entities): the bounding
+        boxes', raised to a face's projection distance onto its untrimmed surface (an edge's onto
+        its curve) where one was computed, and to the distance found on its face (and its
+        edges) where the local projection converged inside it."""
         upper, sample = self._tree.query(y)
         upper = upper * (1 + 1e-9) + 1e-9 * self.size
-        lower = np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
-                               + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)  # (points, entities)
+        lower = self._lower(y)  # (points, entities)
+        bound = lower.copy()
         c, dist, ent, par = np.zeros_like(y), np.full(len(y), np.inf), np.full(len(y), -1), np.zeros((len(y), 2))
-        done = self._local(gmsh.model, y, sample, lower, c, dist, ent, par)
+        done = self._local(m, y, sample, lower, c, dist, ent, par, bound)
         rest = np.flatnonzero(~done)
         if rest.size:  # a point found by the local projection bounds the distance and is a candidate
             seed = (c[rest], dist[rest], ent[rest], par[rest])
             upper = np.minimum(upper[rest], dist[rest] * (1 + 1e-9) + 1e-9 * self.size)
-            c[rest], dist[rest], ent[rest], par[rest] = self._candidates(gmsh.model, y[rest], upper, lower[rest], seed)
-        return c, dist, ent, par
+            sub = bound[rest]
+            c[rest], dist[rest], ent[rest], par[rest] = self._candidates(m, y[rest], upper, lower[rest], seed, sub)
+            bound[rest] = sub
+        r = np.flatnonzero(ent >= 0)
+        bound[r, ent[r]] = dist[r]
+        return c, dist, ent, par, bound
 
-    def _local(self, m, y, sample, lower, c, dist, ent, par):
+    def _newton(self, m, f, uv, y):
+        """Newton on face f from its parameters uv (modified in place) towards the points y:
+        min |X(u, v) - y|^2, the step -A^-1 g with g = J (X - y), A = J J^T + X_ij . (X - y),
+        at most LOCAL_ITERATIONS steps. Returns the points X(uv) and where it converged inside
+        the face (its parametric bounds; a trimmed face's sampled boundary, sure of the side)."""
+        ok = np.zeros(len(y), dtype=bool)
+        for _ in range(LOCAL_ITERATIONS):
+            X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+            J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
+            S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+            r = X - y
+            g = np.einsum("pai,pi->pa", J, r)
+            Sr = np.einsum("pki,pi->pk", S, r)
+            A = np.einsum("pai,pbi->pab", J, J)
+            A[:, 0, 0] += Sr[:, 0]
+            A[:, 1, 1] += Sr[:, 1]
+            A[:, 0, 1] += Sr[:, 2]
+            A[:, 1, 0] += Sr[:, 2]
+            det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+            good = (det > 0) & (A[:, 0, 0] > 0)
+            det = np.where(good, det, 1.0)
+            step = -np.stack([A[:, 1, 1] * g[:, 0] - A[:, 0, 1] * g[:, 1],
+                              A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
+            step[~good] = 0.0
+            uv += step
+            ok = good & (np.linalg.norm(np.einsum("pai,pa->pi", J, step), axis=1) < 1e-13 * self.size)
+            if ok.all():
+                break
+        b0, b1 = self._bounds[(2, f)]
+        tol = 1e-9 * (b1 - b0 + 1.0)
+        ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
+        if not self._filled[f]:
+            inside, sure = self._in_trim(f, uv)
+            ok &= inside & sure
+        return np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3), ok
+
+    def _local(self, m, y, sample, lower, c, dist, ent, par, bound):
         """Newton on the face of each point's nearest sample (on both faces of a sample on an
-        edge), from the sample's parameters: min |X(u, v) - y|^2, the step -A^-1 g with g =
-        J (X - y), A = J J^T + X_ij . (X - y). Where it converges inside a face, that face and
-        its edges are known for the point (the nearest point of a face found inside it is nearer
-        than its edges); the nearest point found is sure (True) where no other entity's bounding
-        box lies nearer. Fills c, dist, ent, par with the nearest point found inside a face (sure
-        or not: a point of the surface, which bounds the distance)."""
+        edge), from the sample's parameters (_newton). Where it converges inside a face, that
+        face and its edges are known for the point (the nearest point of a face found inside it
+        is nearer than its edges: their bounds in `bound` are raised to it); the nearest point
+        found is sure (True) where no other entity's bounding box lies nearer. Fills c, dist,
+        ent, par with the nearest point found inside a face (sure or not: a point of the
+        surface, which bounds the distance)."""
         npts, nent = len(y), len(self._ents)
         k0 = self._sample_entity[sample]
         on_face = self._is_face[k0]
@@ -269,49 +371,69 @@ class SurfaceTool:
             sel = ks == k
             idx, uv = pts[sel], uvs[sel].copy()
             yk = y[idx]
-            ok = np.zeros(len(idx), dtype=bool)
-            for _ in range(LOCAL_ITERATIONS):
-                X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
-                J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
-                S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
-                r = X - yk
-                g = np.einsum("pai,pi->pa", J, r)
-                Sr = np.einsum("pki,pi->pk", S, r)
-                A = np.einsum("pai,pbi->pab", J, J)
-                A[:, 0, 0] += Sr[:, 0]
-                A[:, 1, 1] += Sr[:, 1]
-                A[:, 0, 1] += Sr[:, 2]
-                A[:, 1, 0] += Sr[:, 2]
-                det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
-                good = (det > 0) & (A[:, 0, 0] > 0)
-                det = np.where(good, det, 1.0)
-                step = -np.stack([A[:, 1, 1] * g[:, 0] - A[:, 0, 1] * g[:, 1],
-                                  A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
-                step[~good] = 0.0
-                uv += step
-                ok = good & (np.linalg.norm(np.einsum("pai,pa->pi", J, step), axis=1) < 1e-13 * self.size)
-                if ok.all():
-                    break
-            b0, b1 = self._bounds[(2, f)]
-            tol = 1e-9 * (b1 - b0 + 1.0)
-            ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
-            if not self._filled[f]:
-                inside, sure = self._in_trim(f, uv)
-                ok &= inside & sure
-            X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+            X, ok = self._newton(m, f, uv, yk)
             d = np.linalg.norm(yk - X, axis=1)
             better = ok & (d < dist[idx])
             rows = idx[better]
             c[rows], dist[rows], ent[rows], par[rows] = X[better], d[better], k, uv[better]
-            known[idx[ok], k] = True
-            known[np.ix_(idx[ok], self._face_edges[k])] = True
+            self._settle(known, bound, idx[ok], k, d[ok])
         others = np.where(known, np.inf, lower).min(axis=1)
         return (ent >= 0) & (dist <= others)
 
-    def _candidates(self, m, y, upper, lower, seed):
+    def _settle(self, known, bound, rows, k, d):
+        """Face k's nearest points of `rows` found inside it, at distances d: the face and its
+        edges known for them, their distances' lower bounds raised to d."""
+        known[rows, k] = True
+        bound[rows, k] = np.maximum(bound[rows, k], d)
+        edges = self._face_edges[k]
+        known[np.ix_(rows, edges)] = True
+        bound[np.ix_(rows, edges)] = np.maximum(bound[np.ix_(rows, edges)], d[:, None])
+
+    def _warm(self, m, y, warm, last, ref, delta, c, dist, ent, par, bound):
+        """The points y[warm] near the remembered points ref of the last call (at distances
+        delta), on a face there: Newton on that face from its parameters (_newton). A point
+        that converges inside the face is sure where no other entity may lie nearer: the
+        distance to an entity is at least its remembered lower bound less delta (the distance
+        is 1-Lipschitz) and at least its bounding box's (less 1e-9 of the tool's size, so that a
+        tie goes to the candidates). Where another entity may lie nearer, the point's candidates
+        are the entities whose bounds allow it (_candidates, the face's point the seed). Fills
+        c, dist, ent, par, bound at the points found; returns which of `warm` were found (those
+        whose Newton did not converge inside their face are left to the search)."""
+        ks = last.ent[ref]
+        uvs = last.par[ref].copy()
+        X, d, ok = np.zeros((warm.size, 3)), np.full(warm.size, np.inf), np.zeros(warm.size, dtype=bool)
+        for k in np.unique(ks):
+            sel = np.flatnonzero(ks == k)
+            uv = uvs[sel]
+            X[sel], ok[sel] = self._newton(m, self._ents[k][1], uv, y[warm[sel]])
+            uvs[sel] = uv
+            d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
+        lower = np.maximum(self._lower(y[warm]), last.bound[ref] - delta[:, None])
+        known = np.zeros_like(lower, dtype=bool)
+        for k in np.unique(ks):
+            sel = np.flatnonzero((ks == k) & ok)
+            self._settle(known, lower, sel, k, d[sel])
+        others = np.where(known, np.inf, lower - 1e-9 * self.size).min(axis=1)
+        sure = ok & (d <= others)
+        i = np.flatnonzero(ok & ~sure)
+        if i.size:  # another entity may lie nearer: the candidates among those whose bounds allow it
+            sub = lower[i]
+            X[i], d[i], ks[i], uvs[i] = self._candidates(
+                m, y[warm[i]], d[i] * (1 + 1e-9) + 1e-9 * self.size, np.where(known[i], np.inf, sub),
+                (X[i], d[i], ks[i], uvs[i]), sub)
+            sub[np.arange(i.size), ks[i]] = d[i]
+            lower[i] = sub
+            sure[i] = True
+        rows = warm[sure]
+        c[rows], dist[rows], ent[rows], par[rows], bound[rows] = X[sure], d[sure], ks[sure], uvs[sure], lower[sure]
+        return sure
+
+    def _candidates(self, m, y, upper, lower, seed, bound):
         """The nearest of every entity's projection whose bounding box lies within `upper`, and
         of the seed (c, dist, entity, parameters: the local projection's point, entity -1 where
-        there is none)."""
+        there is none). Raises `bound` to each projection's distance (onto the untrimmed
+        surface, the edge's curve unclamped: lower bounds of the distance to the entity), and a
+        face's whose projection falls outside it to the least of its edges' bounds."""
         npts = len(y)
         cand = lower <= upper[:, None]
         nent = len(self._ents)
@@ -330,6 +452,7 @@ class SurfaceTool:
             b0, b1 = self._bounds[(d, t)]
             c, p = m.getClosestPoint(d, t, y[idx].ravel())
             c = np.asarray(c).reshape(-1, 3)
+            bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
             if d == 1:
                 p = np.asarray(p, dtype=float)
                 q = np.clip(p, b0[0], b1[0])
@@ -363,6 +486,12 @@ class SurfaceTool:
                 unknown[i, k] = False
                 if m.isInside(2, self._ents[k][1], P[i, k], True) <= 0:
                     D[i, k] = np.inf
+        # a face whose projection falls outside it is nearest on its boundary: at least its edges' bounds
+        outside = cand & ~np.isfinite(D) & ~unknown & self._is_face[None, :]
+        for k in np.flatnonzero(outside.any(axis=0)):
+            rows, edges = np.flatnonzero(outside[:, k]), self._face_edges[k]
+            if edges.size:
+                bound[rows, k] = np.maximum(bound[rows, k], bound[np.ix_(rows, edges)].min(axis=1))
         best = np.argmin(D, axis=1)
         r = np.arange(npts)
         return C[r, best], D[r, best], best, P[r, best]
