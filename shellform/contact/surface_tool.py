@@ -108,13 +108,16 @@ class _Current:
 
 class _Projections:
     """Points y (in a tool's model frame) with their closest points c, distances dist, signed
-    distances d, normals n, entities (indices into the tool's entities) and parameters, and
-    lower bounds of their distances to every entity (points, entities)."""
+    distances d, normals n, entities (indices into the tool's entities) and parameters, lower
+    bounds of their distances to every entity (points, entities), and where the closest point
+    was found by Newton on a face (has), the face's derivatives there (J: X_u, X_v; S: X_uu,
+    X_vv, X_uv)."""
 
-    def __init__(self, y, c, dist, d, n, ent, par, bound):
+    def __init__(self, y, c, dist, d, n, ent, par, bound, J, S, has):
         from scipy.spatial import cKDTree
 
         self.y, self.c, self.dist, self.d, self.n, self.ent, self.par, self.bound = y, c, dist, d, n, ent, par, bound
+        self.J, self.S, self.has = J, S, has
         self.tree = cKDTree(y)
 
     def nearest(self, y):
@@ -205,12 +208,14 @@ class SurfaceTool:
         lo, hi = self._box[:, 0].min(axis=0), self._box[:, 1].max(axis=0)
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
-        self._bounds, self._filled, self._trims = {}, {}, {}
+        self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
             b0, b1 = (np.asarray(v, dtype=float) for v in m.getParametrizationBounds(d, t))
             self._bounds[(d, t)] = (b0, b1)
+            if m.getType(d, t) in ("Plane", "Line"):
+                self._flat.add((d, t))
             if d == 2:
                 u, v = np.meshgrid(b0[0] + s * (b1[0] - b0[0]), b0[1] + s * (b1[1] - b0[1]))
                 uv = np.c_[u.ravel(), v.ravel()]
@@ -222,6 +227,9 @@ class SurfaceTool:
                 if uv.size == 0:
                     continue
                 xyz = np.asarray(m.getValue(2, t, uv.ravel())).reshape(-1, 3)
+                J = np.asarray(m.getDerivative(2, t, uv.ravel())).reshape(-1, 2, 3)
+                normal = np.asarray(m.getNormal(t, uv.ravel())).reshape(-1, 3)
+                self._orient[t] = 1.0 if np.einsum("pi,pi->", np.cross(J[:, 0], J[:, 1]), normal) >= 0 else -1.0
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
@@ -243,40 +251,47 @@ class SurfaceTool:
         given again (in the model's frame: the same x and dz) takes its last answer; a point
         near a remembered one starts from that one's face and parameters (_warm); the others
         are searched (_search)."""
+        return self._closest(x, dz)[:5]
+
+    def _closest(self, x, dz):
+        """closest's answers, and where the closest point was found by Newton on a face (has)
+        the face's derivatives there (J, S: _Projections)."""
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         shift = self.translation + np.array([0.0, 0.0, dz])
         y = x - shift  # in the model's frame
         npts = len(y)
         c, dist, ent, par = np.zeros_like(y), np.full(npts, np.inf), np.full(npts, -1), np.zeros((npts, 2))
         d, n, bound = np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, len(self._ents)))
+        J, S, has = np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3)), np.zeros(npts, dtype=bool)
         last, todo = self._last if npts else None, np.ones(npts, dtype=bool)
         if last is not None:
             ref, delta = last.nearest(y)
             same = np.flatnonzero(delta == 0.0)
-            c[same], dist[same], ent[same], par[same] = last.c[ref[same]], last.dist[ref[same]], \
-                last.ent[ref[same]], last.par[ref[same]]
-            d[same], n[same], bound[same] = last.d[ref[same]], last.n[ref[same]], last.bound[ref[same]]
+            r = ref[same]
+            c[same], dist[same], ent[same], par[same] = last.c[r], last.dist[r], last.ent[r], last.par[r]
+            d[same], n[same], bound[same] = last.d[r], last.n[r], last.bound[r]
+            J[same], S[same], has[same] = last.J[r], last.S[r], last.has[r]
             todo[same] = False
             self.counts["repeated"] += same.size
             if same.size == npts:  # every point given again: the remembered points stay
-                return c + shift, d, n, ent, par
+                return c + shift, d, n, ent, par, J, S, has
         with _Current(self.model) as gmsh:
             m = gmsh.model
             new = np.flatnonzero(todo)
             if last is not None:
                 warm = np.flatnonzero(todo & self._is_face[np.maximum(last.ent[ref], 0)] & (last.ent[ref] >= 0))
                 if warm.size:
-                    sure = self._warm(m, y, warm, last, ref[warm], delta[warm], c, dist, ent, par, bound)
+                    sure = self._warm(m, y, warm, last, ref[warm], delta[warm], (c, dist, ent, par, bound, J, S, has))
                     todo[warm[sure]] = False
                     self.counts["warm"] += int(sure.sum())
             rest = np.flatnonzero(todo)
             self.counts["searched"] += rest.size
             if rest.size:
                 c[rest], dist[rest], ent[rest], par[rest], bound[rest] = self._search(m, y[rest])
-            d[new], n[new] = self._signed(gmsh, y[new], c[new], dist[new], ent[new], par[new])
+            d[new], n[new] = self._signed(gmsh, y[new], c[new], dist[new], ent[new], par[new], J[new], has[new])
         if npts:
-            self._last = _Projections(y, c, dist, d, n, ent, par, bound)
-        return c + shift, d.copy(), n.copy(), ent.copy(), par.copy()
+            self._last = _Projections(y, c, dist, d, n, ent, par, bound, J, S, has)
+        return c + shift, d.copy(), n.copy(), ent.copy(), par.copy(), J, S, has
 
     def _lower(self, y):
         """The distance of points y to every entity's bounding box (points, entities): a lower
@@ -311,13 +326,18 @@ class SurfaceTool:
     def _newton(self, m, f, uv, y):
         """Newton on face f from its parameters uv (modified in place) towards the points y:
         min |X(u, v) - y|^2, the step -A^-1 g with g = J (X - y), A = J J^T + X_ij . (X - y),
-        at most LOCAL_ITERATIONS steps. Returns the points X(uv) and where it converged inside
-        the face (its parametric bounds; a trimmed face's sampled boundary, sure of the side)."""
+        at most LOCAL_ITERATIONS steps (on a plane one: X is affine in (u, v), the step exact),
+        until a step moves the point by less than 1e-13 of the tool's size. Returns the points
+        X(uv) (the last evaluation plus J step), where it converged inside the face (its
+        parametric bounds; a trimmed face's sampled boundary, sure of the side), and the
+        derivatives J, S of the last evaluation (a step before uv: within 1e-13 of the size)."""
         ok = np.zeros(len(y), dtype=bool)
-        for _ in range(LOCAL_ITERATIONS):
+        plane = (2, f) in self._flat
+        for _ in range(1 if plane else LOCAL_ITERATIONS):
             X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
             J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
-            S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+            S = np.zeros((len(uv), 3, 3)) if plane else \
+                np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
             r = X - y
             g = np.einsum("pai,pi->pa", J, r)
             Sr = np.einsum("pki,pi->pk", S, r)
@@ -333,16 +353,18 @@ class SurfaceTool:
                               A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
             step[~good] = 0.0
             uv += step
-            ok = good & (np.linalg.norm(np.einsum("pai,pa->pi", J, step), axis=1) < 1e-13 * self.size)
+            move = np.einsum("pai,pa->pi", J, step)
+            ok = good & (plane | (np.linalg.norm(move, axis=1) < 1e-13 * self.size))
             if ok.all():
                 break
+        X = X + move  # the last step's change: exact on a plane, within its square elsewhere
         b0, b1 = self._bounds[(2, f)]
         tol = 1e-9 * (b1 - b0 + 1.0)
         ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
         if not self._filled[f]:
             inside, sure = self._in_trim(f, uv)
             ok &= inside & sure
-        return np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3), ok
+        return X, ok, J, S
 
     def _local(self, m, y, sample, lower, c, dist, ent, par, bound):
         """Newton on the face of each point's nearest sample (on both faces of a sample on an
@@ -371,7 +393,7 @@ class SurfaceTool:
             sel = ks == k
             idx, uv = pts[sel], uvs[sel].copy()
             yk = y[idx]
-            X, ok = self._newton(m, f, uv, yk)
+            X, ok, _, _ = self._newton(m, f, uv, yk)
             d = np.linalg.norm(yk - X, axis=1)
             better = ok & (d < dist[idx])
             rows = idx[better]
@@ -389,51 +411,58 @@ class SurfaceTool:
         known[np.ix_(rows, edges)] = True
         bound[np.ix_(rows, edges)] = np.maximum(bound[np.ix_(rows, edges)], d[:, None])
 
-    def _warm(self, m, y, warm, last, ref, delta, c, dist, ent, par, bound):
+    def _warm(self, m, y, warm, last, ref, delta, out):
         """The points y[warm] near the remembered points ref of the last call (at distances
         delta), on a face there: Newton on that face from its parameters (_newton). A point
         that converges inside the face is sure where no other entity may lie nearer: the
         distance to an entity is at least its remembered lower bound less delta (the distance
-        is 1-Lipschitz) and at least its bounding box's (less 1e-9 of the tool's size, so that a
-        tie goes to the candidates). Where another entity may lie nearer, the point's candidates
+        is 1-Lipschitz; less 1e-9 of the tool's size, so that a tie goes to the candidates). Where another entity may lie nearer, the point's candidates
         are the entities whose bounds allow it (_candidates, the face's point the seed). Fills
-        c, dist, ent, par, bound at the points found; returns which of `warm` were found (those
-        whose Newton did not converge inside their face are left to the search)."""
+        `out` (c, dist, ent, par, bound, J, S, has) at the points found; returns which of `warm`
+        were found (those whose Newton did not converge inside their face are left to the
+        search)."""
+        c, dist, ent, par, bound, Jo, So, has = out
         ks = last.ent[ref]
         uvs = last.par[ref].copy()
         X, d, ok = np.zeros((warm.size, 3)), np.full(warm.size, np.inf), np.zeros(warm.size, dtype=bool)
+        J, S = np.zeros((warm.size, 2, 3)), np.zeros((warm.size, 3, 3))
         for k in np.unique(ks):
             sel = np.flatnonzero(ks == k)
             uv = uvs[sel]
-            X[sel], ok[sel] = self._newton(m, self._ents[k][1], uv, y[warm[sel]])
+            X[sel], ok[sel], J[sel], S[sel] = self._newton(m, self._ents[k][1], uv, y[warm[sel]])
             uvs[sel] = uv
             d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
-        lower = np.maximum(self._lower(y[warm]), last.bound[ref] - delta[:, None])
+        lower = last.bound[ref] - delta[:, None]
         known = np.zeros_like(lower, dtype=bool)
         for k in np.unique(ks):
             sel = np.flatnonzero((ks == k) & ok)
             self._settle(known, lower, sel, k, d[sel])
         others = np.where(known, np.inf, lower - 1e-9 * self.size).min(axis=1)
         sure = ok & (d <= others)
+        newton = sure.copy()
         i = np.flatnonzero(ok & ~sure)
         if i.size:  # another entity may lie nearer: the candidates among those whose bounds allow it
-            sub = lower[i]
+            sub, seed = lower[i], ks[i].copy()
             X[i], d[i], ks[i], uvs[i] = self._candidates(
                 m, y[warm[i]], d[i] * (1 + 1e-9) + 1e-9 * self.size, np.where(known[i], np.inf, sub),
                 (X[i], d[i], ks[i], uvs[i]), sub)
+            newton[i] = ks[i] == seed  # the face's own point nearest
             sub[np.arange(i.size), ks[i]] = d[i]
             lower[i] = sub
             sure[i] = True
         rows = warm[sure]
         c[rows], dist[rows], ent[rows], par[rows], bound[rows] = X[sure], d[sure], ks[sure], uvs[sure], lower[sure]
+        rows = warm[newton]
+        Jo[rows], So[rows], has[rows] = J[newton], S[newton], True
         return sure
 
     def _candidates(self, m, y, upper, lower, seed, bound):
         """The nearest of every entity's projection whose bounding box lies within `upper`, and
         of the seed (c, dist, entity, parameters: the local projection's point, entity -1 where
         there is none). Raises `bound` to each projection's distance (onto the untrimmed
-        surface, the edge's curve unclamped: lower bounds of the distance to the entity), and a
-        face's whose projection falls outside it to the least of its edges' bounds."""
+        surface, the edge's curve unclamped, a straight edge's clamped: lower bounds of the
+        distance to the entity), and a face's whose projection falls outside it to the least of
+        its edges' bounds."""
         npts = len(y)
         cand = lower <= upper[:, None]
         nent = len(self._ents)
@@ -445,10 +474,9 @@ class SurfaceTool:
         C[seeded, k], D[seeded, k], P[seeded, k] = seed[0][seeded], seed[1][seeded], seed[3][seeded]
         cand[seeded, k] = False
         unknown = np.zeros((npts, nent), dtype=bool)  # a trimmed face's projection, not checked yet
-        for k, (d, t) in enumerate(self._ents):
+        for k in np.flatnonzero(cand.any(axis=0)):
+            d, t = self._ents[k]
             idx = np.flatnonzero(cand[:, k])
-            if idx.size == 0:
-                continue
             b0, b1 = self._bounds[(d, t)]
             c, p = m.getClosestPoint(d, t, y[idx].ravel())
             c = np.asarray(c).reshape(-1, 3)
@@ -460,6 +488,8 @@ class SurfaceTool:
                 if moved.any():
                     c[moved] = np.asarray(m.getValue(1, t, q[moved])).reshape(-1, 3)
                 P[idx, k, 0] = q
+                if (d, t) in self._flat:  # a segment's nearest point: the line's, clamped
+                    bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
             else:
                 p = np.asarray(p, dtype=float).reshape(-1, 2)
                 P[idx, k] = p
@@ -547,7 +577,10 @@ class SurfaceTool:
         inside = np.einsum("pi,pi->p", uv - tree.data[i], normals[i]) > 0
         return inside, dist > margin
 
-    def _signed(self, gmsh, y, c, dist, ent, par):
+    def _signed(self, gmsh, y, c, dist, ent, par, J, has):
+        """Signed distances and normals (module docstring); on a face the normal X_u x X_v
+        turned by the face's orientation where its derivatives J are at hand (has), else
+        gmsh's."""
         m = gmsh.model
         n = np.zeros((len(y), 3))
         d = dist.copy()
@@ -555,7 +588,14 @@ class SurfaceTool:
             dim, t = self._ents[k]
             rows = np.flatnonzero(ent == k)
             if dim == 2:
-                nc = self.sign * np.asarray(m.getNormal(t, par[rows].ravel())).reshape(-1, 3)
+                nc = np.zeros((rows.size, 3))
+                at = has[rows]
+                if at.any():
+                    cross = np.cross(J[rows[at], 0], J[rows[at], 1])
+                    nc[at] = self._orient[t] * cross / np.linalg.norm(cross, axis=1)[:, None]
+                if not at.all():
+                    nc[~at] = np.asarray(m.getNormal(t, par[rows[~at]].ravel())).reshape(-1, 3)
+                nc *= self.sign
                 n[rows] = nc
                 d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], nc)
             else:
@@ -589,13 +629,17 @@ class SurfaceTool:
         """H = dn/dx (n, 3, 3) (module docstring): H0 (I + d H0)^-1 on a face, (I - n n^T -
         e e^T) / d beside a sharp edge."""
         x = np.asarray(x, dtype=float).reshape(-1, 3)
-        c, d, n, ent, par = self.closest(x, dz)
+        c, d, n, ent, par, J, S, has = self._closest(x, dz)
         H = np.zeros((len(x), 3, 3))
+        if has.any():  # the derivatives of the Newton that found the point
+            H[has] = self._hessian(J[has], S[has], n[has], d[has])
+        if has.all():
+            return H + 0.0
         with _Current(self.model) as gmsh:
             m = gmsh.model
-            for k in np.unique(ent):
+            for k in np.unique(ent[~has]):
                 dim, t = self._ents[k]
-                rows = np.flatnonzero(ent == k)
+                rows = np.flatnonzero((ent == k) & ~has)
                 if dim == 2:
                     H[rows] = self._face_hessian(m, t, par[rows], n[rows], d[rows])
                     continue
@@ -619,6 +663,11 @@ class SurfaceTool:
         """H0 (I + d H0)^-1 at the face's parameters uv, n the (turned) normals, d the distances."""
         J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)  # rows X_u, X_v
         S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)  # X_uu, X_vv, X_uv
+        return self._hessian(J, S, n, d)
+
+    @staticmethod
+    def _hessian(J, S, n, d):
+        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv)."""
         B = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
         B = np.stack([np.stack([B[:, 0], B[:, 2]], 1), np.stack([B[:, 2], B[:, 1]], 1)], 1)
         G = np.einsum("pai,pbi->pab", J, J)
