@@ -671,7 +671,12 @@ class SurfaceTool:
         B = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
         B = np.stack([np.stack([B[:, 0], B[:, 2]], 1), np.stack([B[:, 2], B[:, 1]], 1)], 1)
         G = np.einsum("pai,pbi->pab", J, J)
-        Gi = np.linalg.pinv(G)
+        det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] * G[:, 1, 0]
+        regular = det > 1e-12 * (G[:, 0, 0] + G[:, 1, 1]) ** 2
+        Gi = np.stack([np.stack([G[:, 1, 1], -G[:, 0, 1]], 1), np.stack([-G[:, 1, 0], G[:, 0, 0]], 1)], 1) \
+            / np.where(regular, det, 1.0)[:, None, None]
+        if not regular.all():  # a singular parametrisation (a pole): the pseudo-inverse
+            Gi[~regular] = np.linalg.pinv(G[~regular])
         A = np.einsum("pai,pab->pbi", J, Gi)  # G^-1 J^T as (p, 2, 3): rows the dual basis
         H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
         H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
