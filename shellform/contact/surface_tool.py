@@ -209,6 +209,7 @@ class SurfaceTool:
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
         self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
+        self._rectangles = []
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
@@ -230,6 +231,8 @@ class SurfaceTool:
                 J = np.asarray(m.getDerivative(2, t, uv.ravel())).reshape(-1, 2, 3)
                 normal = np.asarray(m.getNormal(t, uv.ravel())).reshape(-1, 3)
                 self._orient[t] = 1.0 if np.einsum("pi,pi->", np.cross(J[:, 0], J[:, 1]), normal) >= 0 else -1.0
+                if (d, t) in self._flat and self._filled[t]:
+                    self._rectangle(k, xyz, uv, J, b0, b1)
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
@@ -240,6 +243,26 @@ class SurfaceTool:
 
         self._tree = cKDTree(np.vstack(points))
         self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
+
+    def _rectangle(self, k, xyz, uv, J, b0, b1):
+        """Face k, a plane that fills its parameter rectangle, kept as a rectangle where its
+        parametrisation is X = O + u E_u + v E_v with E_u, E_v orthonormal (OCC's planes; checked at
+        its samples xyz, uv): its nearest point to y is X at the clamped (E . (y - O))."""
+        E = J[0]
+        if np.abs(E @ E.T - np.eye(2)).max() > 1e-12 or np.abs(J - E).max() > 1e-12:
+            return
+        O = xyz[0] - uv[0] @ E
+        if np.abs(O + uv @ E - xyz).max() > 1e-9 * self.size:
+            return
+        self._rectangles.append((k, O, E, b0, b1))
+
+    def _rectangle_distances(self, y):
+        """The faces kept as rectangles (their indices) and the points' distances to them."""
+        if not self._rectangles:
+            return np.zeros(0, dtype=int), np.zeros((len(y), 0))
+        k, O, E, b0, b1 = (np.array(v) for v in zip(*self._rectangles))
+        uv = np.clip(np.einsum("pfi,fai->pfa", y[:, None] - O[None], E), b0[None], b1[None])
+        return k, np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2)
 
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
@@ -416,7 +439,8 @@ class SurfaceTool:
         delta), on a face there: Newton on that face from its parameters (_newton). A point
         that converges inside the face is sure where no other entity may lie nearer: the
         distance to an entity is at least its remembered lower bound less delta (the distance
-        is 1-Lipschitz; less 1e-9 of the tool's size, so that a tie goes to the candidates). Where another entity may lie nearer, the point's candidates
+        is 1-Lipschitz; less 1e-9 of the tool's size, so that a tie goes to the candidates), and
+        a rectangle's (a plane that fills its parameter rectangle) its distance. Where another entity may lie nearer, the point's candidates
         are the entities whose bounds allow it (_candidates, the face's point the seed). Fills
         `out` (c, dist, ent, par, bound, J, S, has) at the points found; returns which of `warm`
         were found (those whose Newton did not converge inside their face are left to the
@@ -433,6 +457,8 @@ class SurfaceTool:
             uvs[sel] = uv
             d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
         lower = last.bound[ref] - delta[:, None]
+        k, exact = self._rectangle_distances(y[warm])  # the rectangles' distances, not bounds
+        lower[:, k] = np.maximum(lower[:, k], exact)
         known = np.zeros_like(lower, dtype=bool)
         for k in np.unique(ks):
             sel = np.flatnonzero((ks == k) & ok)
