@@ -26,6 +26,21 @@ c is found in two steps:
 
 A second, non-global minimum of the distance inside one face is not found.
 
+Every point also gets lower bounds of its distance to every face and edge (the bounding
+boxes', raised by the projections computed on the way). The tool remembers its last call's
+points with their closest points, the face's derivatives there and these bounds
+(_Projections). A point given again takes its last answer (shape on the points of the last
+gap call: H from the derivatives Newton ended with); a point at distance delta from the
+nearest remembered one whose closest point lay on a face
+
+    warm        Newton on that face from the remembered (u, v); a point it finds inside the
+                face is sure where every other entity's bound less delta (the distance is
+                1-Lipschitz) lies farther (a plane that fills its parameter rectangle: its exact
+                distance); where not, the candidates are the entities whose bounds allow them
+                nearer, the face's point the seed.
+
+The other points are searched as above.
+
 Signed distance and normal. The faces' normals (getNormal, oriented by OCC's face orientation:
 outward for the faces of a solid) point to the side of the sheet; ``normals = "inward"`` turns
 them all. With the closest point c on a face of normal n_c at c, the signed distance is
@@ -440,11 +455,11 @@ class SurfaceTool:
         that converges inside the face is sure where no other entity may lie nearer: the
         distance to an entity is at least its remembered lower bound less delta (the distance
         is 1-Lipschitz; less 1e-9 of the tool's size, so that a tie goes to the candidates), and
-        a rectangle's (a plane that fills its parameter rectangle) its distance. Where another entity may lie nearer, the point's candidates
-        are the entities whose bounds allow it (_candidates, the face's point the seed). Fills
-        `out` (c, dist, ent, par, bound, J, S, has) at the points found; returns which of `warm`
-        were found (those whose Newton did not converge inside their face are left to the
-        search)."""
+        a rectangle's (a plane that fills its parameter rectangle) its distance. Where another
+        entity may lie nearer, the point's candidates are the entities whose bounds allow it
+        (_candidates, the face's point the seed). Fills `out` (c, dist, ent, par, bound, J, S,
+        has) at the points found; returns which of `warm` were found (those whose Newton did
+        not converge inside their face are left to the search)."""
         c, dist, ent, par, bound, Jo, So, has = out
         ks = last.ent[ref]
         uvs = last.par[ref].copy()
