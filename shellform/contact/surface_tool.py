@@ -224,7 +224,7 @@ class SurfaceTool:
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
         self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
-        self._rectangles = []
+        self._rectangles, self._cylinders = [], []
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
@@ -248,6 +248,8 @@ class SurfaceTool:
                 self._orient[t] = 1.0 if np.einsum("pi,pi->", np.cross(J[:, 0], J[:, 1]), normal) >= 0 else -1.0
                 if (d, t) in self._flat and self._filled[t]:
                     self._rectangle(k, xyz, uv, J, b0, b1)
+                elif m.getType(d, t) == "Cylinder" and self._filled[t]:
+                    self._cylinder(m, k, t, xyz, uv, b0, b1)
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
@@ -271,13 +273,49 @@ class SurfaceTool:
             return
         self._rectangles.append((k, O, E, b0, b1))
 
+    def _cylinder(self, m, k, f, xyz, uv, b0, b1):
+        """Face k (tag f), a cylinder that fills its parameter rectangle, kept where its
+        parametrisation is X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's
+        cylinders; E and R from the derivatives at (0, 0), checked at its samples xyz, uv): the
+        patch is an arc times a segment, its nearest point to y the arc's nearest to y's
+        projection onto the axis' plane and the segment's nearest to y's height."""
+        J = np.asarray(m.getDerivative(2, f, [0.0, 0.0])).reshape(2, 3)
+        S = np.asarray(m.getSecondDerivative(2, f, [0.0, 0.0])).reshape(3, 3)
+        R = float(np.linalg.norm(S[0]))
+        if not R > 1e-9 * self.size or b1[0] - b0[0] > 2 * np.pi + 1e-12:
+            return
+        E = np.array([-S[0] / R, J[0] / R, J[1]])
+        if np.abs(E @ E.T - np.eye(3)).max() > 1e-12:
+            return
+        O = np.asarray(m.getValue(2, f, [0.0, 0.0])) - R * E[0]
+        X = O + R * (np.cos(uv[:, :1]) * E[0] + np.sin(uv[:, :1]) * E[1]) + uv[:, 1:] * E[2]
+        if np.abs(X - xyz).max() > 1e-9 * self.size:
+            return
+        self._cylinders.append((k, O, E, R, b0, b1))
+
     def _rectangle_distances(self, y):
-        """The faces kept as rectangles (their indices) and the points' distances to them."""
-        if not self._rectangles:
-            return np.zeros(0, dtype=int), np.zeros((len(y), 0))
-        k, O, E, b0, b1 = (np.array(v) for v in zip(*self._rectangles))
-        uv = np.clip(np.einsum("pfi,fai->pfa", y[:, None] - O[None], E), b0[None], b1[None])
-        return k, np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2)
+        """The faces kept as rectangles or cylinders (their indices) and the points' distances
+        to them."""
+        ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
+        if self._rectangles:
+            k, O, E, b0, b1 = (np.array(v) for v in zip(*self._rectangles))
+            uv = np.clip(np.einsum("pfi,fai->pfa", y[:, None] - O[None], E), b0[None], b1[None])
+            ks.append(k)
+            ds.append(np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2))
+        if self._cylinders:
+            k, O, E, R, b0, b1 = (np.array(v) for v in zip(*self._cylinders))
+            q = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)  # (x, y, z) in each cylinder's frame
+            phi = np.arctan2(q[..., 1], q[..., 0])
+            span = b1[None, :, 0] - b0[None, :, 0]
+            after = np.mod(phi - b0[None, :, 0], 2 * np.pi)  # the angle past the arc's start
+            u = np.where(after <= span, b0[None, :, 0] + after,  # on the arc, else its nearer end
+                         np.where(after - span < 2 * np.pi - after, b1[None, :, 0], b0[None, :, 0]))
+            rho = np.hypot(q[..., 0], q[..., 1])
+            plane = np.hypot(rho * np.cos(phi) - R * np.cos(u), rho * np.sin(phi) - R * np.sin(u))
+            height = q[..., 2] - np.clip(q[..., 2], b0[None, :, 1], b1[None, :, 1])
+            ks.append(k)
+            ds.append(np.hypot(plane, height))
+        return np.concatenate(ks), np.hstack(ds)
 
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
@@ -455,7 +493,8 @@ class SurfaceTool:
         that converges inside the face is sure where no other entity may lie nearer: the
         distance to an entity is at least its remembered lower bound less delta (the distance
         is 1-Lipschitz; less 1e-9 of the tool's size, so that a tie goes to the candidates), and
-        a rectangle's (a plane that fills its parameter rectangle) its distance. Where another
+        a rectangle's or a cylinder's (a plane or a cylinder that fills its parameter rectangle)
+        its distance (_rectangle_distances). Where another
         entity may lie nearer, the point's candidates are the entities whose bounds allow it
         (_candidates, the face's point the seed). Fills `out` (c, dist, ent, par, bound, J, S,
         has) at the points found; returns which of `warm` were found (those whose Newton did
@@ -472,14 +511,18 @@ class SurfaceTool:
             uvs[sel] = uv
             d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
         lower = last.bound[ref] - delta[:, None]
-        k, exact = self._rectangle_distances(y[warm])  # the rectangles' distances, not bounds
-        lower[:, k] = np.maximum(lower[:, k], exact)
         known = np.zeros_like(lower, dtype=bool)
         for k in np.unique(ks):
             sel = np.flatnonzero((ks == k) & ok)
             self._settle(known, lower, sel, k, d[sel])
         others = np.where(known, np.inf, lower - 1e-9 * self.size).min(axis=1)
         sure = ok & (d <= others)
+        i = np.flatnonzero(ok & ~sure)
+        if i.size:  # the rectangles' and cylinders' distances
+            k, exact = self._rectangle_distances(y[warm[i]])
+            lower[np.ix_(i, k)] = np.maximum(lower[np.ix_(i, k)], exact)
+            others = np.where(known[i], np.inf, lower[i] - 1e-9 * self.size).min(axis=1)
+            sure[i] = d[i] <= others
         newton = sure.copy()
         i = np.flatnonzero(ok & ~sure)
         if i.size:  # another entity may lie nearer: the candidates among those whose bounds allow it
