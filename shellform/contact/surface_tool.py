@@ -35,9 +35,9 @@ nearest remembered one whose closest point lay on a face
 
     warm        Newton on that face from the remembered (u, v); a point it finds inside the
                 face is sure where every other entity's bound less delta (the distance is
-                1-Lipschitz) lies farther (a plane that fills its parameter rectangle: its exact
-                distance); where not, the candidates are the entities whose bounds allow them
-                nearer, the face's point the seed.
+                1-Lipschitz) lies farther (a plane or a cylinder that fills its parameter
+                rectangle: its exact distance); where not, the candidates are the entities whose
+                bounds allow them nearer, the face's point the seed.
 
 The other points are searched as above.
 
