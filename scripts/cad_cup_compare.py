@@ -5,7 +5,9 @@
 
 demos/numisheet93_aluminium.toml and demos/numisheet93_aluminium_cad.toml with mesh.n = N, each
 drawn STROKE mm: increments, iterations, punch force, draw-in, peak thickness strain, the run's
-wall time and the driver's split of it (times; parts_s: the parts' share, the tools' included).
+wall time and the driver's split of it (times; parts_s: the parts' share, the tools' included);
+for the STEP tools, how many points each answered again, by a warm start and by a search
+(SurfaceTool.counts).
 """
 
 import sys
@@ -29,3 +31,6 @@ for name in ("numisheet93_aluminium", "numisheet93_aluminium_cad"):
     print(f"{name}: increments {len(h)}, iterations {sum(x.iterations for x in h)}, force {p.punch_force():.6g} N, "
           f"DX {d['DX']:.10g}, DD {d['DD']:.10g}, thinning {peak_thinning(p)['max_thickness_strain']:.8g}, "
           f"run {run:.2f} s ({times})", flush=True)
+    for tool_name, (tool, _, _) in p.tool_placements().items():
+        if hasattr(tool, "counts"):
+            print(f"  {tool_name}: points " + ", ".join(f"{k} {v}" for k, v in tool.counts.items()), flush=True)

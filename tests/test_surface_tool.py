@@ -94,6 +94,55 @@ def test_gap_normal_shape_match_the_analytic_tools(cad, name, regions, dz):
         assert np.abs(np.einsum("pij,pj->pi", H1, n1)).max() < 1e-9  # H n = 0
 
 
+@pytest.mark.parametrize("name, regions, travel", [("punch", PUNCH_REGIONS, -0.2), ("die", DIE_REGIONS, 0.0)])
+def test_moved_points_start_from_their_last_closest_points(cad, name, regions, travel):
+    """The contact set's calls: the points of the last call moved a little (0.05 mm each way,
+    the punch 0.2 mm down a call), then given again (shape after gap). The moved points start
+    from their last closest points (nearly all: counts), the points given again take their last
+    answer; every answer the analytic tool's within the accuracy asked, and the last call's
+    those of a new tool that searches every point, to round-off."""
+    analytic, tool = ANALYTIC[name], cad[name]
+    x = np.vstack([_near(analytic, _box(lo, hi, 120), 0.0) for lo, hi in regions.values()])
+    tool.gap(x, 0.4, 0.0)
+    for step in range(1, 4):
+        x = x + RNG.normal(0.0, 0.05, x.shape)
+        dz = step * travel
+        before = dict(tool.counts)
+        g1, n1 = tool.gap(x, 0.4, dz)
+        H1 = tool.shape(x, 0.4, dz)
+        assert tool.counts["warm"] - before["warm"] >= 0.9 * len(x)
+        assert tool.counts["repeated"] - before["repeated"] == len(x)
+        g0, n0 = analytic.gap(x, 0.4, dz)
+        H0 = analytic.shape(x, 0.4, dz)
+        assert np.abs(g1 - g0).max() < GAP and np.abs(n1 - n0).max() < NORMAL
+        assert np.abs(H1 - H0).max() < CURVATURE * max(np.abs(H0).max(), 1.0 / 8.0)
+    fresh = SurfaceTool.from_file(cad["folder"] / f"{name}.step", tool.translation)
+    g2, n2 = fresh.gap(x, 0.4, dz)
+    assert fresh.counts == {"repeated": 0, "warm": 0, "searched": len(x)}
+    assert np.abs(g2 - g1).max() < 1e-10 and np.abs(n2 - n1).max() < 1e-10
+    assert np.abs(fresh.shape(x, 0.4, dz) - H1).max() < 1e-9
+
+
+@pytest.mark.parametrize("x0, spread, z", [
+    ((0.012, 0.012), 0.004, (-30.0, -15.0)),  # in the opening: the walls x = +-37 (planes), 0.024 mm apart
+    ((0.012, 0.012), 0.004, (3.0, 6.0)),  # above it: the shoulders along x = +-37 (cylinders), 0.02 mm apart
+])
+def test_a_moved_point_whose_nearest_face_jumps_is_found(cad, x0, spread, z):
+    """Points beside the die's middle plane x = 0, nearer its side x = 37 than the sides y =
+    +-37, moved to the other side of that plane: the nearest face jumps to the side x = -37
+    across the opening (a face that does not meet the last one). The warm start's bounds refuse
+    the last face; the answers are the analytic tool's."""
+    analytic, tool = ANALYTIC["die"], cad["die"]
+    x = np.c_[RNG.uniform(*x0, 100), RNG.uniform(-spread, spread, 100), RNG.uniform(*z, 100)]
+    normals = []
+    for y in (x, x * [-1.0, 1.0, 1.0]):
+        g1, n1 = tool.gap(y, 0.4)
+        g0, n0 = analytic.gap(y, 0.4)
+        assert np.abs(g1 - g0).max() < GAP and np.abs(n1 - n0).max() < NORMAL
+        normals.append(n1)
+    assert np.all(normals[0][:, 0] < -0.2) and np.all(normals[1][:, 0] > 0.2)  # the face across
+
+
 def _one_sided(tool, x, step, dz=0.0):
     """H just beside x on both sides of a seam (x -/+ step)."""
     return tool.shape(x - step, 0.0, dz), tool.shape(x + step, 0.0, dz)

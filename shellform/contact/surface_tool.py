@@ -26,6 +26,21 @@ c is found in two steps:
 
 A second, non-global minimum of the distance inside one face is not found.
 
+Every point also gets lower bounds of its distance to every face and edge (the bounding
+boxes', raised by the projections computed on the way). The tool remembers its last call's
+points with their closest points, the face's derivatives there and these bounds
+(_Projections). A point given again takes its last answer (shape on the points of the last
+gap call: H from the derivatives Newton ended with); a point at distance delta from the
+nearest remembered one whose closest point lay on a face
+
+    warm        Newton on that face from the remembered (u, v); a point it finds inside the
+                face is sure where every other entity's bound less delta (the distance is
+                1-Lipschitz) lies farther (a plane or a cylinder that fills its parameter
+                rectangle: its exact distance); where not, the candidates are the entities whose
+                bounds allow them nearer, the face's point the seed.
+
+The other points are searched as above.
+
 Signed distance and normal. The faces' normals (getNormal, oriented by OCC's face orientation:
 outward for the faces of a solid) point to the side of the sheet; ``normals = "inward"`` turns
 them all. With the closest point c on a face of normal n_c at c, the signed distance is
@@ -106,6 +121,27 @@ class _Current:
             gmsh.model.setCurrent(self.previous)
 
 
+class _Projections:
+    """Points y (in a tool's model frame) with their closest points c, distances dist, signed
+    distances d, normals n, entities (indices into the tool's entities) and parameters, lower
+    bounds of their distances to every entity (points, entities), and where the closest point
+    was found by Newton on a face (has), the face's derivatives there (J: X_u, X_v; S: X_uu,
+    X_vv, X_uv)."""
+
+    def __init__(self, y, c, dist, d, n, ent, par, bound, J, S, has):
+        from scipy.spatial import cKDTree
+
+        self.y, self.c, self.dist, self.d, self.n, self.ent, self.par, self.bound = y, c, dist, d, n, ent, par, bound
+        self.J, self.S, self.has = J, S, has
+        self.tree = cKDTree(y)
+
+    def nearest(self, y):
+        """The nearest remembered point of each of y (its index) and the distance to it (0
+        exactly where the point is given again)."""
+        delta, ref = self.tree.query(y)
+        return ref, delta
+
+
 class SurfaceTool:
     """A rigid tool: the faces of the OCC model `model` (a gmsh model's name), placed by
     `translation` (mm), its faces' normals pointing to the sheet (`normals` "outward") or away
@@ -126,6 +162,8 @@ class SurfaceTool:
             self._face_adjacent = {e: sorted(set(int(f) for f in gmsh.model.getAdjacencies(1, e)[0]))
                                    for e in self.edges}
             self._setup(gmsh)
+            self._last = None  # the last call's points and their closest points (_Projections)
+            self.counts = {"repeated": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
             self._index = {de: k for k, de in enumerate(self._ents)}
             self._is_face = np.array([d == 2 for d, _ in self._ents])
             self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
@@ -185,12 +223,15 @@ class SurfaceTool:
         lo, hi = self._box[:, 0].min(axis=0), self._box[:, 1].max(axis=0)
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
-        self._bounds, self._filled, self._trims = {}, {}, {}
+        self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
+        self._rectangles, self._cylinders = [], []
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
             b0, b1 = (np.asarray(v, dtype=float) for v in m.getParametrizationBounds(d, t))
             self._bounds[(d, t)] = (b0, b1)
+            if m.getType(d, t) in ("Plane", "Line"):
+                self._flat.add((d, t))
             if d == 2:
                 u, v = np.meshgrid(b0[0] + s * (b1[0] - b0[0]), b0[1] + s * (b1[1] - b0[1]))
                 uv = np.c_[u.ravel(), v.ravel()]
@@ -202,6 +243,13 @@ class SurfaceTool:
                 if uv.size == 0:
                     continue
                 xyz = np.asarray(m.getValue(2, t, uv.ravel())).reshape(-1, 3)
+                J = np.asarray(m.getDerivative(2, t, uv.ravel())).reshape(-1, 2, 3)
+                normal = np.asarray(m.getNormal(t, uv.ravel())).reshape(-1, 3)
+                self._orient[t] = 1.0 if np.einsum("pi,pi->", np.cross(J[:, 0], J[:, 1]), normal) >= 0 else -1.0
+                if (d, t) in self._flat and self._filled[t]:
+                    self._rectangle(k, xyz, uv, J, b0, b1)
+                elif m.getType(d, t) == "Cylinder" and self._filled[t]:
+                    self._cylinder(m, k, t, xyz, uv, b0, b1)
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
@@ -213,43 +261,195 @@ class SurfaceTool:
         self._tree = cKDTree(np.vstack(points))
         self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
 
+    def _rectangle(self, k, xyz, uv, J, b0, b1):
+        """Face k, a plane that fills its parameter rectangle, kept as a rectangle where its
+        parametrisation is X = O + u E_u + v E_v with E_u, E_v orthonormal (OCC's planes; checked at
+        its samples xyz, uv): its nearest point to y is X at the clamped (E . (y - O))."""
+        E = J[0]
+        if np.abs(E @ E.T - np.eye(2)).max() > 1e-12 or np.abs(J - E).max() > 1e-12:
+            return
+        O = xyz[0] - uv[0] @ E
+        if np.abs(O + uv @ E - xyz).max() > 1e-9 * self.size:
+            return
+        self._rectangles.append((k, O, E, b0, b1))
+
+    def _cylinder(self, m, k, f, xyz, uv, b0, b1):
+        """Face k (tag f), a cylinder that fills its parameter rectangle, kept where its
+        parametrisation is X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's
+        cylinders; E and R from the derivatives at (0, 0), checked at its samples xyz, uv): the
+        patch is an arc times a segment, its nearest point to y the arc's nearest to y's
+        projection onto the axis' plane and the segment's nearest to y's height."""
+        J = np.asarray(m.getDerivative(2, f, [0.0, 0.0])).reshape(2, 3)
+        S = np.asarray(m.getSecondDerivative(2, f, [0.0, 0.0])).reshape(3, 3)
+        R = float(np.linalg.norm(S[0]))
+        if not R > 1e-9 * self.size or b1[0] - b0[0] > 2 * np.pi + 1e-12:
+            return
+        E = np.array([-S[0] / R, J[0] / R, J[1]])
+        if np.abs(E @ E.T - np.eye(3)).max() > 1e-12:
+            return
+        O = np.asarray(m.getValue(2, f, [0.0, 0.0])) - R * E[0]
+        X = O + R * (np.cos(uv[:, :1]) * E[0] + np.sin(uv[:, :1]) * E[1]) + uv[:, 1:] * E[2]
+        if np.abs(X - xyz).max() > 1e-9 * self.size:
+            return
+        self._cylinders.append((k, O, E, R, b0, b1))
+
+    def _rectangle_distances(self, y):
+        """The faces kept as rectangles or cylinders (their indices) and the points' distances
+        to them."""
+        ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
+        if self._rectangles:
+            k, O, E, b0, b1 = (np.array(v) for v in zip(*self._rectangles))
+            uv = np.clip(np.einsum("pfi,fai->pfa", y[:, None] - O[None], E), b0[None], b1[None])
+            ks.append(k)
+            ds.append(np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2))
+        if self._cylinders:
+            k, O, E, R, b0, b1 = (np.array(v) for v in zip(*self._cylinders))
+            q = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)  # (x, y, z) in each cylinder's frame
+            phi = np.arctan2(q[..., 1], q[..., 0])
+            span = b1[None, :, 0] - b0[None, :, 0]
+            after = np.mod(phi - b0[None, :, 0], 2 * np.pi)  # the angle past the arc's start
+            u = np.where(after <= span, b0[None, :, 0] + after,  # on the arc, else its nearer end
+                         np.where(after - span < 2 * np.pi - after, b1[None, :, 0], b0[None, :, 0]))
+            rho = np.hypot(q[..., 0], q[..., 1])
+            plane = np.hypot(rho * np.cos(phi) - R * np.cos(u), rho * np.sin(phi) - R * np.sin(u))
+            height = q[..., 2] - np.clip(q[..., 2], b0[None, :, 1], b1[None, :, 1])
+            ks.append(k)
+            ds.append(np.hypot(plane, height))
+        return np.concatenate(ks), np.hstack(ds)
+
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
         """For points x (n, 3): the closest surface points c (placed), the signed distances d,
         the normals n, and per point the entity (dim, tag) it lies on with its parametric
-        coordinates (a face: (u, v); an edge: (t, 0))."""
+        coordinates (a face: (u, v); an edge: (t, 0)).
+
+        The last call's points are remembered with their closest points (_Projections): a point
+        given again (in the model's frame: the same x and dz) takes its last answer; a point
+        near a remembered one starts from that one's face and parameters (_warm); the others
+        are searched (_search)."""
+        return self._closest(x, dz)[:5]
+
+    def _closest(self, x, dz):
+        """closest's answers, and where the closest point was found by Newton on a face (has)
+        the face's derivatives there (J, S: _Projections)."""
         x = np.asarray(x, dtype=float).reshape(-1, 3)
         shift = self.translation + np.array([0.0, 0.0, dz])
         y = x - shift  # in the model's frame
+        npts = len(y)
+        c, dist, ent, par = np.zeros_like(y), np.full(npts, np.inf), np.full(npts, -1), np.zeros((npts, 2))
+        d, n, bound = np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, len(self._ents)))
+        J, S, has = np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3)), np.zeros(npts, dtype=bool)
+        last, todo = self._last if npts else None, np.ones(npts, dtype=bool)
+        if last is not None:
+            ref, delta = last.nearest(y)
+            same = np.flatnonzero(delta == 0.0)
+            r = ref[same]
+            c[same], dist[same], ent[same], par[same] = last.c[r], last.dist[r], last.ent[r], last.par[r]
+            d[same], n[same], bound[same] = last.d[r], last.n[r], last.bound[r]
+            J[same], S[same], has[same] = last.J[r], last.S[r], last.has[r]
+            todo[same] = False
+            self.counts["repeated"] += same.size
+            if same.size == npts:  # every point given again: the remembered points stay
+                return c + shift, d, n, ent, par, J, S, has
         with _Current(self.model) as gmsh:
-            c, dist, ent, par = self._nearest(gmsh, y)
-            d, n = self._signed(gmsh, y, c, dist, ent, par)
-        return c + shift, d, n, ent, par
+            m = gmsh.model
+            new = np.flatnonzero(todo)
+            if last is not None:
+                warm = np.flatnonzero(todo & self._is_face[np.maximum(last.ent[ref], 0)] & (last.ent[ref] >= 0))
+                if warm.size:
+                    sure = self._warm(m, y, warm, last, ref[warm], delta[warm], (c, dist, ent, par, bound, J, S, has))
+                    todo[warm[sure]] = False
+                    self.counts["warm"] += int(sure.sum())
+            rest = np.flatnonzero(todo)
+            self.counts["searched"] += rest.size
+            if rest.size:
+                c[rest], dist[rest], ent[rest], par[rest], bound[rest] = self._search(m, y[rest])
+            d[new], n[new] = self._signed(gmsh, y[new], c[new], dist[new], ent[new], par[new], J[new], has[new])
+        if npts:
+            self._last = _Projections(y, c, dist, d, n, ent, par, bound, J, S, has)
+        return c + shift, d.copy(), n.copy(), ent.copy(), par.copy(), J, S, has
 
-    def _nearest(self, gmsh, y):
+    def _lower(self, y):
+        """The distance of points y to every entity's bounding box (points, entities): a lower
+        bound of their distance to the entity."""
+        return np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
+                              + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)
+
+    def _search(self, m, y):
         """Closest points: first the local projection from the nearest sample (_local), where
-        it is sure; the other points by the candidates' projections (_candidates)."""
+        it is sure; the other points by the candidates' projections (_candidates). Also returns
+        lower bounds of every point's distance to every entity (points, entities): the bounding
+        boxes', raised to a face's projection distance onto its untrimmed surface (an edge's onto
+        its curve) where one was computed, and to the distance found on its face (and its
+        edges) where the local projection converged inside it."""
         upper, sample = self._tree.query(y)
         upper = upper * (1 + 1e-9) + 1e-9 * self.size
-        lower = np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
-                               + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)  # (points, entities)
+        lower = self._lower(y)  # (points, entities)
+        bound = lower.copy()
         c, dist, ent, par = np.zeros_like(y), np.full(len(y), np.inf), np.full(len(y), -1), np.zeros((len(y), 2))
-        done = self._local(gmsh.model, y, sample, lower, c, dist, ent, par)
+        done = self._local(m, y, sample, lower, c, dist, ent, par, bound)
         rest = np.flatnonzero(~done)
         if rest.size:  # a point found by the local projection bounds the distance and is a candidate
             seed = (c[rest], dist[rest], ent[rest], par[rest])
             upper = np.minimum(upper[rest], dist[rest] * (1 + 1e-9) + 1e-9 * self.size)
-            c[rest], dist[rest], ent[rest], par[rest] = self._candidates(gmsh.model, y[rest], upper, lower[rest], seed)
-        return c, dist, ent, par
+            sub = bound[rest]
+            c[rest], dist[rest], ent[rest], par[rest] = self._candidates(m, y[rest], upper, lower[rest], seed, sub)
+            bound[rest] = sub
+        r = np.flatnonzero(ent >= 0)
+        bound[r, ent[r]] = dist[r]
+        return c, dist, ent, par, bound
 
-    def _local(self, m, y, sample, lower, c, dist, ent, par):
+    def _newton(self, m, f, uv, y):
+        """Newton on face f from its parameters uv (modified in place) towards the points y:
+        min |X(u, v) - y|^2, the step -A^-1 g with g = J (X - y), A = J J^T + X_ij . (X - y),
+        at most LOCAL_ITERATIONS steps (on a plane one: X is affine in (u, v), the step exact),
+        until a step moves the point by less than 1e-13 of the tool's size. Returns the points
+        X(uv) (the last evaluation plus J step), where it converged inside the face (its
+        parametric bounds; a trimmed face's sampled boundary, sure of the side), and the
+        derivatives J, S of the last evaluation (a step before uv: within 1e-13 of the size)."""
+        ok = np.zeros(len(y), dtype=bool)
+        plane = (2, f) in self._flat
+        for _ in range(1 if plane else LOCAL_ITERATIONS):
+            X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+            J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
+            S = np.zeros((len(uv), 3, 3)) if plane else \
+                np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+            r = X - y
+            g = np.einsum("pai,pi->pa", J, r)
+            Sr = np.einsum("pki,pi->pk", S, r)
+            A = np.einsum("pai,pbi->pab", J, J)
+            A[:, 0, 0] += Sr[:, 0]
+            A[:, 1, 1] += Sr[:, 1]
+            A[:, 0, 1] += Sr[:, 2]
+            A[:, 1, 0] += Sr[:, 2]
+            det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+            good = (det > 0) & (A[:, 0, 0] > 0)
+            det = np.where(good, det, 1.0)
+            step = -np.stack([A[:, 1, 1] * g[:, 0] - A[:, 0, 1] * g[:, 1],
+                              A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
+            step[~good] = 0.0
+            uv += step
+            move = np.einsum("pai,pa->pi", J, step)
+            ok = good & (plane | (np.linalg.norm(move, axis=1) < 1e-13 * self.size))
+            if ok.all():
+                break
+        X = X + move  # the last step's change: exact on a plane, within its square elsewhere
+        b0, b1 = self._bounds[(2, f)]
+        tol = 1e-9 * (b1 - b0 + 1.0)
+        ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
+        if not self._filled[f]:
+            inside, sure = self._in_trim(f, uv)
+            ok &= inside & sure
+        return X, ok, J, S
+
+    def _local(self, m, y, sample, lower, c, dist, ent, par, bound):
         """Newton on the face of each point's nearest sample (on both faces of a sample on an
-        edge), from the sample's parameters: min |X(u, v) - y|^2, the step -A^-1 g with g =
-        J (X - y), A = J J^T + X_ij . (X - y). Where it converges inside a face, that face and
-        its edges are known for the point (the nearest point of a face found inside it is nearer
-        than its edges); the nearest point found is sure (True) where no other entity's bounding
-        box lies nearer. Fills c, dist, ent, par with the nearest point found inside a face (sure
-        or not: a point of the surface, which bounds the distance)."""
+        edge), from the sample's parameters (_newton). Where it converges inside a face, that
+        face and its edges are known for the point (the nearest point of a face found inside it
+        is nearer than its edges: their bounds in `bound` are raised to it); the nearest point
+        found is sure (True) where no other entity's bounding box lies nearer. Fills c, dist,
+        ent, par with the nearest point found inside a face (sure or not: a point of the
+        surface, which bounds the distance)."""
         npts, nent = len(y), len(self._ents)
         k0 = self._sample_entity[sample]
         on_face = self._is_face[k0]
@@ -269,49 +469,84 @@ class SurfaceTool:
             sel = ks == k
             idx, uv = pts[sel], uvs[sel].copy()
             yk = y[idx]
-            ok = np.zeros(len(idx), dtype=bool)
-            for _ in range(LOCAL_ITERATIONS):
-                X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
-                J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)
-                S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
-                r = X - yk
-                g = np.einsum("pai,pi->pa", J, r)
-                Sr = np.einsum("pki,pi->pk", S, r)
-                A = np.einsum("pai,pbi->pab", J, J)
-                A[:, 0, 0] += Sr[:, 0]
-                A[:, 1, 1] += Sr[:, 1]
-                A[:, 0, 1] += Sr[:, 2]
-                A[:, 1, 0] += Sr[:, 2]
-                det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
-                good = (det > 0) & (A[:, 0, 0] > 0)
-                det = np.where(good, det, 1.0)
-                step = -np.stack([A[:, 1, 1] * g[:, 0] - A[:, 0, 1] * g[:, 1],
-                                  A[:, 0, 0] * g[:, 1] - A[:, 1, 0] * g[:, 0]], axis=1) / det[:, None]
-                step[~good] = 0.0
-                uv += step
-                ok = good & (np.linalg.norm(np.einsum("pai,pa->pi", J, step), axis=1) < 1e-13 * self.size)
-                if ok.all():
-                    break
-            b0, b1 = self._bounds[(2, f)]
-            tol = 1e-9 * (b1 - b0 + 1.0)
-            ok &= np.all((uv >= b0 - tol) & (uv <= b1 + tol), axis=1)
-            if not self._filled[f]:
-                inside, sure = self._in_trim(f, uv)
-                ok &= inside & sure
-            X = np.asarray(m.getValue(2, f, uv.ravel())).reshape(-1, 3)
+            X, ok, _, _ = self._newton(m, f, uv, yk)
             d = np.linalg.norm(yk - X, axis=1)
             better = ok & (d < dist[idx])
             rows = idx[better]
             c[rows], dist[rows], ent[rows], par[rows] = X[better], d[better], k, uv[better]
-            known[idx[ok], k] = True
-            known[np.ix_(idx[ok], self._face_edges[k])] = True
+            self._settle(known, bound, idx[ok], k, d[ok])
         others = np.where(known, np.inf, lower).min(axis=1)
         return (ent >= 0) & (dist <= others)
 
-    def _candidates(self, m, y, upper, lower, seed):
+    def _settle(self, known, bound, rows, k, d):
+        """Face k's nearest points of `rows` found inside it, at distances d: the face and its
+        edges known for them, their distances' lower bounds raised to d."""
+        known[rows, k] = True
+        bound[rows, k] = np.maximum(bound[rows, k], d)
+        edges = self._face_edges[k]
+        known[np.ix_(rows, edges)] = True
+        bound[np.ix_(rows, edges)] = np.maximum(bound[np.ix_(rows, edges)], d[:, None])
+
+    def _warm(self, m, y, warm, last, ref, delta, out):
+        """The points y[warm] near the remembered points ref of the last call (at distances
+        delta), on a face there: Newton on that face from its parameters (_newton). A point
+        that converges inside the face is sure where no other entity may lie nearer: the
+        distance to an entity is at least its remembered lower bound less delta (the distance
+        is 1-Lipschitz; less 1e-9 of the tool's size, so that a tie goes to the candidates), and
+        a rectangle's or a cylinder's (a plane or a cylinder that fills its parameter rectangle)
+        its distance (_rectangle_distances). Where another
+        entity may lie nearer, the point's candidates are the entities whose bounds allow it
+        (_candidates, the face's point the seed). Fills `out` (c, dist, ent, par, bound, J, S,
+        has) at the points found; returns which of `warm` were found (those whose Newton did
+        not converge inside their face are left to the search)."""
+        c, dist, ent, par, bound, Jo, So, has = out
+        ks = last.ent[ref]
+        uvs = last.par[ref].copy()
+        X, d, ok = np.zeros((warm.size, 3)), np.full(warm.size, np.inf), np.zeros(warm.size, dtype=bool)
+        J, S = np.zeros((warm.size, 2, 3)), np.zeros((warm.size, 3, 3))
+        for k in np.unique(ks):
+            sel = np.flatnonzero(ks == k)
+            uv = uvs[sel]
+            X[sel], ok[sel], J[sel], S[sel] = self._newton(m, self._ents[k][1], uv, y[warm[sel]])
+            uvs[sel] = uv
+            d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
+        lower = last.bound[ref] - delta[:, None]
+        known = np.zeros_like(lower, dtype=bool)
+        for k in np.unique(ks):
+            sel = np.flatnonzero((ks == k) & ok)
+            self._settle(known, lower, sel, k, d[sel])
+        others = np.where(known, np.inf, lower - 1e-9 * self.size).min(axis=1)
+        sure = ok & (d <= others)
+        i = np.flatnonzero(ok & ~sure)
+        if i.size:  # the rectangles' and cylinders' distances
+            k, exact = self._rectangle_distances(y[warm[i]])
+            lower[np.ix_(i, k)] = np.maximum(lower[np.ix_(i, k)], exact)
+            others = np.where(known[i], np.inf, lower[i] - 1e-9 * self.size).min(axis=1)
+            sure[i] = d[i] <= others
+        newton = sure.copy()
+        i = np.flatnonzero(ok & ~sure)
+        if i.size:  # another entity may lie nearer: the candidates among those whose bounds allow it
+            sub, seed = lower[i], ks[i].copy()
+            X[i], d[i], ks[i], uvs[i] = self._candidates(
+                m, y[warm[i]], d[i] * (1 + 1e-9) + 1e-9 * self.size, np.where(known[i], np.inf, sub),
+                (X[i], d[i], ks[i], uvs[i]), sub)
+            newton[i] = ks[i] == seed  # the face's own point nearest
+            sub[np.arange(i.size), ks[i]] = d[i]
+            lower[i] = sub
+            sure[i] = True
+        rows = warm[sure]
+        c[rows], dist[rows], ent[rows], par[rows], bound[rows] = X[sure], d[sure], ks[sure], uvs[sure], lower[sure]
+        rows = warm[newton]
+        Jo[rows], So[rows], has[rows] = J[newton], S[newton], True
+        return sure
+
+    def _candidates(self, m, y, upper, lower, seed, bound):
         """The nearest of every entity's projection whose bounding box lies within `upper`, and
         of the seed (c, dist, entity, parameters: the local projection's point, entity -1 where
-        there is none)."""
+        there is none). Raises `bound` to each projection's distance (onto the untrimmed
+        surface, the edge's curve unclamped, a straight edge's clamped: lower bounds of the
+        distance to the entity), and a face's whose projection falls outside it to the least of
+        its edges' bounds."""
         npts = len(y)
         cand = lower <= upper[:, None]
         nent = len(self._ents)
@@ -323,13 +558,13 @@ class SurfaceTool:
         C[seeded, k], D[seeded, k], P[seeded, k] = seed[0][seeded], seed[1][seeded], seed[3][seeded]
         cand[seeded, k] = False
         unknown = np.zeros((npts, nent), dtype=bool)  # a trimmed face's projection, not checked yet
-        for k, (d, t) in enumerate(self._ents):
+        for k in np.flatnonzero(cand.any(axis=0)):
+            d, t = self._ents[k]
             idx = np.flatnonzero(cand[:, k])
-            if idx.size == 0:
-                continue
             b0, b1 = self._bounds[(d, t)]
             c, p = m.getClosestPoint(d, t, y[idx].ravel())
             c = np.asarray(c).reshape(-1, 3)
+            bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
             if d == 1:
                 p = np.asarray(p, dtype=float)
                 q = np.clip(p, b0[0], b1[0])
@@ -337,6 +572,8 @@ class SurfaceTool:
                 if moved.any():
                     c[moved] = np.asarray(m.getValue(1, t, q[moved])).reshape(-1, 3)
                 P[idx, k, 0] = q
+                if (d, t) in self._flat:  # a segment's nearest point: the line's, clamped
+                    bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
             else:
                 p = np.asarray(p, dtype=float).reshape(-1, 2)
                 P[idx, k] = p
@@ -363,6 +600,12 @@ class SurfaceTool:
                 unknown[i, k] = False
                 if m.isInside(2, self._ents[k][1], P[i, k], True) <= 0:
                     D[i, k] = np.inf
+        # a face whose projection falls outside it is nearest on its boundary: at least its edges' bounds
+        outside = cand & ~np.isfinite(D) & ~unknown & self._is_face[None, :]
+        for k in np.flatnonzero(outside.any(axis=0)):
+            rows, edges = np.flatnonzero(outside[:, k]), self._face_edges[k]
+            if edges.size:
+                bound[rows, k] = np.maximum(bound[rows, k], bound[np.ix_(rows, edges)].min(axis=1))
         best = np.argmin(D, axis=1)
         r = np.arange(npts)
         return C[r, best], D[r, best], best, P[r, best]
@@ -418,7 +661,10 @@ class SurfaceTool:
         inside = np.einsum("pi,pi->p", uv - tree.data[i], normals[i]) > 0
         return inside, dist > margin
 
-    def _signed(self, gmsh, y, c, dist, ent, par):
+    def _signed(self, gmsh, y, c, dist, ent, par, J, has):
+        """Signed distances and normals (module docstring); on a face the normal X_u x X_v
+        turned by the face's orientation where its derivatives J are at hand (has), else
+        gmsh's."""
         m = gmsh.model
         n = np.zeros((len(y), 3))
         d = dist.copy()
@@ -426,7 +672,14 @@ class SurfaceTool:
             dim, t = self._ents[k]
             rows = np.flatnonzero(ent == k)
             if dim == 2:
-                nc = self.sign * np.asarray(m.getNormal(t, par[rows].ravel())).reshape(-1, 3)
+                nc = np.zeros((rows.size, 3))
+                at = has[rows]
+                if at.any():
+                    cross = np.cross(J[rows[at], 0], J[rows[at], 1])
+                    nc[at] = self._orient[t] * cross / np.linalg.norm(cross, axis=1)[:, None]
+                if not at.all():
+                    nc[~at] = np.asarray(m.getNormal(t, par[rows[~at]].ravel())).reshape(-1, 3)
+                nc *= self.sign
                 n[rows] = nc
                 d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], nc)
             else:
@@ -460,13 +713,17 @@ class SurfaceTool:
         """H = dn/dx (n, 3, 3) (module docstring): H0 (I + d H0)^-1 on a face, (I - n n^T -
         e e^T) / d beside a sharp edge."""
         x = np.asarray(x, dtype=float).reshape(-1, 3)
-        c, d, n, ent, par = self.closest(x, dz)
+        c, d, n, ent, par, J, S, has = self._closest(x, dz)
         H = np.zeros((len(x), 3, 3))
+        if has.any():  # the derivatives of the Newton that found the point
+            H[has] = self._hessian(J[has], S[has], n[has], d[has])
+        if has.all():
+            return H + 0.0
         with _Current(self.model) as gmsh:
             m = gmsh.model
-            for k in np.unique(ent):
+            for k in np.unique(ent[~has]):
                 dim, t = self._ents[k]
-                rows = np.flatnonzero(ent == k)
+                rows = np.flatnonzero((ent == k) & ~has)
                 if dim == 2:
                     H[rows] = self._face_hessian(m, t, par[rows], n[rows], d[rows])
                     continue
@@ -490,10 +747,20 @@ class SurfaceTool:
         """H0 (I + d H0)^-1 at the face's parameters uv, n the (turned) normals, d the distances."""
         J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)  # rows X_u, X_v
         S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)  # X_uu, X_vv, X_uv
+        return self._hessian(J, S, n, d)
+
+    @staticmethod
+    def _hessian(J, S, n, d):
+        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv)."""
         B = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
         B = np.stack([np.stack([B[:, 0], B[:, 2]], 1), np.stack([B[:, 2], B[:, 1]], 1)], 1)
         G = np.einsum("pai,pbi->pab", J, J)
-        Gi = np.linalg.pinv(G)
+        det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] * G[:, 1, 0]
+        regular = det > 1e-12 * (G[:, 0, 0] + G[:, 1, 1]) ** 2
+        Gi = np.stack([np.stack([G[:, 1, 1], -G[:, 0, 1]], 1), np.stack([-G[:, 1, 0], G[:, 0, 0]], 1)], 1) \
+            / np.where(regular, det, 1.0)[:, None, None]
+        if not regular.all():  # a singular parametrisation (a pole): the pseudo-inverse
+            Gi[~regular] = np.linalg.pinv(G[~regular])
         A = np.einsum("pai,pab->pbi", J, Gi)  # G^-1 J^T as (p, 2, 3): rows the dual basis
         H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
         H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
