@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from shellform import scene
-from shellform.contact.surface_tool import cad_cup_tools
+from shellform.contact.cad_tools import cad_cup_tools
 from shellform.contact.tools import square_cup_tools
 
 points = int(sys.argv[1]) if len(sys.argv) > 1 else 2000

@@ -15,7 +15,7 @@ from shellform import supports as named_supports
 from shellform.assembly.sheet_element import BS
 from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
-from shellform.contact.surface_tool import cad_cup_tools, check_start
+from shellform.contact.cad_tools import cad_cup_tools, check_start
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import blank
 from shellform.nonlinear.model import SheetModel

@@ -66,30 +66,24 @@ analytic tools take one side of a region boundary.
 
 gmsh runs in this process, initialised once per process (every MPI rank evaluates its own
 points); each tool is a gmsh model of its own, made current while it is evaluated. A file is
-read first by a child process (importing gmsh only, no MPI) stopped after READ_SECONDS (a file
+read first by a child process (cad_files.py: importing gmsh only, no MPI) stopped after READ_SECONDS (a file
 that stalls or crashes OCC's reader does not stall or crash the run), then imported here with
 gmsh.model.occ.importShapes, which reads the shapes only (gmsh's open/merge would also merge a
 FILE.opt script beside it).
 Lengths are in mm: OCC converts the file's unit to mm (Geometry.OCCTargetUnit).
 """
 
-import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 
+from shellform.contact.cad_files import probe
 from shellform.errors import InputError
 
-CAD_SUFFIXES = (".step", ".stp", ".STEP", ".STP", ".iges", ".igs", ".IGES", ".IGS", ".brep", ".BREP")
-MAX_CAD_BYTES = 200_000_000  # a tool's CAD file larger than this is refused
-READ_SECONDS = 60.0  # the longest the child may take to read a tool's file
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
 SAMPLES = 24  # points per parametric direction sampled on a face (per edge: along it) for the upper bounds
 BOUNDARY_SAMPLES = 400  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
 NORMALS = ("outward", "inward")
-_MARK = "shellform-cad-read: "
 
 
 def _gmsh():
@@ -765,107 +759,3 @@ class SurfaceTool:
         H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
         H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
         return H0 @ np.linalg.inv(np.eye(3) + d[:, None, None] * H0)
-
-
-def cad_cup_tools(spec, thickness: float) -> dict:
-    """Punch, die and blank holder of a scene's [tools] with shape = "cad" around a sheet of that
-    thickness whose mid-surface is z = 0: the punch and the die from their files, placed by
-    their translations; the holder the flat analytic one (tools.BlankHolder) with its face on
-    the sheet's upper surface over the plan outside the rounded square (holder_half_width,
-    holder_corner_radius): it pinches the flange onto the die's flat top, which check_start
-    asks to lie on the sheet's lower surface there."""
-    from shellform.contact.tools import BlankHolder
-
-    return dict(
-        punch=SurfaceTool.from_file(spec.punch_file, spec.punch_translation, spec.punch_normals, "tools.punch_file"),
-        die=SurfaceTool.from_file(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file"),
-        holder=BlankHolder(spec.holder_half_width, spec.holder_corner_radius, thickness / 2),
-    )
-
-
-def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
-    """The CAD tools around the blank at the start (x: its nodes, half: their half thicknesses,
-    every rank its own): InputError naming the field where
-
-    - a tool's faces' normals point away from the sheet: every node lies behind the tool's
-      surface (tools.punch_normals, tools.die_normals);
-    - a tool overlaps the blank: a node penetrates it by more than `tolerance`
-      (tools.punch_translation, tools.die_translation);
-    - the die's top under the holder is not flat on the sheet's lower surface: the holder pinches
-      the flange onto it (tools.die_translation where it lies off the sheet by more than
-      `tolerance`, tools.holder_half_width where its normal is not +z: the holder's plan reaches
-      over the die's shoulder)."""
-    from mpi4py import MPI
-
-    x = np.asarray(x, dtype=float).reshape(-1, 3)
-    for name in ("punch", "die"):
-        g, _ = tools[name].gap(x, half, 0.0)
-        highest = comm.allreduce(float(g.max(initial=-np.inf)), op=MPI.MAX)
-        deepest = comm.allreduce(float(g.min(initial=np.inf)), op=MPI.MIN)
-        if highest < -tolerance:
-            raise InputError(f"tools.{name}_normals", f"the {name}'s faces' normals point away from the sheet: "
-                             "every node of the blank lies behind its surface (turn them with "
-                             f"{name}_normals = 'inward', or 'outward' if that was set)")
-        if deepest < -tolerance:
-            raise InputError(f"tools.{name}_translation", f"the {name} overlaps the blank at the start: a node "
-                             f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
-    under = np.isfinite(tools["holder"].gap(x, 0.0, 0.0)[0])
-    g, n = tools["die"].gap(x[under], half[under] if np.ndim(half) else half, 0.0)
-    off = comm.allreduce(float(np.abs(g).max(initial=0.0)), op=MPI.MAX)
-    tilt = comm.allreduce(float(np.abs(n[:, 2] - 1.0).max(initial=0.0)), op=MPI.MAX)
-    if tilt > 1e-9:
-        raise InputError("tools.holder_half_width", "the holder reaches over a part of the die that is not its flat "
-                         "top (the die's normal there is not +z): the holder's inner edge must lie on the flat top")
-    if off > tolerance:
-        raise InputError("tools.die_translation", f"the die's flat top under the holder lies {off:.4g} mm off the "
-                         "sheet's lower surface z = -t/2: the holder pinches the flange onto it")
-
-
-def probe(path: Path, field: str) -> dict:
-    """Check a tool's CAD file before it is imported here: it exists, is a CAD file by its
-    name, is not too large, and a child process stopped after READ_SECONDS reads it and finds
-    faces in it. Returns the child's summary (faces, bounding box). InputError naming `field`."""
-    if not path.is_file():
-        raise InputError(field, f"no such file: {path}")
-    if path.suffix not in CAD_SUFFIXES:
-        raise InputError(field, f"{path.name} is not a CAD file: a tool's file must end in one of "
-                         f"{', '.join(CAD_SUFFIXES)}")
-    if path.stat().st_size > MAX_CAD_BYTES:
-        raise InputError(field, f"{path} is larger than {MAX_CAD_BYTES:,} bytes")
-    cmd = [sys.executable, "-P", "-c", _CHILD, str(path)]
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=READ_SECONDS, stdin=subprocess.DEVNULL)
-    except subprocess.TimeoutExpired:
-        raise InputError(field, f"gmsh did not finish reading {path} within {READ_SECONDS:g} s") from None
-    lines = [ln for ln in done.stdout.splitlines() if ln.startswith(_MARK)]
-    if not lines:
-        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
-        raise InputError(field, f"gmsh stopped while reading {path} (exit status {done.returncode}): {tail[0]}")
-    result = json.loads(lines[-1][len(_MARK):])
-    if "error" in result:
-        raise InputError(field, f"gmsh cannot read {path}: {result['error']}")
-    if result["faces"] == 0:
-        raise InputError(field, f"{path} holds no surface (a tool is the faces of a CAD model)")
-    return result
-
-
-# the child of probe: python -P -c _CHILD FILE. It imports gmsh only (not shellform, whose import
-# would start MPI in a child of an MPI rank) and prints one line, _MARK and JSON: the file's
-# faces and bounding box, or {"error": gmsh's message}.
-_CHILD = """
-import json, sys
-import gmsh
-gmsh.initialize(readConfigFiles=False, interruptible=False)
-gmsh.option.setNumber("General.Terminal", 0)
-gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
-gmsh.model.add("shellform_tool")
-try:
-    gmsh.model.occ.importShapes(sys.argv[1])
-    gmsh.model.occ.synchronize()
-    faces = gmsh.model.getEntities(2)
-    result = {"faces": len(faces), "box": list(gmsh.model.getBoundingBox(-1, -1)) if faces else [0.0] * 6}
-except Exception as exc:
-    result = {"error": str(exc)}
-gmsh.finalize()
-print("\\n" + MARK + json.dumps(result), flush=True)
-""".replace("MARK", repr(_MARK))

@@ -1,0 +1,62 @@
+"""The square cup's tools from a scene's [tools] with shape = "cad": the punch and the die as
+CAD surfaces (surface_tool.py), the blank holder the flat analytic one, and the checks of their
+placement around the blank at the start."""
+
+import numpy as np
+
+from shellform.contact.surface_tool import SurfaceTool
+from shellform.errors import InputError
+
+
+def cad_cup_tools(spec, thickness: float) -> dict:
+    """Punch, die and blank holder of a scene's [tools] with shape = "cad" around a sheet of that
+    thickness whose mid-surface is z = 0: the punch and the die from their files, placed by
+    their translations; the holder the flat analytic one (tools.BlankHolder) with its face on
+    the sheet's upper surface over the plan outside the rounded square (holder_half_width,
+    holder_corner_radius): it pinches the flange onto the die's flat top, which check_start
+    asks to lie on the sheet's lower surface there."""
+    from shellform.contact.tools import BlankHolder
+
+    return dict(
+        punch=SurfaceTool.from_file(spec.punch_file, spec.punch_translation, spec.punch_normals, "tools.punch_file"),
+        die=SurfaceTool.from_file(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file"),
+        holder=BlankHolder(spec.holder_half_width, spec.holder_corner_radius, thickness / 2),
+    )
+
+
+def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
+    """The CAD tools around the blank at the start (x: its nodes, half: their half thicknesses,
+    every rank its own): InputError naming the field where
+
+    - a tool's faces' normals point away from the sheet: every node lies behind the tool's
+      surface (tools.punch_normals, tools.die_normals);
+    - a tool overlaps the blank: a node penetrates it by more than `tolerance`
+      (tools.punch_translation, tools.die_translation);
+    - the die's top under the holder is not flat on the sheet's lower surface: the holder pinches
+      the flange onto it (tools.die_translation where it lies off the sheet by more than
+      `tolerance`, tools.holder_half_width where its normal is not +z: the holder's plan reaches
+      over the die's shoulder)."""
+    from mpi4py import MPI
+
+    x = np.asarray(x, dtype=float).reshape(-1, 3)
+    for name in ("punch", "die"):
+        g, _ = tools[name].gap(x, half, 0.0)
+        highest = comm.allreduce(float(g.max(initial=-np.inf)), op=MPI.MAX)
+        deepest = comm.allreduce(float(g.min(initial=np.inf)), op=MPI.MIN)
+        if highest < -tolerance:
+            raise InputError(f"tools.{name}_normals", f"the {name}'s faces' normals point away from the sheet: "
+                             "every node of the blank lies behind its surface (turn them with "
+                             f"{name}_normals = 'inward', or 'outward' if that was set)")
+        if deepest < -tolerance:
+            raise InputError(f"tools.{name}_translation", f"the {name} overlaps the blank at the start: a node "
+                             f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
+    under = np.isfinite(tools["holder"].gap(x, 0.0, 0.0)[0])
+    g, n = tools["die"].gap(x[under], half[under] if np.ndim(half) else half, 0.0)
+    off = comm.allreduce(float(np.abs(g).max(initial=0.0)), op=MPI.MAX)
+    tilt = comm.allreduce(float(np.abs(n[:, 2] - 1.0).max(initial=0.0)), op=MPI.MAX)
+    if tilt > 1e-9:
+        raise InputError("tools.holder_half_width", "the holder reaches over a part of the die that is not its flat "
+                         "top (the die's normal there is not +z): the holder's inner edge must lie on the flat top")
+    if off > tolerance:
+        raise InputError("tools.die_translation", f"the die's flat top under the holder lies {off:.4g} mm off the "
+                         "sheet's lower surface z = -t/2: the holder pinches the flange onto it")
