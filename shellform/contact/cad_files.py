@@ -3,12 +3,11 @@ file by its name, is not too large, and a child process (importing gmsh only, no
 after READ_SECONDS reads it and finds faces in it, so that a file that stalls or crashes OCC's
 reader does not stall or crash the run."""
 
-import json
-import subprocess
 import sys
 from pathlib import Path
 
 from shellform.errors import InputError
+from shellform.mesh.gmsh_file import read_in_child
 
 CAD_SUFFIXES = (".step", ".stp", ".STEP", ".STP", ".iges", ".igs", ".IGES", ".IGS", ".brep", ".BREP")
 MAX_CAD_BYTES = 200_000_000  # a tool's CAD file larger than this is refused
@@ -27,18 +26,7 @@ def probe(path: Path, field: str) -> dict:
                          f"{', '.join(CAD_SUFFIXES)}")
     if path.stat().st_size > MAX_CAD_BYTES:
         raise InputError(field, f"{path} is larger than {MAX_CAD_BYTES:,} bytes")
-    cmd = [sys.executable, "-P", "-c", _CHILD, str(path)]
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=READ_SECONDS, stdin=subprocess.DEVNULL)
-    except subprocess.TimeoutExpired:
-        raise InputError(field, f"gmsh did not finish reading {path} within {READ_SECONDS:g} s") from None
-    lines = [ln for ln in done.stdout.splitlines() if ln.startswith(_MARK)]
-    if not lines:
-        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
-        raise InputError(field, f"gmsh stopped while reading {path} (exit status {done.returncode}): {tail[0]}")
-    result = json.loads(lines[-1][len(_MARK):])
-    if "error" in result:
-        raise InputError(field, f"gmsh cannot read {path}: {result['error']}")
+    result = read_in_child([sys.executable, "-P", "-c", _CHILD, str(path)], path, field, _MARK, READ_SECONDS)
     if result["faces"] == 0:
         raise InputError(field, f"{path} holds no surface (a tool is the faces of a CAD model)")
     return result

@@ -221,21 +221,30 @@ def read_file(path, options: dict) -> tuple[tuple[str, ...], int, tuple[float, f
     READ_SECONDS."""
     script = Path(__file__).with_name("gmsh_reader.py")
     cmd = [sys.executable, "-P", str(script), str(path), json.dumps(options)]  # -P: not the script's folder on sys.path
-    try:
-        done = subprocess.run(cmd, capture_output=True, text=True, timeout=READ_SECONDS, stdin=subprocess.DEVNULL)
-    except subprocess.TimeoutExpired:
-        raise InputError(FIELD, f"gmsh did not finish reading {path} within {READ_SECONDS:g} s "
-                         "(a long loop, or a mesh made in the file?)") from None
-    lines = [ln for ln in done.stdout.splitlines() if ln.startswith(_MARK)]
-    if not lines:
-        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
-        raise InputError(FIELD, f"gmsh stopped while reading {path} (exit status {done.returncode}): {tail[0]}")
-    result = json.loads(lines[-1][len(_MARK):])
-    if "error" in result:
-        raise InputError(FIELD, f"gmsh cannot read {path}: {result['error']}")
+    result = read_in_child(cmd, path, FIELD, _MARK, READ_SECONDS, "(a long loop, or a mesh made in the file?)")
     if result.get("empty"):
         raise InputError(FIELD, f"{path} holds no geometry and no mesh (an empty file?)")
     return tuple(result["groups"]), int(result["triangles"]), tuple(result["size"])
 
 
 _MARK = "shellform-gmsh-read: "
+
+
+def read_in_child(cmd: list, path, field: str, mark: str, seconds: float, slow: str = "") -> dict:
+    """Run `cmd`, a child process in which gmsh reads `path` and prints one line, `mark` and
+    JSON: its summary, or {"error": gmsh's message}. The child is stopped after `seconds`.
+    Returns the summary; InputError naming `field` where the child overran (`slow`: a likely
+    cause), stopped without its line, or gmsh could not read the file."""
+    try:
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=seconds, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise InputError(field, f"gmsh did not finish reading {path} within {seconds:g} s" + (f" {slow}" if slow else "")) \
+            from None
+    lines = [ln for ln in done.stdout.splitlines() if ln.startswith(mark)]
+    if not lines:
+        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
+        raise InputError(field, f"gmsh stopped while reading {path} (exit status {done.returncode}): {tail[0]}")
+    result = json.loads(lines[-1][len(mark):])
+    if "error" in result:
+        raise InputError(field, f"gmsh cannot read {path}: {result['error']}")
+    return result
