@@ -64,14 +64,13 @@ class ContactSet(Part):
         self.toggles = np.zeros(n, dtype=np.int32)
         self.known_tolerance = 1e-3 * controls.penetration  # |known corrections| at convergence
         self.early_step = self.EARLY_STEP
-        self.lam_n = self.lam = 0.0
+        self.lam_n = 0.0
         self.curvature = np.zeros((n, 2, 2))  # W of each node's tool in its tangent slots
         self.shift = np.zeros(n)  # z-travel of each node's tool in this increment
         self.slid_off = np.zeros(n, dtype=bool)  # nodes that slid off their tool's extent (this iterate)
         self.switched = np.zeros(n, dtype=bool)  # nodes that switched in the last update
         self.net = np.zeros(n)  # the net normal forces of the last refresh
         self.frozen = 0
-        self._step = np.inf
         self.residual = None  # the driver's residual with its reactions (bind)
         self.comm = None
         self.committed = None
@@ -154,7 +153,6 @@ class ContactSet(Part):
         c = self.committed
         self.tool, self.pressure = c["tool"].copy(), c["pressure"].copy()
         self.toggles = np.zeros_like(self.toggles)
-        self.lam = lam
 
     def constrain(self, c, lam: float) -> None:
         """Frames and known normal rows of the nodes on the tools, at the current iterate."""

@@ -85,12 +85,10 @@ class PinchingHolder(Part):
         self.under_now = np.zeros(n, dtype=bool)  # under the holder in this increment (pinch)
         self.face = np.zeros(n)  # the holder face's normal force on each node
         self.contact = self.friction = None
-        self.driver = None
         self._dlift, self._lift0 = 0.0, 0.0
         self.committed = None
 
     def bind(self, driver) -> None:
-        self.driver = driver
         V = driver.model.V
         self._unit, self._response = fem.Function(V), fem.Function(V)  # the unit lift and its response
 

@@ -59,6 +59,17 @@ def read_csv(path, field: str = FIELD, columns: str = "plastic strain, true stre
     return np.array(rows, dtype=np.float64).reshape(-1, 2)
 
 
+def two_columns(table, field: str, columns: str) -> tuple[np.ndarray, np.ndarray]:
+    """The two columns (copies) of a table of at least two finite rows; InputError naming
+    `field` where it is not one (`columns`: their names, for the message)."""
+    t = np.asarray(table, dtype=np.float64)
+    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 2:
+        raise InputError(field, f"needs at least two rows ({columns})")
+    if not np.all(np.isfinite(t)):
+        raise InputError(field, "holds a value that is not finite")
+    return t[:, 0].copy(), t[:, 1].copy()
+
+
 @dataclass(frozen=True)
 class FlowCurve:
     """A validated table and its fitted extrapolation; ``packed`` is what the numba code reads."""
@@ -70,12 +81,7 @@ class FlowCurve:
 
     @classmethod
     def from_table(cls, table, extrapolation: str) -> "FlowCurve":
-        t = np.asarray(table, dtype=np.float64)
-        if t.ndim != 2 or t.shape[1] != 2 or len(t) < 2:
-            raise InputError(FIELD, "needs at least two rows (plastic strain, true stress)")
-        if not np.all(np.isfinite(t)):
-            raise InputError(FIELD, "holds a value that is not finite")
-        p, s = t[:, 0].copy(), t[:, 1].copy()
+        p, s = two_columns(table, FIELD, "plastic strain, true stress")
         if p[0] != 0.0:
             raise InputError(FIELD, f"must start at plastic strain 0 (the initial yield stress), starts at {p[0]}")
         if s[0] <= 0.0:

@@ -52,12 +52,9 @@ def measured(rows):
     """The curve eps1(eps2) through the measured points (minor, major), linear between them and
     along the end segments beyond them; InputError naming material.forming_limit_curve where
     the points are no curve (fewer than two, minor not increasing, major not positive)."""
-    t = np.asarray(rows, dtype=np.float64)
-    if t.ndim != 2 or t.shape[1] != 2 or len(t) < 2:
-        raise InputError(FIELD, "needs at least two rows (minor true strain, major true strain)")
-    if not np.all(np.isfinite(t)):
-        raise InputError(FIELD, "holds a value that is not finite")
-    minor, major = t[:, 0].copy(), t[:, 1].copy()
+    from shellform.material.flow_curve import two_columns
+
+    minor, major = two_columns(rows, FIELD, "minor true strain, major true strain")
     bad = np.flatnonzero(np.diff(minor) <= 0.0)
     if bad.size:
         raise InputError(FIELD, f"the minor strain must increase: row {bad[0] + 2} ({minor[bad[0] + 1]}) follows "
