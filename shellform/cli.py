@@ -42,6 +42,7 @@ STUDIES = {
     "outlines": "circle and triangle plates, error against time",
     "locking": "membrane locking: thin roll-ups and a curved roof",
     "cup-convergence": "the aluminium and the square cup on a sequence of meshes: observed orders, Richardson estimates",
+    "pinch-edge": "the holder's edge load resolved below the thickness: a plane-strain strip",
 }
 
 SCENE_HELP = "the scene's TOML file (docs/scenes.md)"

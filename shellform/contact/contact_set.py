@@ -142,11 +142,13 @@ class ContactSet(Part):
         return self.pressure + (self.holder.face if self.holder is not None else 0.0)
 
     def dp_dnet(self) -> np.ndarray:
-        """d(face forces)/dR0 per node: 1 on a tool, sign(R0) on a pinched node (the closed
-        holder's share of F through sum max(-R0, 0) left out), 0 off the tools."""
-        pinched = self.holder.pinched if self.holder is not None else np.zeros(self.tool.size, dtype=bool)
+        """d(face forces)/dR0 per node: 1 on a tool where it presses, on a pinched node the
+        closed holder's (its face_slopes: F's spread held fixed), 0 off the tools."""
         on = self.tool != FREE
-        return np.where(on, np.where(pinched, np.sign(self.net), (self.net > 0).astype(float)), 0.0)
+        tool = (self.net > 0).astype(float)
+        if self.holder is not None:
+            tool = np.where(self.holder.pinched, self.holder.face_slopes(self.net), tool)
+        return np.where(on, tool, 0.0)
 
     # -- the part's protocol -------------------------------------------------------------------
     def start(self, lam: float, predicting: bool) -> None:

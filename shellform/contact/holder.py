@@ -3,13 +3,23 @@
 Between the rigid die and the rigid holder, a flange node is *pinched*: its normal position is
 known (it lies on the die) whatever the sign of its net normal force R0 (die minus holder).
 The shell carries no through-thickness strain, so the two faces' forces are known only through
-their difference R0 and the holder's total F; their split is a modelling choice, the *squeeze*
-s_i >= 0 with  sum_i (s_i + max(-R0_i, 0)) = F :
+their difference R0 and the holder's total F; their split is a modelling choice. The holder
+presses each pinched node with what holds it down plus a *squeeze* s_i >= 0:
 
-    die face     d_i = s_i + max(R0_i, 0)
-    holder face  h_i = s_i + max(-R0_i, 0)        sum_i h_i = F,  friction pressure d_i + h_i
+    off the edge's band   h_i = s_i + max(-R0_i, 0),   d_i = s_i + max(R0_i, 0)
+    on the edge's band    h_i = s_i + f e_i,           d_i = max(h_i + R0_i, 0)
+                          sum_i h_i = F,  friction pressure d_i + h_i
 
-The squeeze left to spread is S = F - sum_i max(-R0_i, 0). ``spread`` says how:
+The band is the pinched nodes that carry the couple turning the sheet from the flange onto the
+die's shoulder: e_i is their share of the edge load V_e per unit length of the holder's inner
+edge (pinch_edge.py: the couple over the sheet's own through-thickness compliance, the same total
+on every mesh), which replaces the discrete force the rigid pinch puts there (it grows as 1/h).
+With E_in the holding-down off the band and E_e = sum e_i, the holder carries the edge in full
+(f = 1) while E_in + E_e <= F; beyond, it *rides* on its edge: f = (F - E_in) / E_e and no squeeze
+is left. A holder riding on its edge is lifted by micrometres (the couple's arm grows to take
+less force: EdgeLoad.riding_lift), so the flange stays pinched while that lift is below the
+contact's tolerance (1 % of t); where it is not (a light holder), the holder opens. The squeeze left to spread is
+S = F - E_in - f E_e >= 0. ``spread`` says how:
 - "area" (default): s_i = S A_i / sum A (tributary areas), the uniform flange pressure of a
   holder whose own compliance and the sheet's absorb the flange's thickness differences. On a
   nodal mesh the rigid law below puts the whole force on 2 to 4 of the thickest nodes, which a
@@ -18,7 +28,10 @@ The squeeze left to spread is S = F - sum_i max(-R0_i, 0). ``spread`` says how:
 - "rigid": the rigid holder on the thickest rim: s_i = k_i max(top_i - Z, 0) with the
   through-thickness stiffness k_i = E A_i / t and Z fixed by sum s_i = S.
 
-The holder *opens* when the flange pushes it up harder than F holds it down (S < 0). Open, it
+The holder *opens* when the flange off the band pushes it up harder than F holds it down
+(E_in > F), or when the edge would lift it by more than the tolerance (f below the share that
+keeps riding_lift within it): both are criteria on forces per unit length and a physical lift,
+not on the mesh. Open, it
 is still a rigid tool: a face lifted by `lift` above its closed position, with one unknown
 (the lift z_H) and one equation (its nodal forces sum to F), solved with the sheet in each
 Newton iteration as a bordered system, one more solve with the same factors:
@@ -47,6 +60,7 @@ from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
 from shellform.contact.nodes import W_SLOPES
+from shellform.contact.pinch_edge import edge_weights
 from shellform.nonlinear.parts import Part
 from shellform.results.log import say
 from shellform.scene import SPREADS
@@ -69,10 +83,11 @@ class PinchingHolder(Part):
     """The holder (tool: a BlankHolder) with force F on the owned nodes under it (plan position
     over the die's flat top): a part. area: tributary areas of the owned nodes; stiffness: their
     E A / t (the "rigid" spread); nodes: the SheetNodes; friction: the CoulombFriction whose
-    slip forces depend on the lifted nodes' normal forces."""
+    slip forces depend on the lifted nodes' normal forces; edge: the pinch's EdgeLoad
+    (pinch_edge.py; None: no band, the rigid pinch's discrete couple)."""
 
     def __init__(self, tool, force: float, nodes, stiffness: np.ndarray, comm, spread: str = "area",
-                 thickness: float = 0.0, max_toggles: int = 2, trace: bool = False):
+                 thickness: float = 0.0, max_toggles: int = 2, trace: bool = False, edge=None):
         if spread not in SPREADS:
             raise ValueError(f"holder spread must be one of {SPREADS}, got {spread!r}")
         self.tool, self.force, self.comm, self.spread = tool, float(force), comm, spread
@@ -84,6 +99,9 @@ class PinchingHolder(Part):
         self.pinched_n = self.pinched.copy()  # of the last converged increment
         self.under_now = np.zeros(n, dtype=bool)  # under the holder in this increment (pinch)
         self.face = np.zeros(n)  # the holder face's normal force on each node
+        self.edge_law = edge
+        self.edge_load = edge.line_load if edge is not None else 0.0
+        self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.contact = self.friction = None
         self._dlift, self._lift0 = 0.0, 0.0
         self.committed = None
@@ -109,14 +127,56 @@ class PinchingHolder(Part):
     def _sum(self, v) -> float:
         return self.comm.allreduce(float(np.sum(v)), op=MPI.SUM)
 
-    def squeeze_left(self, pinched: np.ndarray, net: np.ndarray) -> float:
-        """S = F - sum over the pinched nodes of max(-R0, 0), all ranks (< 0: the holder lifts)."""
-        return self.force - self._sum(np.maximum(-net[pinched], 0.0))
+    def edge_shares(self, x: np.ndarray, pinched: np.ndarray) -> np.ndarray:
+        """e_i = V_e A_i j_i (2 / b) sin^2(pi s_i / b) on the pinched nodes at x within b = 2 h_i
+        of the holder's inner edge (s_i their plan distance from it, j_i the edge's length per
+        unit length of their offset line), 0 elsewhere (pinch_edge.py)."""
+        if self.edge_load <= 0.0:
+            return np.zeros(pinched.size)
+        s, j = self.tool.edge_offset(x)
+        w = edge_weights(s, self.nodes.cell_size)
+        return np.where(pinched, self.edge_load * self.area * j * w, 0.0)
 
-    def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray):
+    def demands(self, pinched: np.ndarray, net: np.ndarray, edge: np.ndarray) -> tuple[float, float]:
+        """(E_in, E_e), all ranks: the holding-down the pinched nodes off the edge's band need
+        (sum max(-R0, 0)) and the edge load on the band (sum e_i)."""
+        inner = pinched & (edge <= 0.0)
+        both = self.comm.allreduce(np.array([np.maximum(-net[inner], 0.0).sum(), edge.sum()]), op=MPI.SUM)
+        return float(both[0]), float(both[1])
+
+    def lifted(self, net: np.ndarray, edge: np.ndarray, tolerance: float) -> bool:
+        """The closed holder cannot hold the flange: its holding-down off the edge's band passes
+        F, or riding on its edge would lift it by more than `tolerance` (all ranks agree)."""
+        inner, total_edge = self.demands(self.pinched, net, edge)
+        if inner > self.force:
+            return True
+        share = 1.0 if total_edge <= self.force - inner else (self.force - inner) / total_edge
+        return self.edge_law is not None and share < 1.0 and self.edge_law.riding_lift(share) > tolerance
+
+    def may_ride(self, x: np.ndarray, under: np.ndarray, contact) -> bool:
+        """Whether the open holder, closed on the flange on the die under it, could carry at
+        least the share of its edge load that keeps riding within the contact's tolerance."""
+        if self.edge_law is None:
+            return True
+        total = self._sum(self.edge_shares(x, under & contact.on(contact.die)))
+        share = 1.0 if total <= self.force else self.force / total
+        return self.edge_law.riding_lift(share) <= contact.controls.penetration
+
+    def held_down(self, net: np.ndarray) -> tuple[float, float]:
+        """(E_in + f E_e, E_e) / F of the closed holder at its last split: the part of F that holds
+        the flange down against its own lift, and the edge load's demand (> 1: the holder rides
+        on its edge)."""
+        inner, edge = self.demands(self.pinched, net, self.edge)
+        return (inner + min(edge, max(self.force - inner, 0.0))) / self.force, edge / self.force
+
+    def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray):
         """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed
-        holder, from their net normal forces R0 and their tops z + t/2 (the "rigid" spread)."""
-        S = max(self.squeeze_left(pinched, net), 0.0)
+        holder, from their net normal forces R0, their tops z + t/2 (the "rigid" spread) and the
+        edge load's shares e_i (module docstring)."""
+        inner, total_edge = self.demands(pinched, net, edge)
+        left = max(self.force - inner, 0.0)
+        f = 1.0 if total_edge <= left else left / total_edge
+        S = left - f * total_edge
         s = np.zeros(net.size)
         if self.spread == "area":
             total = self._sum(self.area[pinched])
@@ -128,9 +188,15 @@ class PinchingHolder(Part):
             if all_tops.size:
                 Z = holder_height(all_tops, all_k, S)
                 s[pinched] = self.k[pinched] * np.maximum(tops[pinched] - Z, 0.0)
-        d = np.where(pinched, s + np.maximum(net, 0.0), 0.0)
-        h = np.where(pinched, s + np.maximum(-net, 0.0), 0.0)
+        band = edge > 0.0
+        h = np.where(pinched, s + np.where(band, f * edge, np.maximum(-net, 0.0)), 0.0)
+        d = np.where(pinched, np.where(band, np.maximum(h + net, 0.0), s + np.maximum(net, 0.0)), 0.0)
         return d, h
+
+    def face_slopes(self, net: np.ndarray) -> np.ndarray:
+        """d(d_i + h_i)/dR0 of the pinched nodes at the last split (F's spread held fixed):
+        sign(R0) off the edge's band; on it 1 where the die's face presses, 0 where it is clear."""
+        return np.where(self.edge > 0.0, (self.face + net > 0.0).astype(float), np.sign(net))
 
     def face_gap(self, x: np.ndarray, half: np.ndarray):
         """Gap and normal of the open holder's face to the nodes at x with half thicknesses
@@ -173,9 +239,11 @@ class PinchingHolder(Part):
         forces `net` (die minus holder on a pinched node), at positions x: the closed holder's
         split; the open holder's face takes the force of the nodes on it."""
         if self.closed:
-            d, self.face = self.split(self.pinched, net, self._tops(x))
+            self.edge = self.edge_shares(x, self.pinched)
+            d, self.face = self.split(self.pinched, net, self._tops(x), self.edge)
             contact.press(self.pinched, d[self.pinched])
         else:
+            self.edge = np.zeros(net.size)
             on = contact.on(contact.holder_tool)
             self.face = np.where(on, np.maximum(net, 0.0), 0.0)
             contact.press(on, 0.0)
@@ -201,23 +269,24 @@ class PinchingHolder(Part):
         return on, self.comm.allreduce(int(on.sum()), op=MPI.SUM)
 
     def settle(self, x, under, net, lam, contact) -> int:
-        """After a converged pass: open the holder if the flange lifts it (the squeeze left is
-        negative): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
+        """After a converged pass: open the holder if the flange lifts it (its holding-down off the
+        edge's band, E_in, passes F): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
         the die, the face at its closed position. Close it once its lift is below that position
         by more than the contact set's known tolerance (within a pass the lift may pass it),
-        unless that would spend its last switch of the increment; lower an open holder that
+        unless that would spend its last switch of the increment or its edge load would lift it
+        again (may_ride); lower an open holder that
         touches nothing onto the nearest node. Then its face forces. `net`, the nodes' net normal
         forces, is updated where a node changes faces. Returns the changes (the same on all ranks)."""
         changes = 0
         if self.toggles < self.max_toggles and self.force > 0:
-            if self.closed and self.squeeze_left(self.pinched, net) < 0:
+            if self.closed and self.lifted(net, self.edge_shares(x, self.pinched), contact.controls.penetration):
                 self.closed = False
                 self.lift = self.lift_floor(self._tops(x)[self.pinched])
                 held = self.pinched & (net < 0)
                 contact.assign(held, contact.holder_tool)
                 net[held] *= -1  # now the force of the face they lie on, along its normal
                 changes = 1
-            elif (not self.closed and self.toggles + 1 < self.max_toggles
+            elif (not self.closed and self.toggles + 1 < self.max_toggles and self.may_ride(x, under, contact)
                   and self.lift < self._lift_floor_over(x, under) - contact.known_tolerance):
                 # the face presses into the flange on the die: closed (if it may still open
                 # again in this increment: closed with its switches spent, it could be left

@@ -2,7 +2,9 @@
 
 Reference positions X, the current positions x = X + (u, v, w) of the carrier, the positions
 x_n at the start of the increment (slip is measured from them), each node's tributary area
-A_i (a third of each cell around it) and half thickness h_i = t/2 exp(e33_i) (e33 the
+A_i (a third of each cell around it), its local cell size h_i = sqrt(2 a_i) (a_i the
+area-weighted mean area of the cells around it: a right triangle's legs, 0.93 of an equilateral
+one's side) and half thickness h_i = t/2 exp(e33_i) (e33 the
 area-weighted thickness strain of the cells around it, updated with every converged increment:
 the sheet's surface is h_i from its mid-surface), and the carrier slots a symmetry plane holds.
 A part of its own: it commits and checkpoints x_n and h_i.
@@ -29,7 +31,7 @@ class SheetNodes(Part):
         for bc in bcs:
             held[bc.dof_indices()[0]] = True
         self.held = held.reshape(-1, BS)[: self.n_owned]  # carrier slots fixed by symmetry
-        self.area, e33 = self._areas_and_thickness_strain()
+        self.area, e33, self.cell_size = self._areas_and_thickness_strain()
         self.half_thickness = 0.5 * model.thickness * np.exp(e33)
         self.q = None
         self.x_n = self.X[: self.n_owned].copy()
@@ -51,7 +53,8 @@ class SheetNodes(Part):
         return self.q.x.array.reshape(-1, BS)[: self.n_owned, W_SLOPES]
 
     def _areas_and_thickness_strain(self):
-        """Tributary areas (a third of each cell) and their area-weighted thickness strain."""
+        """Tributary areas (a third of each cell), their area-weighted thickness strain and the
+        local cell size."""
         m = self.model
         x = m.cell_coords.reshape(-1, 3, 3)
         a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
@@ -59,17 +62,17 @@ class SheetNodes(Part):
         e33 = m.thickness_strain() if m.plastic else np.zeros(m.num_cells)
         f = fem.Function(m.V)
         arr = f.x.array.reshape(-1, BS)
-        for col, values in ((0, cell_area / 3), (1, cell_area / 3 * e33)):
+        for col, values in ((0, cell_area / 3), (1, cell_area / 3 * e33), (2, cell_area**2 / 3)):
             np.add.at(arr[:, col], m.dofs.ravel(), np.repeat(values, 3))
         f.x.scatter_reverse(la.InsertMode.add)
         f.x.scatter_forward()
         area = arr[: self.n_owned, 0].copy()
-        return area, arr[: self.n_owned, 1] / area
+        return area, arr[: self.n_owned, 1] / area, np.sqrt(2.0 * arr[: self.n_owned, 2] / area)
 
     def commit(self, lam: float) -> None:
         self.x_n = self.positions()
         if self.model.plastic:
-            _, e33 = self._areas_and_thickness_strain()
+            _, e33, _ = self._areas_and_thickness_strain()
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
 
     def checkpoint(self) -> dict:

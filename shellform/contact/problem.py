@@ -16,6 +16,7 @@ from shellform.assembly.sheet_element import BS
 from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.cad_tools import cad_cup_tools, check_start
+from shellform.contact.pinch_edge import edge_load
 from shellform.contact.tools import square_cup_tools
 from shellform.mesh import blank
 from shellform.nonlinear.model import SheetModel
@@ -37,7 +38,8 @@ class DrawingProblem:
     def from_scene(cls, s: Scene, comm=MPI.COMM_WORLD, checkpoint_dir=None, verbose=True, trace=False):
         pr, t = s.process, s.tools
         rect = blank(comm, s)
-        model = SheetModel(rect.mesh, s.hill79().pack(), s.material.thickness, s.effects, pr.thickness_points)
+        material = s.hill79().pack()
+        model = SheetModel(rect.mesh, material, s.material.thickness, s.effects, pr.thickness_points)
         bcs = named_supports.boundary_conditions(model.V, model.components, rect, s.supports,
                                                  fixed=named_supports.sheet_fixed_components)
         tools = (cad_cup_tools if t.shape == "cad" else square_cup_tools)(t, s.material.thickness)
@@ -50,6 +52,7 @@ class DrawingProblem:
         driver = SemiInverseDriver(
             model, bcs, [tools["punch"], tools["die"]], [-t.stroke, 0.0], friction=mu, holder=tools["holder"],
             holder_force=t.blank_holder_force / symmetry, drawbeads=beads,
+            holder_edge=edge_load(material, s.material.thickness, tools["die"], tools["holder"]),
             contact=ContactControls(1e-2 * s.material.thickness, holder_spread=t.holder_spread, trace=trace),
             controls=controls, checkpoint_dir=checkpoint_dir, verbose=verbose)
         return cls(s, rect, model, driver, symmetry)
@@ -96,14 +99,15 @@ class DrawingProblem:
             return 0.0
         return d.model.mesh.comm.allreduce(float(d.holder.face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
 
-    def holder_held_down(self) -> float:
-        """The part of the closed holder's force that holds pinched nodes down against the sheet's
-        own lift (their sum of max(-R0, 0), R0 the net normal force), as a fraction of F; the
-        holder opens when it passes 1. 0 when the holder is open."""
+    def holder_held_down(self) -> tuple[float, float]:
+        """The closed holder's (held down, edge load) as fractions of F (holder.py, held_down):
+        the part of its force that holds pinched nodes down against the sheet's own lift, the
+        edge's band included, and the edge load's demand (> 1: it rides on its edge). (0, 0)
+        when the holder is open."""
         d = self.driver
         if d.holder is None or d.holder.force <= 0 or not d.holder.closed:
-            return 0.0
-        return 1.0 - d.holder.squeeze_left(d.holder.pinched, d.net_normal_forces()) / d.holder.force
+            return 0.0, 0.0
+        return d.holder.held_down(d.net_normal_forces())
 
     def holder_largest_at(self) -> tuple[float, float]:
         """Initial (x, y) of the node with the largest holder force (mm), all ranks."""

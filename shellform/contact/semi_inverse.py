@@ -37,17 +37,19 @@ class SemiInverseDriver(Driver):
     tools: rigid tools with ``gap(x, offset, dz) -> (gap, normal)`` and ``shape(x, offset, dz)``
     in contact order (e.g. punch, die); ``travel[k]`` is tool k's z-travel at lambda = 1 (punch:
     -stroke); holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool
-    `die` (default: the last tool); friction: mu; drawbeads: DrawbeadLine's (drawbead.py).
+    `die` (default: the last tool); friction: mu; drawbeads: DrawbeadLine's (drawbead.py);
+    holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge).
     """
 
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
                  prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None,
-                 drawbeads=()):
+                 drawbeads=(), holder_edge=None):
         c = contact or ContactControls(penetration=1e-3 * model.thickness)
         t, E, comm = model.thickness, model.material[0], model.mesh.comm
         self.nodes = nodes = SheetNodes(model, bcs)
         self.holder = None if holder is None else PinchingHolder(
-            holder, holder_force, nodes, E * nodes.area / t, comm, c.holder_spread, t, c.max_toggles, c.trace)
+            holder, holder_force, nodes, E * nodes.area / t, comm, c.holder_spread, t, c.max_toggles, c.trace,
+            holder_edge)
         self.contact = ContactSet(nodes, tools, travel, c, t, die, self.holder)
         self.friction = CoulombFriction(friction, CoulombFriction.STICK_STIFFNESS * E * nodes.area / model.cell_size,
                                         nodes.held[:, :2], self.contact, nodes, c.friction_rtol, c.trace)

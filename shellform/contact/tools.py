@@ -229,6 +229,15 @@ class BlankHolder:
         sd = np.where(s >= 0.0, (self.z_face + dz) - x[:, 2], np.inf)
         return sd - offset, np.tile(DOWN, (len(x), 1))
 
+    def edge_offset(self, x):
+        """(s, j) of points x: s their plan distance from the face's inner edge (> 0 under the
+        face), j the length of the edge per unit length of the offset line through them,
+        1 - s tr(Hs) = rc / (rc + s) beside a corner arc, 1 beside a side."""
+        x, _ = _points(x, 0.0)
+        s = rounded_square_sdf(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)[0]
+        Hs = rounded_square_hessian(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)
+        return s, 1.0 - s * np.trace(Hs, axis1=1, axis2=2)
+
     def shape(self, x, offset=0.0, dz: float = 0.0):
         """H = dn/dx = 0: a flat face (and nothing over the opening)."""
         x, _ = _points(x, offset)

@@ -87,6 +87,11 @@ def uniaxial(mat, strain: float, steps: int) -> Path:
     return _drive(mat, np.linspace(0.0, strain, steps + 1), _UNIAXIAL)
 
 
+def plane_strain(mat, strain: float, steps: int) -> Path:
+    """Strain-driven plane strain: e11 up to `strain` in equal steps, e22 = 0, s12 = 0."""
+    return _drive(mat, np.linspace(0.0, strain, steps + 1), _PLANE_STRAIN)
+
+
 def _perfectly_plastic(mat) -> tuple[np.ndarray, float]:
     """The material with its initial yield stress and no hardening (Swift, n = 0)."""
     mat = _packed(mat)

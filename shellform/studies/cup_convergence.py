@@ -6,8 +6,9 @@ The NUMISHEET'93 aluminium cup (demos/numisheet93_aluminium.toml) to 40 mm on n 
 meshes, n = 16, 24, 35, 50, 71, and the paper's square cup (demos/square_cup.toml) to 30 mm on
 n = 16, 24, 35, 50. For each run: DX, DY, DD and the punch force at 15 mm and at the end, the
 peak thinning and where it is, the stroke at which the holder opens (if it does), the largest
-nodal share of the holder's force and the peak of the pinch edge's holding-down sum (each over
-the stroke). For each answer, over the three finest finished meshes, the observed order of
+nodal share of the holder's force, the peak of what it holds down, the edge load's share of F
+(holder.py, pinch_edge.py) at the start and its peak, and the largest change of the punch force
+between consecutive increments in the last 40 % of the stroke. For each answer, over the three finest finished meshes, the observed order of
 convergence p and the Richardson estimate of the converged value with its uncertainty
 (`richardson`). Writes cup_convergence.csv (one row per run), cup_convergence_estimates.csv
 (one row per case and answer) and cup_convergence.png (each answer against the cell size).
@@ -78,6 +79,16 @@ def run_name(case: str, n: int) -> str:
     return f"{case} n {n}"
 
 
+def late_jump(curve: list[dict], late: float = 0.6) -> float:
+    """The largest relative change of the punch force between consecutive increments beyond
+    `late` of the stroke."""
+    stroke = [float(r["stroke_mm"]) for r in curve]
+    force = [float(r["punch_force_kN"]) for r in curve]
+    jumps = [abs(force[i] - force[i - 1]) / abs(force[i]) for i in range(1, len(curve))
+             if stroke[i] > late * stroke[-1] and force[i] != 0.0]
+    return max(jumps, default=0.0)
+
+
 def row(case: str, n: int, out: Path) -> dict:
     """A run's row from its summary.json and force_stroke.csv."""
     d = folder(out, run_name(case, n))
@@ -91,6 +102,9 @@ def row(case: str, n: int, out: Path) -> dict:
          "cutbacks": s["cutbacks"], "wall_s": s["wall_time_s"]["total"], "holder_opens_mm": opened,
          "largest_share": max(float(x["holder_largest_share"]) for x in curve),
          "held_down_peak": max(float(x["holder_held_down"]) for x in curve),
+         "edge_load_start": float(curve[0]["holder_edge_load"]),
+         "edge_load_peak": max(float(x["holder_edge_load"]) for x in curve),
+         "late_force_jump": late_jump(curve),
          "max_thickness_strain": s["max_thickness_strain"], "where_x_mm": s["where_initial_xy_mm"][0],
          "where_y_mm": s["where_initial_xy_mm"][1], "stopped": s["stopped"] or ""}
     for rep in s["reports"]:
@@ -121,14 +135,14 @@ def estimates(rows: list[dict], reports) -> list[dict]:
 
 
 def plot(path: Path, rows: list[dict]) -> None:
-    """DX, DD and the punch force at each case's end, and the peak holding-down sum, against
-    the cell size."""
+    """DX, DD and the punch force at each case's end, and the edge load's share of F at the
+    start, against the cell size."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    keys = ["DX_end", "DD_end", "force_end", "held_down_peak"]
+    keys = ["DX_end", "DD_end", "force_end", "edge_load_start"]
     fig, axes = plt.subplots(1, len(keys), figsize=(4 * len(keys), 3.2))
     for ax, key in zip(axes, keys):
         for case in sorted({r["case"] for r in rows}):
@@ -148,15 +162,20 @@ def run(out: Path, levels=None, cases=tuple(CASES), stroke=None) -> list[dict]:
     out.mkdir(parents=True, exist_ok=True)
     quick = levels == QUICK_LEVELS
     stroke = stroke or (QUICK_STROKE if quick else None)
-    rows, ests = [], []
     for case in cases:
-        ns = levels or CASES[case][1]
-        reports = tuple(r for r in CASES[case][2] if stroke is None or r < stroke) + ((stroke,) if stroke else ())
-        part = []
-        for n in ns:
+        for n in levels or CASES[case][1]:
             say(f"cup-convergence: {run_name(case, n)}")
             run_cup(scene_of(case, n, stroke), folder(out, run_name(case, n)))
-            part.append(row(case, n, out))
+    return tables(out, {case: levels or CASES[case][1] for case in cases}, stroke)
+
+
+def tables(out: Path, levels: dict, stroke=None) -> list[dict]:
+    """The tables and the plot of the runs in out: levels, per case its mesh levels."""
+    out = Path(out)
+    rows, ests = [], []
+    for case, ns in levels.items():
+        reports = tuple(r for r in CASES[case][2] if stroke is None or r < stroke) + ((stroke,) if stroke else ())
+        part = [row(case, n, out) for n in ns]
         rows += part
         ests += estimates(part, reports)
     write_csv(out / "cup_convergence.csv", rows, list(dict.fromkeys(k for r in rows for k in r)))
