@@ -55,7 +55,7 @@ def record(dr):
         return
     R = dr.residual_full[: dr.n_owned * BS].reshape(-1, BS)
     pinched = dr.holder.pinched
-    print(f"n {n} {variant} {p.stroke:.1f} mm: held down {p.holder_held_down():.4f} F, largest share "
+    print(f"n {n} {variant} {p.stroke:.1f} mm: held down {p.holder_held_down()[0]:.4f} F, largest share "
           f"{p.holder_share():.4f} F, slope reactions {np.abs(R[pinched][:, W_SLOPES]).sum():.0f} N mm, "
           f"punch {p.punch_force() / 1e3:.3f} kN, holder closed {dr.holder.closed}", flush=True)
 

@@ -18,8 +18,8 @@ With E_in the holding-down off the band and E_e = sum e_i, the holder carries th
 (f = 1) while E_in + E_e <= F; beyond, it *rides* on its edge: f = (F - E_in) / E_e and no squeeze
 is left. A holder riding on its edge is lifted by micrometres (the couple's arm grows to take
 less force: EdgeLoad.riding_lift), so the flange stays pinched while that lift is below the
-contact's tolerance (1 % of t); where it is not (a light holder), the holder opens. The squeeze left to spread is
-S = F - E_in - f E_e >= 0. ``spread`` says how:
+contact's tolerance (1 % of t); where it is not (a light holder), the holder opens. The squeeze
+left to spread is S = F - E_in - f E_e >= 0. ``spread`` says how:
 - "area" (default): s_i = S A_i / sum A (tributary areas), the uniform flange pressure of a
   holder whose own compliance and the sheet's absorb the flange's thickness differences. On a
   nodal mesh the rigid law below puts the whole force on 2 to 4 of the thickest nodes, which a
@@ -144,39 +144,42 @@ class PinchingHolder(Part):
         both = self.comm.allreduce(np.array([np.maximum(-net[inner], 0.0).sum(), edge.sum()]), op=MPI.SUM)
         return float(both[0]), float(both[1])
 
+    def edge_share(self, inner: float, total_edge: float) -> float:
+        """f: the share of its edge load E_e the holder gives after the holding-down E_in."""
+        left = max(self.force - inner, 0.0)
+        return 1.0 if total_edge <= left else left / total_edge
+
+    def rides(self, share: float, tolerance: float) -> bool:
+        """Whether giving its edge `share` of the edge load lifts the holder by at most
+        `tolerance` (EdgeLoad.riding_lift; always without an edge load)."""
+        return self.edge_law is None or share >= 1.0 or self.edge_law.riding_lift(share) <= tolerance
+
     def lifted(self, net: np.ndarray, edge: np.ndarray, tolerance: float) -> bool:
         """The closed holder cannot hold the flange: its holding-down off the edge's band passes
         F, or riding on its edge would lift it by more than `tolerance` (all ranks agree)."""
         inner, total_edge = self.demands(self.pinched, net, edge)
-        if inner > self.force:
-            return True
-        share = 1.0 if total_edge <= self.force - inner else (self.force - inner) / total_edge
-        return self.edge_law is not None and share < 1.0 and self.edge_law.riding_lift(share) > tolerance
+        return inner > self.force or not self.rides(self.edge_share(inner, total_edge), tolerance)
 
     def may_ride(self, x: np.ndarray, under: np.ndarray, contact) -> bool:
         """Whether the open holder, closed on the flange on the die under it, could carry at
         least the share of its edge load that keeps riding within the contact's tolerance."""
-        if self.edge_law is None:
-            return True
         total = self._sum(self.edge_shares(x, under & contact.on(contact.die)))
-        share = 1.0 if total <= self.force else self.force / total
-        return self.edge_law.riding_lift(share) <= contact.controls.penetration
+        return self.rides(self.edge_share(0.0, total), contact.controls.penetration)
 
     def held_down(self, net: np.ndarray) -> tuple[float, float]:
         """(E_in + f E_e, E_e) / F of the closed holder at its last split: the part of F that holds
         the flange down against its own lift, and the edge load's demand (> 1: the holder rides
         on its edge)."""
         inner, edge = self.demands(self.pinched, net, self.edge)
-        return (inner + min(edge, max(self.force - inner, 0.0))) / self.force, edge / self.force
+        return (inner + self.edge_share(inner, edge) * edge) / self.force, edge / self.force
 
     def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray):
         """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed
         holder, from their net normal forces R0, their tops z + t/2 (the "rigid" spread) and the
         edge load's shares e_i (module docstring)."""
         inner, total_edge = self.demands(pinched, net, edge)
-        left = max(self.force - inner, 0.0)
-        f = 1.0 if total_edge <= left else left / total_edge
-        S = left - f * total_edge
+        f = self.edge_share(inner, total_edge)
+        S = max(self.force - inner, 0.0) - f * total_edge
         s = np.zeros(net.size)
         if self.spread == "area":
             total = self._sum(self.area[pinched])
