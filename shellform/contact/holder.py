@@ -21,17 +21,13 @@ less force: EdgeLoad.riding_lift), so the flange stays pinched while that lift i
 contact's tolerance (1 % of t); where it is not (a light holder), the holder opens. The squeeze
 left to spread is S = F - E_in - f E_e >= 0. ``spread`` says how:
 - "area" (default): s_i = S A_i / sum A (tributary areas), the uniform flange pressure of a
-  holder whose own compliance and the sheet's absorb the flange's thickness differences. On a
-  nodal mesh the rigid law below puts the whole force on 2 to 4 of the thickest nodes, which a
-  real holder (elastic, on a sheet whose thickness varies by micrometres between nodes early in
-  the stroke) does not do, and friction on those few nodes then drives the flange.
+  holder whose own compliance and the sheet's absorb the flange's thickness differences.
 - "rigid": the rigid holder on the thickest rim: s_i = k_i max(top_i - Z, 0) with the
   through-thickness stiffness k_i = E A_i / t and Z fixed by sum s_i = S.
 
 The holder *opens* when the flange off the band pushes it up harder than F holds it down
-(E_in > F), or when the edge would lift it by more than the tolerance (f below the share that
-keeps riding_lift within it): both are criteria on forces per unit length and a physical lift,
-not on the mesh. Open, it
+(E_in > F), or when riding on its edge would lift it by more than the tolerance: criteria on
+forces per unit length and a physical lift, not on the mesh. Open, it
 is still a rigid tool: a face lifted by `lift` above its closed position, with one unknown
 (the lift z_H) and one equation (its nodal forces sum to F), solved with the sheet in each
 Newton iteration as a bordered system, one more solve with the same factors:
@@ -40,11 +36,12 @@ Newton iteration as a bordered system, one more solve with the same factors:
     dz_H = (F - sum p_i - sum (K dq_a)_i) / sum (K dq_b)_i   (sums over the holder's normal rows)
 
 F - sum p_i is the derivative of the energy with respect to the lift: it enters the residual's
-norm and the line search's energy slope. A node under it touches it, the die, or neither, and leaves the
-face it touches when its force turns tensile. With the "area" spread the lifted face conforms
+norm and the line search's energy slope. A node under it touches it, the die, or neither, and
+leaves the face it touches when its force turns tensile. With the "area" spread the lifted face conforms
 to the flange's thickness as the closed holder's pressure does (over each node it lies `lift`
 above the node's own top when the node is on the die); with "rigid" it is flat. The holder
-closes again when its lift falls to that closed position. With F = 0 there is no holder.
+closes again when its lift falls to that closed position and it could ride there. With F = 0
+there is no holder.
 
 The holder's faces hold the flange flat: under the closed holder the pinched nodes' w and
 slopes are known, under the open one the slopes of every node beneath it. The pinched set only
