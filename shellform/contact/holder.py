@@ -326,11 +326,15 @@ class PinchingHolder(Part):
     def constrain(self, c, lam: float) -> None:
         """The holder's flat faces hold the flange flat: the slopes of w are known on the
         pinched nodes, and on every node under the open holder (on a face or between them);
-        they stay known (and the pinched nodes' w) within the increment."""
+        they stay known (and the pinched nodes' w) within the increment. Flat is the lower
+        surface: the mid-surface lies a half thickness above the die, so its slopes are the half
+        thickness's gradient (SheetNodes.surface_slopes), not zero: zero slopes under a w that
+        follows the thickness kink the sheet at every node, with curvatures ~ dh / h^2 that grow
+        as the mesh is refined."""
         flat = self.pinched.copy()
         if self.is_open:
             flat |= self.under_now
-        c.known[flat, W_SLOPES] = -self.nodes.slopes()[flat]
+        c.known[flat, W_SLOPES] = (self.nodes.surface_slopes - self.nodes.slopes())[flat]
         c.flags[flat, W_SLOPES] = True
         c.stable[flat, W_SLOPES] = True
         c.stable[self.pinched, 2] = True

@@ -6,7 +6,9 @@ A_i (a third of each cell around it), its local cell size h_i = sqrt(2 a_i) (a_i
 area-weighted mean area of the cells around it: a right triangle's legs, 0.93 of an equilateral
 one's side) and half thickness h_i = t/2 exp(e33_i) (e33 the
 area-weighted thickness strain of the cells around it, updated with every converged increment:
-the sheet's surface is h_i from its mid-surface), and the carrier slots a symmetry plane holds.
+the sheet's surface is h_i from its mid-surface) with its plan gradient grad h_i (the area-weighted
+mean of the cells' gradients of its linear interpolant, in the reference plan: the slopes of a
+mid-surface whose lower surface lies on a flat face), and the carrier slots a symmetry plane holds.
 A part of its own: it commits and checkpoints x_n and h_i.
 """
 
@@ -33,6 +35,7 @@ class SheetNodes(Part):
         self.held = held.reshape(-1, BS)[: self.n_owned]  # carrier slots fixed by symmetry
         self.area, e33, self.cell_size = self._areas_and_thickness_strain()
         self.half_thickness = 0.5 * model.thickness * np.exp(e33)
+        self.surface_slopes = self.gradient(self.half_thickness)
         self.q = None
         self.x_n = self.X[: self.n_owned].copy()
 
@@ -69,11 +72,31 @@ class SheetNodes(Part):
         area = arr[: self.n_owned, 0].copy()
         return area, arr[: self.n_owned, 1] / area, np.sqrt(2.0 * arr[: self.n_owned, 2] / area)
 
+    def gradient(self, values: np.ndarray) -> np.ndarray:
+        """(n_owned, 2): the area-weighted mean over the cells around each node of the plan
+        gradient of the linear interpolant of the owned nodes' `values`."""
+        m = self.model
+        f = fem.Function(m.V)
+        arr = f.x.array.reshape(-1, BS)
+        arr[: self.n_owned, 0] = values
+        f.x.scatter_forward()  # the ghosts' values
+        v = arr[:, 0][m.dofs.reshape(-1, 3)]
+        x = m.cell_coords.reshape(-1, 3, 3)[:, :, :2]
+        J = np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]], axis=1)  # rows: the edges from vertex 0
+        g = np.linalg.solve(J, np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=1)[..., None])[..., 0]
+        area = 0.5 * np.abs(np.linalg.det(J))
+        arr[:] = 0.0
+        for col, values in ((0, area), (1, area * g[:, 0]), (2, area * g[:, 1])):
+            np.add.at(arr[:, col], m.dofs.ravel(), np.repeat(values, 3))
+        f.x.scatter_reverse(la.InsertMode.add)
+        return arr[: self.n_owned, 1:3] / arr[: self.n_owned, :1]
+
     def commit(self, lam: float) -> None:
         self.x_n = self.positions()
         if self.model.plastic:
             _, e33, _ = self._areas_and_thickness_strain()
             self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
+            self.surface_slopes = self.gradient(self.half_thickness)
 
     def checkpoint(self) -> dict:
         return {"nodes": {"contact_x_n": self.x_n, "contact_half_thickness": self.half_thickness}}
@@ -81,3 +104,4 @@ class SheetNodes(Part):
     def restore(self, state: dict, lam_scale: float) -> None:
         self.x_n = state["nodes"]["contact_x_n"].copy()
         self.half_thickness = state["nodes"]["contact_half_thickness"].copy()
+        self.surface_slopes = self.gradient(self.half_thickness)
