@@ -11,7 +11,8 @@ presses each pinched node with what holds it down plus a *squeeze* s_i >= 0:
                           sum_i h_i = F,  friction pressure d_i + h_i
 
 The band is the pinched nodes that carry the couple turning the sheet from the flange onto the
-die's shoulder: e_i is their share of the edge load V_e per unit length of the holder's inner
+die's shoulder (within two cells of the holder's inner edge, or drawn past it in this
+increment): e_i is their share of the edge load V_e per unit length of the holder's inner
 edge (pinch_edge.py: the couple over the sheet's own through-thickness compliance, the same total
 on every mesh), which replaces the discrete force the rigid pinch puts there (it grows as 1/h).
 With E_in the holding-down off the band and E_e = sum e_i, the holder carries the edge in full
@@ -99,6 +100,7 @@ class PinchingHolder(Part):
         self.edge_law = edge
         self.edge_load = edge.line_load if edge is not None else 0.0
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
+        self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
         self.contact = self.friction = None
         self._dlift, self._lift0 = 0.0, 0.0
         self.committed = None
@@ -124,20 +126,23 @@ class PinchingHolder(Part):
     def _sum(self, v) -> float:
         return self.comm.allreduce(float(np.sum(v)), op=MPI.SUM)
 
-    def edge_shares(self, x: np.ndarray, pinched: np.ndarray) -> np.ndarray:
-        """e_i = V_e A_i j_i (2 / b) sin^2(pi s_i / b) on the pinched nodes at x within b = 2 h_i
-        of the holder's inner edge (s_i their plan distance from it, j_i the edge's length per
-        unit length of their offset line), 0 elsewhere (pinch_edge.py)."""
+    def edge_shares(self, x: np.ndarray, pinched: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(e, band): e_i = V_e A_i j_i (2 / b) sin^2(pi s_i / b) on the pinched nodes at x within
+        b = 2 h_i of the holder's inner edge (s_i their plan distance from it, j_i the edge's
+        length per unit length of their offset line), 0 elsewhere (pinch_edge.py); the band, the
+        pinched nodes with s_i < b, includes those drawn past the edge in this increment (s < 0,
+        still pinched until the next): their discrete couple is the edge's too."""
         if self.edge_load <= 0.0:
-            return np.zeros(pinched.size)
+            return np.zeros(pinched.size), np.zeros(pinched.size, dtype=bool)
         s, j = self.tool.edge_offset(x)
         w = edge_weights(s, self.nodes.cell_size)
-        return np.where(pinched, self.edge_load * self.area * j * w, 0.0)
+        band = pinched & (s < 2.0 * self.nodes.cell_size)
+        return np.where(pinched, self.edge_load * self.area * j * w, 0.0), band
 
-    def demands(self, pinched: np.ndarray, net: np.ndarray, edge: np.ndarray) -> tuple[float, float]:
+    def demands(self, pinched: np.ndarray, net: np.ndarray, edge: np.ndarray, band: np.ndarray) -> tuple[float, float]:
         """(E_in, E_e), all ranks: the holding-down the pinched nodes off the edge's band need
         (sum max(-R0, 0)) and the edge load on the band (sum e_i)."""
-        inner = pinched & (edge <= 0.0)
+        inner = pinched & ~band
         both = self.comm.allreduce(np.array([np.maximum(-net[inner], 0.0).sum(), edge.sum()]), op=MPI.SUM)
         return float(both[0]), float(both[1])
 
@@ -151,30 +156,30 @@ class PinchingHolder(Part):
         `tolerance` (EdgeLoad.riding_lift; always without an edge load)."""
         return self.edge_law is None or share >= 1.0 or self.edge_law.riding_lift(share) <= tolerance
 
-    def lifted(self, net: np.ndarray, edge: np.ndarray, tolerance: float) -> bool:
+    def lifted(self, net: np.ndarray, edge: np.ndarray, band: np.ndarray, tolerance: float) -> bool:
         """The closed holder cannot hold the flange: its holding-down off the edge's band passes
         F, or riding on its edge would lift it by more than `tolerance` (all ranks agree)."""
-        inner, total_edge = self.demands(self.pinched, net, edge)
+        inner, total_edge = self.demands(self.pinched, net, edge, band)
         return inner > self.force or not self.rides(self.edge_share(inner, total_edge), tolerance)
 
     def may_ride(self, x: np.ndarray, under: np.ndarray, contact) -> bool:
         """Whether the open holder, closed on the flange on the die under it, could carry at
         least the share of its edge load that keeps riding within the contact's tolerance."""
-        total = self._sum(self.edge_shares(x, under & contact.on(contact.die)))
+        total = self._sum(self.edge_shares(x, under & contact.on(contact.die))[0])
         return self.rides(self.edge_share(0.0, total), contact.controls.penetration)
 
     def held_down(self, net: np.ndarray) -> tuple[float, float]:
         """(E_in + f E_e, E_e) / F of the closed holder at its last split: the part of F that holds
         the flange down against its own lift, and the edge load's demand (> 1: the holder rides
         on its edge)."""
-        inner, edge = self.demands(self.pinched, net, self.edge)
+        inner, edge = self.demands(self.pinched, net, self.edge, self.band)
         return (inner + self.edge_share(inner, edge) * edge) / self.force, edge / self.force
 
-    def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray):
+    def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray, band: np.ndarray):
         """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed
         holder, from their net normal forces R0, their tops z + t/2 (the "rigid" spread) and the
-        edge load's shares e_i (module docstring)."""
-        inner, total_edge = self.demands(pinched, net, edge)
+        edge load's shares e_i on its band (module docstring)."""
+        inner, total_edge = self.demands(pinched, net, edge, band)
         f = self.edge_share(inner, total_edge)
         S = max(self.force - inner, 0.0) - f * total_edge
         s = np.zeros(net.size)
@@ -188,7 +193,6 @@ class PinchingHolder(Part):
             if all_tops.size:
                 Z = holder_height(all_tops, all_k, S)
                 s[pinched] = self.k[pinched] * np.maximum(tops[pinched] - Z, 0.0)
-        band = edge > 0.0
         h = np.where(pinched, s + np.where(band, f * edge, np.maximum(-net, 0.0)), 0.0)
         d = np.where(pinched, np.where(band, np.maximum(h + net, 0.0), s + np.maximum(net, 0.0)), 0.0)
         return d, h
@@ -196,7 +200,7 @@ class PinchingHolder(Part):
     def face_slopes(self, net: np.ndarray) -> np.ndarray:
         """d(d_i + h_i)/dR0 of the pinched nodes at the last split (F's spread held fixed):
         sign(R0) off the edge's band; on it 1 where the die's face presses, 0 where it is clear."""
-        return np.where(self.edge > 0.0, (self.face + net > 0.0).astype(float), np.sign(net))
+        return np.where(self.band, (self.face + net > 0.0).astype(float), np.sign(net))
 
     def face_gap(self, x: np.ndarray, half: np.ndarray):
         """Gap and normal of the open holder's face to the nodes at x with half thicknesses
@@ -239,11 +243,11 @@ class PinchingHolder(Part):
         forces `net` (die minus holder on a pinched node), at positions x: the closed holder's
         split; the open holder's face takes the force of the nodes on it."""
         if self.closed:
-            self.edge = self.edge_shares(x, self.pinched)
-            d, self.face = self.split(self.pinched, net, self._tops(x), self.edge)
+            self.edge, self.band = self.edge_shares(x, self.pinched)
+            d, self.face = self.split(self.pinched, net, self._tops(x), self.edge, self.band)
             contact.press(self.pinched, d[self.pinched])
         else:
-            self.edge = np.zeros(net.size)
+            self.edge, self.band = np.zeros(net.size), np.zeros(net.size, dtype=bool)
             on = contact.on(contact.holder_tool)
             self.face = np.where(on, np.maximum(net, 0.0), 0.0)
             contact.press(on, 0.0)
@@ -279,7 +283,7 @@ class PinchingHolder(Part):
         forces, is updated where a node changes faces. Returns the changes (the same on all ranks)."""
         changes = 0
         if self.toggles < self.max_toggles and self.force > 0:
-            if self.closed and self.lifted(net, self.edge_shares(x, self.pinched), contact.controls.penetration):
+            if self.closed and self.lifted(net, *self.edge_shares(x, self.pinched), contact.controls.penetration):
                 self.closed = False
                 self.lift = self.lift_floor(self._tops(x)[self.pinched])
                 held = self.pinched & (net < 0)
