@@ -98,7 +98,6 @@ class PinchingHolder(Part):
         self.under_now = np.zeros(n, dtype=bool)  # under the holder in this increment (pinch)
         self.face = np.zeros(n)  # the holder face's normal force on each node
         self.edge_law = edge
-        self.edge_load = edge.line_load if edge is not None else 0.0
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
         self.contact = self.friction = None
@@ -113,6 +112,11 @@ class PinchingHolder(Part):
         """The contact set whose die the holder pinches onto and whose tools its open face joins,
         and the friction on its nodes."""
         self.contact, self.friction = contact, friction
+
+    @property
+    def edge_load(self) -> float:
+        """V_e (N/mm), 0 without an edge load."""
+        return self.edge_law.line_load if self.edge_law is not None else 0.0
 
     @property
     def is_open(self) -> bool:

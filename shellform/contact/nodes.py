@@ -33,9 +33,12 @@ class SheetNodes(Part):
         for bc in bcs:
             held[bc.dof_indices()[0]] = True
         self.held = held.reshape(-1, BS)[: self.n_owned]  # carrier slots fixed by symmetry
-        self.area, e33, self.cell_size = self._areas_and_thickness_strain()
-        self.half_thickness = 0.5 * model.thickness * np.exp(e33)
-        self.surface_slopes = self.gradient(self.half_thickness)
+        x = model.cell_coords.reshape(-1, 3, 3)[:, :, :2]
+        self._edges = np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]], axis=1)  # rows: the edges from vertex 0
+        self._cell_area = 0.5 * np.abs(np.linalg.det(self._edges))
+        sums = self._cell_sums(self._cell_area / 3, self._cell_area**2 / 3)
+        self.area, self.cell_size = sums[:, 0], np.sqrt(2.0 * sums[:, 1] / sums[:, 0])
+        self._set_thickness(self._half_thickness())
         self.q = None
         self.x_n = self.X[: self.n_owned].copy()
 
@@ -55,53 +58,49 @@ class SheetNodes(Part):
         """(n_owned, 2) the slopes (w_x, w_y) of the owned nodes."""
         return self.q.x.array.reshape(-1, BS)[: self.n_owned, W_SLOPES]
 
-    def _areas_and_thickness_strain(self):
-        """Tributary areas (a third of each cell), their area-weighted thickness strain and the
-        local cell size."""
-        m = self.model
-        x = m.cell_coords.reshape(-1, 3, 3)
-        a, b = x[:, 1, :2] - x[:, 0, :2], x[:, 2, :2] - x[:, 0, :2]
-        cell_area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-        e33 = m.thickness_strain() if m.plastic else np.zeros(m.num_cells)
-        f = fem.Function(m.V)
+    def _cell_sums(self, *values) -> np.ndarray:
+        """(n_owned, len(values)): per node the sum over the cells around it of each cell array
+        in `values` (all ranks' cells)."""
+        f = fem.Function(self.model.V)
         arr = f.x.array.reshape(-1, BS)
-        for col, values in ((0, cell_area / 3), (1, cell_area / 3 * e33), (2, cell_area**2 / 3)):
-            np.add.at(arr[:, col], m.dofs.ravel(), np.repeat(values, 3))
+        for col, v in enumerate(values):
+            np.add.at(arr[:, col], self.model.dofs.ravel(), np.repeat(v, 3))
         f.x.scatter_reverse(la.InsertMode.add)
-        f.x.scatter_forward()
-        area = arr[: self.n_owned, 0].copy()
-        return area, arr[: self.n_owned, 1] / area, np.sqrt(2.0 * arr[: self.n_owned, 2] / area)
+        return arr[: self.n_owned, : len(values)].copy()
+
+    def _half_thickness(self) -> np.ndarray:
+        """t/2 exp(e33) with e33 the area-weighted thickness strain of the cells around each node."""
+        m = self.model
+        if not m.plastic:
+            return np.full(self.n_owned, 0.5 * m.thickness)
+        e33 = self._cell_sums(self._cell_area / 3 * m.thickness_strain())[:, 0] / self.area
+        return 0.5 * m.thickness * np.exp(e33)
+
+    def _set_thickness(self, half: np.ndarray) -> None:
+        """The half thickness and the slopes of a mid-surface a half thickness above a flat face."""
+        self.half_thickness = half
+        self.surface_slopes = self.gradient(half)
 
     def gradient(self, values: np.ndarray) -> np.ndarray:
         """(n_owned, 2): the area-weighted mean over the cells around each node of the plan
         gradient of the linear interpolant of the owned nodes' `values`."""
-        m = self.model
-        f = fem.Function(m.V)
+        f = fem.Function(self.model.V)
         arr = f.x.array.reshape(-1, BS)
         arr[: self.n_owned, 0] = values
         f.x.scatter_forward()  # the ghosts' values
-        v = arr[:, 0][m.dofs.reshape(-1, 3)]
-        x = m.cell_coords.reshape(-1, 3, 3)[:, :, :2]
-        J = np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]], axis=1)  # rows: the edges from vertex 0
-        g = np.linalg.solve(J, np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=1)[..., None])[..., 0]
-        area = 0.5 * np.abs(np.linalg.det(J))
-        arr[:] = 0.0
-        for col, values in ((0, area), (1, area * g[:, 0]), (2, area * g[:, 1])):
-            np.add.at(arr[:, col], m.dofs.ravel(), np.repeat(values, 3))
-        f.x.scatter_reverse(la.InsertMode.add)
-        return arr[: self.n_owned, 1:3] / arr[: self.n_owned, :1]
+        v = arr[:, 0][self.model.dofs.reshape(-1, 3)]
+        g = np.linalg.solve(self._edges, np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=1)[..., None])[..., 0]
+        sums = self._cell_sums(self._cell_area, self._cell_area * g[:, 0], self._cell_area * g[:, 1])
+        return sums[:, 1:] / sums[:, :1]
 
     def commit(self, lam: float) -> None:
         self.x_n = self.positions()
         if self.model.plastic:
-            _, e33, _ = self._areas_and_thickness_strain()
-            self.half_thickness = 0.5 * self.model.thickness * np.exp(e33)
-            self.surface_slopes = self.gradient(self.half_thickness)
+            self._set_thickness(self._half_thickness())
 
     def checkpoint(self) -> dict:
         return {"nodes": {"contact_x_n": self.x_n, "contact_half_thickness": self.half_thickness}}
 
     def restore(self, state: dict, lam_scale: float) -> None:
         self.x_n = state["nodes"]["contact_x_n"].copy()
-        self.half_thickness = state["nodes"]["contact_half_thickness"].copy()
-        self.surface_slopes = self.gradient(self.half_thickness)
+        self._set_thickness(state["nodes"]["contact_half_thickness"].copy())
