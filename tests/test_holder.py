@@ -115,3 +115,36 @@ def test_the_pinch_holds_the_slopes_of_a_mid_surface_on_the_die():
     pinched = p.driver.holder.pinched
     assert pinched.sum() > 0
     assert np.abs(n.slopes()[pinched] - start[pinched]).max() <= p.driver.contact.known_tolerance  # met as known values are
+
+
+def test_a_node_held_flat_takes_the_thickness_of_the_material_between_the_faces():
+    """The pinched nodes' half thickness is the area-weighted thickness of the cells wholly under
+    the pinch (where a node has one), not of the cells bent beyond its edge: computed here from
+    the cells' thickness strains, it differs from the all-cells average at the pinch's edge, where
+    the bent cells thin, and nowhere inside."""
+    s = square_cup()
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(4.0 / s.tools.stroke)
+    n, m = d.nodes, d.model
+    flat = d.holder.flat()
+    assert flat.sum() > 0 and np.array_equal(flat, n.flat)
+    cells = m.dofs.reshape(-1, 3)
+    e33, area = m.thickness_strain(), m.cell_area
+    between = flat[cells].all(axis=1)
+    held, every = np.zeros(n.n_owned), np.zeros(n.n_owned)
+    for k in range(3):
+        np.add.at(held, cells[between, k], (area * e33)[between])
+        np.add.at(every, cells[:, k], area * e33)
+    a_held, a_every = np.zeros(n.n_owned), np.zeros(n.n_owned)
+    for k in range(3):
+        np.add.at(a_held, cells[between, k], area[between])
+        np.add.at(a_every, cells[:, k], area)
+    inside = flat & (a_held > 0)
+    expected = np.where(inside, held / np.where(a_held > 0, a_held, 1.0), every / a_every)
+    np.testing.assert_allclose(n.half_thickness, 0.5 * s.material.thickness * np.exp(expected), rtol=0, atol=1e-12)
+    edge = inside & (a_held < a_every)  # held nodes with cells beyond the pinch
+    mixed = every / a_every
+    assert edge.sum() > 0
+    assert (expected[edge] - mixed[edge]).max() > 1e-3  # the bent cells are thinner
+    assert np.abs(expected[flat & ~edge] - mixed[flat & ~edge]).max() < 1e-15

@@ -241,6 +241,12 @@ class PinchingHolder(Part):
         self.pinched = (self.pinched | now) if grow else now
         self.pinched &= self.closed & on_die
         self.under_now = (self.under_now | under) if grow else under.copy()
+        self.nodes.hold_flat(self.flat())
+
+    def flat(self) -> np.ndarray:
+        """The nodes the faces hold flat: the pinched ones, and under the open holder every node
+        beneath it."""
+        return self.pinched | self.under_now if self.is_open else self.pinched.copy()
 
     def faces(self, x, net, contact) -> None:
         """The face forces of the holder (and of the die under it) from the nodes' net normal
@@ -338,10 +344,9 @@ class PinchingHolder(Part):
         surface: the mid-surface lies a half thickness above the die, so its slopes are the half
         thickness's gradient (SheetNodes.surface_slopes), not zero: zero slopes under a w that
         follows the thickness kink the sheet at every node, with curvatures ~ dh / h^2 that grow
-        as the mesh is refined."""
-        flat = self.pinched.copy()
-        if self.is_open:
-            flat |= self.under_now
+        as the mesh is refined. The thickness of a node held flat is that of the material between
+        the faces (SheetNodes.hold_flat), not of the cells bent beyond the pinch's edge."""
+        flat = self.flat()
         c.known[flat, W_SLOPES] = (self.nodes.surface_slopes - self.nodes.slopes())[flat]
         c.flags[flat, W_SLOPES] = True
         c.stable[flat, W_SLOPES] = True

@@ -10,6 +10,13 @@ the sheet's surface is h_i from its mid-surface) with its plan gradient grad h_i
 mean of the cells' gradients of its linear interpolant, in the reference plan: the slopes of a
 mid-surface whose lower surface lies on a flat face), and the carrier slots a symmetry plane holds.
 A part of its own: it commits and checkpoints x_n and h_i.
+
+A node *held flat* between two faces (hold_flat: the holder's pinch) takes h_i and grad h_i from
+the cells around it that lie wholly between the faces, the material the faces hold, where it has
+any: at the pinch's edge the cells beyond it bend onto the die's shoulder and thin, and their
+average would dip the held node's surface by micrometres over one cell, a curvature ~ dh / h^2
+forced on the flat sheet that grows as the mesh is refined (docs/contact.md, "The flange's
+thickness at the pinch's edge").
 """
 
 import numpy as np
@@ -38,7 +45,8 @@ class SheetNodes(Part):
         self._cell_area = 0.5 * np.abs(np.linalg.det(self._edges))
         sums = self._cell_sums(self._cell_area / 3, self._cell_area**2 / 3)
         self.area, self.cell_size = sums[:, 0], np.sqrt(2.0 * sums[:, 1] / sums[:, 0])
-        self._set_thickness(self._half_thickness())
+        self.flat = np.zeros(self.n_owned, dtype=bool)
+        self._set_thickness()
         self.q = None
         self.x_n = self.X[: self.n_owned].copy()
 
@@ -59,48 +67,74 @@ class SheetNodes(Part):
         return self.q.x.array.reshape(-1, BS)[: self.n_owned, W_SLOPES]
 
     def _cell_sums(self, *values) -> np.ndarray:
-        """(n_owned, len(values)): per node the sum over the cells around it of each cell array
-        in `values` (all ranks' cells)."""
+        """(n_owned, len(values)): per node the sum over the cells around it of each array in
+        `values`, per cell or per cell and vertex (cells, 3) (all ranks' cells)."""
         f = fem.Function(self.model.V)
         arr = f.x.array.reshape(-1, BS)
         for col, v in enumerate(values):
-            np.add.at(arr[:, col], self.model.dofs.ravel(), np.repeat(v, 3))
+            v = np.asarray(v, dtype=float)
+            np.add.at(arr[:, col], self.model.dofs.ravel(), (v if v.ndim == 2 else np.repeat(v[:, None], 3, axis=1)).ravel())
         f.x.scatter_reverse(la.InsertMode.add)
         return arr[: self.n_owned, : len(values)].copy()
 
-    def _half_thickness(self) -> np.ndarray:
-        """t/2 exp(e33) with e33 the area-weighted thickness strain of the cells around each node."""
-        m = self.model
-        if not m.plastic:
-            return np.full(self.n_owned, 0.5 * m.thickness)
-        e33 = self._cell_sums(self._cell_area / 3 * m.thickness_strain())[:, 0] / self.area
-        return 0.5 * m.thickness * np.exp(e33)
-
-    def _set_thickness(self, half: np.ndarray) -> None:
-        """The half thickness and the slopes of a mid-surface a half thickness above a flat face."""
-        self.half_thickness = half
-        self.surface_slopes = self.gradient(half)
-
-    def gradient(self, values: np.ndarray) -> np.ndarray:
-        """(n_owned, 2): the area-weighted mean over the cells around each node of the plan
-        gradient of the linear interpolant of the owned nodes' `values`."""
+    def _at_vertices(self, values: np.ndarray) -> np.ndarray:
+        """(cells, 3): the owned nodes' `values` at each cell's vertices (ghosts' from their owners)."""
         f = fem.Function(self.model.V)
         arr = f.x.array.reshape(-1, BS)
         arr[: self.n_owned, 0] = values
-        f.x.scatter_forward()  # the ghosts' values
-        v = arr[:, 0][self.model.dofs.reshape(-1, 3)]
+        f.x.scatter_forward()
+        return arr[:, 0][self.model.dofs.reshape(-1, 3)]
+
+    def hold_flat(self, held: np.ndarray) -> None:
+        """The owned nodes held flat between two faces (module docstring); their surface follows
+        at the next commit."""
+        self.flat = np.asarray(held, dtype=bool).copy()
+
+    def _weights(self) -> np.ndarray:
+        """(cells, 3): the area with which each cell counts at each of its vertices: its area,
+        but 0 at a node held flat when the cell does not lie wholly between the faces and the
+        node has a cell that does."""
+        held = self._at_vertices(self.flat.astype(float)) > 0.5
+        between = held.all(axis=1)
+        a = np.repeat(self._cell_area[:, None], 3, axis=1)
+        inner = self._cell_sums(np.where(between[:, None], a, 0.0))[:, 0] > 0.0
+        keep = ~(held & ~between[:, None] & (self._at_vertices(inner.astype(float)) > 0.5))
+        return np.where(keep, a, 0.0)
+
+    def _set_thickness(self, half: np.ndarray | None = None) -> None:
+        """The half thickness (given, or t/2 exp(e33) with e33 the thickness strain of the cells
+        around each node, weighted by _weights) and the slopes of a mid-surface a half thickness
+        above a flat face."""
+        m, w = self.model, self._weights()
+        if half is None and not m.plastic:
+            half = np.full(self.n_owned, 0.5 * m.thickness)
+        elif half is None:
+            sums = self._cell_sums(w * m.thickness_strain()[:, None], w)
+            half = 0.5 * m.thickness * np.exp(sums[:, 0] / sums[:, 1])
+        self.half_thickness = half
+        self.surface_slopes = self.gradient(half, w)
+
+    def gradient(self, values: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
+        """(n_owned, 2): the mean over the cells around each node of the plan gradient of the
+        linear interpolant of the owned nodes' `values`, weighted by the cells' areas (or by
+        `weights`, (cells, 3))."""
+        v = self._at_vertices(values)
         g = np.linalg.solve(self._edges, np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=1)[..., None])[..., 0]
-        sums = self._cell_sums(self._cell_area, self._cell_area * g[:, 0], self._cell_area * g[:, 1])
+        w = np.repeat(self._cell_area[:, None], 3, axis=1) if weights is None else weights
+        sums = self._cell_sums(w, w * g[:, 0:1], w * g[:, 1:2])
         return sums[:, 1:] / sums[:, :1]
 
     def commit(self, lam: float) -> None:
         self.x_n = self.positions()
         if self.model.plastic:
-            self._set_thickness(self._half_thickness())
+            self._set_thickness()
 
     def checkpoint(self) -> dict:
-        return {"nodes": {"contact_x_n": self.x_n, "contact_half_thickness": self.half_thickness}}
+        return {"nodes": {"contact_x_n": self.x_n, "contact_half_thickness": self.half_thickness,
+                          "contact_flat": self.flat}}
 
     def restore(self, state: dict, lam_scale: float) -> None:
-        self.x_n = state["nodes"]["contact_x_n"].copy()
-        self._set_thickness(state["nodes"]["contact_half_thickness"].copy())
+        nodes = state["nodes"]
+        self.x_n = nodes["contact_x_n"].copy()
+        self.flat = nodes["contact_flat"].astype(bool)
+        self._set_thickness(nodes["contact_half_thickness"].copy())

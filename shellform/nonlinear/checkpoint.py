@@ -31,7 +31,7 @@ from shellform.errors import InputError
 from shellform.results.tables import sync_folder, write_atomically
 
 CURRENT, PREVIOUS = "checkpoint.npz", "checkpoint.previous.npz"
-FORMAT = 2  # 1: last_converged.rank*.npz, one per rank
+FORMAT = 3  # 1: last_converged.rank*.npz, one per rank; 2: without the nodes held flat
 GROUPS = ("nodes", "cells", "global")
 
 
