@@ -32,12 +32,13 @@ def test_cup_without_a_holder_force_draws(force):
 
 def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
     """A light holder (400 N) cannot hold the pinch's edge: riding on it would lift it by more
-    than the contact tolerance (pinch_edge.EdgeLoad.riding_lift), so it opens at the first
-    increment and stays open to 4 mm, a rigid face at its own lift (within the tolerance, 1 % of
-    t, of its closed position: micrometres), solved with the sheet in each Newton iteration: its
-    nodes' forces sum to F (to Newton's tolerance), no node under it passes its face, the tools
-    balance to Newton's tolerance, and Newton's last pass converges fast (each step at least 5 times smaller, from
-    its second iterate) in at most 4 iterations."""
+    than the contact tolerance (pinch_edge.EdgeLoad.riding_lift, 1.7 mm), so it opens at the
+    first increment and stays open to 4 mm, a rigid face at its own lift, solved with the sheet in
+    each Newton iteration: the flange turning onto the shoulder tilts and lifts it (0.56 mm at
+    4 mm), never by more than riding on the edge would; its nodes' forces sum to F (to Newton's
+    tolerance), no node under it passes its face, the tools balance to Newton's tolerance, and
+    Newton's last pass converges fast (each step at least 5 times smaller, from its second
+    iterate) in at most 4 iterations."""
     s = square_cup(blank_holder_force=400.0)
     p = DrawingProblem.from_scene(s, verbose=False)
     F = s.tools.blank_holder_force
@@ -53,11 +54,12 @@ def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
         # the tools balance to Newton's tolerance (rtol of the residual's scale, per quarter)
         assert p.force_balance() * p.punch_force() <= 4 * d.controls.rtol * d.scale
         assert p.max_penetration() <= tol  # the open face included
-        assert abs(p.holder_lift()) < tol and p.in_contact()["holder"] > 0
+        assert -tol < p.holder_lift() <= h.edge_law.riding_lift(F / edge) and p.in_contact()["holder"] > 0
         last = d.pass_residuals[-1][1:]
         assert len(last) <= 5 and all(b <= a / 5 for a, b in zip(last, last[1:]))
 
     p.driver.run(4.0 / s.tools.stroke, on_increment=check)
+    assert p.holder_lift() > 10 * tol  # lifted by the tilted flange, not held at micrometres
     assert p.stroke == pytest.approx(4.0)
 
 
@@ -113,8 +115,11 @@ def test_the_pinch_holds_the_slopes_of_a_mid_surface_on_the_die():
     assert np.abs(start).max() > 1e-8
     p.driver.run(1.2 / s.tools.stroke)
     pinched = p.driver.holder.pinched
-    assert pinched.sum() > 0
-    assert np.abs(n.slopes()[pinched] - start[pinched]).max() <= p.driver.contact.known_tolerance  # met as known values are
+    held = n.interior(pinched)
+    edge = pinched & ~held  # the pinch's boundary: a cell reaches beyond the faces, the slopes are the sheet's
+    assert held.sum() > 0 and edge.sum() > 0
+    assert np.abs(n.slopes()[held] - start[held]).max() <= p.driver.contact.known_tolerance  # met as known values are
+    assert np.abs(n.slopes()[edge] - start[edge]).max() > 1e-2  # turning onto the shoulder
 
 
 def test_a_node_held_flat_takes_the_thickness_of_the_material_between_the_faces():

@@ -44,8 +44,10 @@ above the node's own top when the node is on the die); with "rigid" it is flat. 
 closes again when its lift falls to that closed position and it could ride there. With F = 0
 there is no holder.
 
-The holder's faces hold the flange flat: under the closed holder the pinched nodes' w and
-slopes are known, under the open one the slopes of every node beneath it. The pinched set only
+The holder's faces hold the flange flat: under the closed holder the pinched nodes' w is known,
+and their slopes where the faces hold the node's every cell (not on the pinch's boundary, where
+a cell reaches beyond the faces and the sheet turns within it); under the open one the slopes of
+every node beneath it but its boundary. The pinched set only
 grows within an increment (a node drawn out from under the holder leaves at the next one), so
 that a node at the holder's edge cannot switch from one pass to the next. The holder switches
 (opens or closes) at most `max_toggles` times per increment. Its state machine runs in the
@@ -100,6 +102,7 @@ class PinchingHolder(Part):
         self.edge_law = edge
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
+        self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
         self.contact = self.friction = None
         self._dlift, self._lift0 = 0.0, 0.0
         self.committed = None
@@ -241,7 +244,9 @@ class PinchingHolder(Part):
         self.pinched = (self.pinched | now) if grow else now
         self.pinched &= self.closed & on_die
         self.under_now = (self.under_now | under) if grow else under.copy()
-        self.nodes.hold_flat(self.flat())
+        flat = self.flat()
+        self.nodes.hold_flat(flat)
+        self.sloped = self.nodes.interior(flat)
 
     def flat(self) -> np.ndarray:
         """The nodes the faces hold flat: the pinched ones, and under the open holder every node
@@ -338,15 +343,18 @@ class PinchingHolder(Part):
         self.pinch(self.under(self.nodes.x_n), self.contact, grow=False)
 
     def constrain(self, c, lam: float) -> None:
-        """The holder's flat faces hold the flange flat: the slopes of w are known on the
-        pinched nodes, and on every node under the open holder (on a face or between them);
-        they stay known (and the pinched nodes' w) within the increment. Flat is the lower
+        """The holder's flat faces hold the flange flat: the slopes of w are known on the nodes
+        they hold flat (the pinched ones, every node under the open holder) but for the
+        boundary of that region, where a cell reaches beyond the faces: the sheet turns within
+        that cell, and held flat at its node it would turn a cell inside the edge, at a place that
+        jumps by a cell each time a row of nodes is drawn out (a sawtooth in the punch force,
+        docs/contact.md). They stay known (and the pinched nodes' w) within the increment. Flat is the lower
         surface: the mid-surface lies a half thickness above the die, so its slopes are the half
         thickness's gradient (SheetNodes.surface_slopes), not zero: zero slopes under a w that
         follows the thickness kink the sheet at every node, with curvatures ~ dh / h^2 that grow
         as the mesh is refined. The thickness of a node held flat is that of the material between
         the faces (SheetNodes.hold_flat), not of the cells bent beyond the pinch's edge."""
-        flat = self.flat()
+        flat = self.sloped
         c.known[flat, W_SLOPES] = (self.nodes.surface_slopes - self.nodes.slopes())[flat]
         c.flags[flat, W_SLOPES] = True
         c.stable[flat, W_SLOPES] = True

@@ -90,6 +90,13 @@ class SheetNodes(Part):
         at the next commit."""
         self.flat = np.asarray(held, dtype=bool).copy()
 
+    def interior(self, region: np.ndarray) -> np.ndarray:
+        """The owned nodes of `region` (a mask) whose cells all lie wholly in it: the region less
+        its boundary, the nodes with a cell that reaches outside."""
+        inside = self._at_vertices(np.asarray(region, dtype=float)) > 0.5
+        reaches_out = inside & ~inside.all(axis=1)[:, None]
+        return np.asarray(region, dtype=bool) & ~(self._cell_sums(reaches_out.astype(float))[:, 0] > 0.0)
+
     def _weights(self) -> np.ndarray:
         """(cells, 3): the area with which each cell counts at each of its vertices: its area,
         but 0 at a node held flat when the cell does not lie wholly between the faces and the
