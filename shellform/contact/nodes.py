@@ -90,6 +90,21 @@ class SheetNodes(Part):
         at the next commit."""
         self.flat = np.asarray(held, dtype=bool).copy()
 
+    def current_area(self) -> np.ndarray:
+        """(n_owned,): a third of the current plan area of each cell around each node."""
+        x = self.local_positions()[:, :2][self.model.dofs.reshape(-1, 3)]
+        e1, e2 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
+        a = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        return self._cell_sums(a / 3)[:, 0]
+
+    def spread(self, values: np.ndarray) -> np.ndarray:
+        """(n_owned,): the area-weighted mean over the cells around each node of the spread
+        (largest minus smallest) of the owned nodes' `values` over the cell's vertices: of a
+        distance to a line, the spacing of the rows of nodes along it."""
+        v = self._at_vertices(values)
+        sums = self._cell_sums(self._cell_area * (v.max(axis=1) - v.min(axis=1)), self._cell_area)
+        return sums[:, 0] / sums[:, 1]
+
     def interior(self, region: np.ndarray) -> np.ndarray:
         """The owned nodes of `region` (a mask) whose cells all lie wholly in it: the region less
         its boundary, the nodes with a cell that reaches outside."""

@@ -26,10 +26,11 @@ force per unit length V_e from it, and that moment M_e, for the scene's sheet an
 own compliance would widen the band and lower V_e: rigid tools give the largest edge load.
 
 No mesh of a cup resolves 1.7 t, so the edge load is lumped (holder.py): the holder's face presses
-the pinched nodes within b = 2 h of its inner edge with V_e A_i j_i (2 / b) sin^2(pi s / b), s the
-node's plan distance from the edge, h the local cell size, j the edge's length per unit length of
-the offset line through the node (1 beside a straight edge): a kernel whose sum over rows of nodes
-h apart is 1 for any offset of the rows, so the edge's total is V_e times its length on every mesh.
+the pinched nodes within b = 2 r of its inner edge with V_e a_i j_i (2 / b) sin^2(pi s / b), s the
+node's plan distance from the edge, a its current plan area, r the current spacing of its rows
+along s, j the edge's length per unit length of the offset line through the node (1 beside a
+straight edge): a kernel whose sum over rows of nodes r apart is 1 for any offset of the rows, so
+the edge's total is V_e times its length on every mesh and however the flange has deformed.
 The holder rides on its edge while the lift that gives the edge less than V_e stays below the
 contact's tolerance (EdgeLoad.riding_lift); beyond, it opens.
 """
@@ -129,7 +130,8 @@ class Strip:
         M0 = abs(float(np.interp(0.0, x[1:-1], self.section(D2 @ w)[1])))
         Vh = float(np.sum(np.maximum(ph - self.p0, 0.0)) * hh)
         return {"h_mm": h, "Vh_N_per_mm": Vh, "M0_Nmm_per_mm": M0, "Vh_t_over_M0": Vh * self.t / M0,
-                "C_EDGE": C_EDGE, "peak_holder_MPa": float(ph.max()), "newton": it}
+                "C_EDGE": C_EDGE, "peak_holder_MPa": float(ph.max()), "newton": it,
+                "depth_mm": -x[under][::-1], "holder_MPa": np.maximum(ph - self.p0, 0.0)[under][::-1]}
 
 
 @dataclass(frozen=True)
@@ -165,7 +167,8 @@ def edge_load(material, thickness: float, die, holder) -> EdgeLoad:
 
 
 def edge_weights(s: np.ndarray, h: np.ndarray) -> np.ndarray:
-    """(2 / b) sin^2(pi s / b) for 0 <= s < b = 2 h, else 0 (1/mm): the band's kernel."""
+    """(2 / b) sin^2(pi s / b) for 0 <= s < b = 2 h, else 0 (1/mm): the band's kernel over rows of
+    nodes h apart."""
     b = 2.0 * h
     inside = (s >= 0.0) & (s < b)
     return np.where(inside, 2.0 / b * np.sin(np.pi * np.clip(s / b, 0.0, 1.0)) ** 2, 0.0)
