@@ -7,7 +7,7 @@ A material travels to the numba functions as one packed float64 array ``mat`` (s
                   4 Swift-Voce, 5 table (shellform.material.hardening states each law and its
                   parameters H_ ...)
     H_ .. H_+NH   the hardening law's parameters (A_, B_, C_ the first three)
-    CRITERION_    the yield function's id (shellform.material.criteria: its place in CRITERIA)
+    CRITERION_    the yield function's id (shellform.material.criteria: its place in REGISTRY)
     COS_, SIN_    cos and sin of the rolling direction's angle theta from the x axis
     ROTATED_      1.0 where the return mapping turns strains into the rolling-direction axes
                   (theta not a multiple of 180 degrees, a criterion that is not planar
@@ -16,9 +16,10 @@ A material travels to the numba functions as one packed float64 array ``mat`` (s
     TABLE_ ..     a tabulated flow curve: its number of points N + 1, p_0..p_N, sigma_0..sigma_N
                   (shellform.material.flow_curve; the array ends there, 1 + 0 points without one)
 
-The yield function, its parameters and its derivatives live in one file each (hill79, ...);
-the return mapping (plane_stress) is written once for all of them; section integrates the
-layers through the thickness; point drives a material point for tests and studies.
+The yield function, its parameters and its derivatives live in one file each (hill79, ...),
+registered by its name in shellform.material.criteria.REGISTRY; the return mapping
+(plane_stress) is written once for all of them; section integrates the layers through the
+thickness; point drives a material point for tests and studies.
 """
 
 from dataclasses import dataclass, field

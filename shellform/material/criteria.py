@@ -1,8 +1,10 @@
-"""The registered yield functions and the dispatch the return mapping calls.
+"""The registry of yield functions and the dispatch the return mapping calls.
 
-A yield function is one file in shellform/material/ holding
+A yield function is one module of shellform/material/ that declares everything about itself:
 
     NAME                      its name in a scene (material.yield_function)
+    PARAMETERS                its [material] keys in a scene (shellform.scene.schema.YIELD_PARAMETERS
+                              is read from here; every key is a field of schema.Material)
     PLANAR_ISOTROPIC          True where the rolling direction changes nothing (the return
                               mapping then does not turn into its axes)
     parameters(values)        its parameters from the material's keys, validated (InputError
@@ -11,25 +13,63 @@ A yield function is one file in shellform/material/ holding
                               rolling-direction axes, and for order > 0 its gradient (3)
                               and Hessian (6, upper triangle), as one 10-tuple
 
-It is registered here: its module in CRITERIA (its id is its place there) and one line in
-``yield_function`` below, in the same order; its scene keys go to YIELD_PARAMETERS in
-shellform/scene/schema.py. numba compiles the dispatch into a switch on the packed
+Registering it is one line: its module's name in REGISTRY. Its id (the packed
+mat[CRITERION_]) is its place there; CRITERIA maps the NAMEs to the modules in that order.
+
+The dispatch ``yield_function`` is generated from REGISTRY (``dispatch_source``): a chain of
+``if c == i: return criterion_i.yield_function(...)`` for the ids 1, 2, ..., the first
+registered (id 0, Hill 1979) the fall-through. numba compiles it into a switch on the packed
 id; each criterion's yield_function is declared inline="always" (numba IR inlining) and so
-inlined into its branch (docs/material.md: cost).
+inlined into its branch (docs/material.md: cost), and the dispatch is inline="always" too, so
+the return mapping holds the switch itself, as it would hold a hand-written one. Its code is
+compiled with this file's name: numba caches it with the package's other numba code (the
+cache folder is keyed by the sources of shellform/material, this registry among them).
 """
 
-from shellform.material import CRITERION_, hill48, hill79, yld2000
+import importlib
+
+from shellform.material import CRITERION_
 from shellform import _jit as jit
 
-CRITERIA = {m.NAME: m for m in (hill79, hill48, yld2000)}  # name -> module; the id of each is its place here
+REGISTRY = ("hill79", "hill48", "yld2000")  # modules of shellform.material; the id of each is its place here
+
+DECLARES = ("NAME", "PARAMETERS", "PLANAR_ISOTROPIC", "parameters", "yield_function")
 
 
-@jit.njit(inline="always")
-def yield_function(s0, s1, s2, mat, order):
-    """sigma_bar(s) and (order > 0) its derivatives, of the packed material's criterion."""
-    c = mat[CRITERION_]
-    if c == 1.0:
-        return hill48.yield_function(s0, s1, s2, mat, order)
-    if c == 2.0:
-        return yld2000.yield_function(s0, s1, s2, mat, order)
-    return hill79.yield_function(s0, s1, s2, mat, order)
+def _checked(modules: tuple) -> dict:
+    """name -> module, in registry order; TypeError where a module misses a declaration or a
+    name is registered twice (an error of the code, not of a scene)."""
+    for m in modules:
+        missing = [d for d in DECLARES if not hasattr(m, d)]
+        if missing:
+            raise TypeError(f"yield function {m.__name__} does not declare {', '.join(missing)}")
+    names = [m.NAME for m in modules]
+    if len(set(names)) != len(names):
+        raise TypeError(f"a yield function's NAME is registered twice: {names}")
+    return {m.NAME: m for m in modules}
+
+
+MODULES = tuple(importlib.import_module(f"{__package__}.{name}") for name in REGISTRY)
+CRITERIA = _checked(MODULES)  # NAME -> module, in registry order
+
+
+def dispatch_source(modules: tuple) -> str:
+    """The Python source of the dispatch over `modules` (module i as the global criterion_i)."""
+    lines = ["def yield_function(s0, s1, s2, mat, order):",
+             '    """sigma_bar(s) and (order > 0) its derivatives, of the packed material\'s criterion."""',
+             "    c = mat[CRITERION_]"]
+    for i in range(1, len(modules)):
+        lines += [f"    if c == {float(i)!r}:", f"        return criterion_{i}.yield_function(s0, s1, s2, mat, order)"]
+    lines.append("    return criterion_0.yield_function(s0, s1, s2, mat, order)")
+    return "\n".join(lines) + "\n"
+
+
+def _dispatch(modules: tuple):
+    """The dispatch over `modules`, compiled by numba (inline="always", cached)."""
+    namespace = {"__name__": __name__, "CRITERION_": CRITERION_}
+    namespace.update({f"criterion_{i}": m for i, m in enumerate(modules)})
+    exec(compile(dispatch_source(modules), __file__, "exec"), namespace)
+    return jit.njit(inline="always")(namespace["yield_function"])
+
+
+yield_function = _dispatch(MODULES)

@@ -34,6 +34,7 @@ NAME = "hill48"
 PLANAR_ISOTROPIC = False  # the rolling direction matters: the return mapping turns into its axes
 LANKFORD = ("r0", "r45", "r90")
 STRESSES = ("sigma0", "sigma45", "sigma90", "sigma_b")
+PARAMETERS = LANKFORD + STRESSES  # its scene keys: one set or the other
 
 
 def coefficients(values: dict) -> tuple[float, float, float, float]:

@@ -30,6 +30,7 @@ from shellform.material import PAR_, number, require
 from shellform import _jit as jit
 
 NAME = "hill79"
+PARAMETERS = ("r", "m")  # its scene keys (material.r, material.m)
 PLANAR_ISOTROPIC = True  # the rolling direction changes nothing: the map need not turn
 EPS2 = 1.0e-24  # eps^2 of the regularisation above
 

@@ -46,6 +46,8 @@ from shellform import _jit as jit
 
 NAME = "yld2000"
 PLANAR_ISOTROPIC = False  # the rolling direction matters: the return mapping turns into its axes
+FIT_DATA = ("r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b")  # what ``fit`` takes
+PARAMETERS = ("alpha", "a") + FIT_DATA  # its scene keys: alpha or the data to fit them, and a
 EPS2 = 1.0e-24
 
 
@@ -200,8 +202,6 @@ def uniaxial_and_biaxial(alpha, a) -> dict:
     out["sigma_b"], out["r_b"] = 1.0 / sb, a1 / a0
     return out
 
-
-FIT_DATA = ("r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b")
 
 
 def fit(data: dict, a: float) -> list[float]:
