@@ -15,9 +15,10 @@ from shellform.mesh import outline
 from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
-from shellform.scene.schema import (ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS, DIAGONALS, HARDENING,
-                                    MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
-                                    NONLINEAR_SUPPORTS, REGIONS, SIDES, SUPPORTS, Scene, bounds)
+from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
+                                    DIAGONALS, HARDENING, MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS,
+                                    MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, REGIONS, SIDES, SUPPORTS, Scene,
+                                    bounds)
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
@@ -148,9 +149,9 @@ def _validate_material(s: Scene) -> None:
             f"must be one of {', '.join(YIELD_FUNCTIONS)}, got {mat.yield_function!r}")
     require(math.isfinite(mat.rolling_direction), "material.rolling_direction",
             f"must be finite (degrees), got {mat.rolling_direction}")
-    for name in ANISOTROPY_PARAMETERS + ("alpha",):
+    for name in ANISOTROPY_PARAMETERS + ANISOTROPY_LISTS:
         v = getattr(mat, name)
-        if name != "alpha":
+        if name in ANISOTROPY_PARAMETERS:
             require(math.isfinite(v) and v >= 0.0, f"material.{name}", f"must be > 0 (0: unset), got {v}")
         require(not v or name in YIELD_PARAMETERS[mat.yield_function], f"material.{name}",
                 f"is no parameter of yield_function = {mat.yield_function!r} "

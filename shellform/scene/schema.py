@@ -12,15 +12,16 @@ scene is a new one, made by ``Scene.changed`` and checked again. See docs/scenes
 """
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 from shellform import effects as registry
+from shellform.material import SheetMaterial, criteria
 from shellform.mesh import outline
 
 __all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS",
            "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
-           "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS",
+           "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS", "ANISOTROPY_LISTS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
            "Drawbead", "ToolsSpec", "Probe", "Output", "Scene", "bounds"]
 
@@ -45,12 +46,8 @@ CIRCLE_REGIONS = ("full", "half", "quarter")
 MESH_KINDS = ("structured", "unstructured")
 DIAGONALS = ("right", "left", "crossed", "right/left", "left/right")
 HARDENING = ("none", "power", "swift", "voce", "swift_voce", "table")
-ANISOTROPY_PARAMETERS = ("r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b", "a")  # 0: unset
-YIELD_PARAMETERS = {  # the [material] keys of each yield function (shellform.material.criteria.CRITERIA)
-    "hill79": ("r", "m"),
-    "hill48": ("r0", "r45", "r90", "sigma0", "sigma45", "sigma90", "sigma_b"),
-    "yld2000": ("alpha", "a", "r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b"),
-}
+# the [material] keys of each yield function, as its file declares them (shellform.material.criteria)
+YIELD_PARAMETERS = {name: criterion.PARAMETERS for name, criterion in criteria.CRITERIA.items()}
 YIELD_FUNCTIONS = tuple(YIELD_PARAMETERS)
 CURVE_PARAMETERS = {"none": (), "power": ("yield_stress", "n"), "swift": ("K", "eps0", "n"),
                     "voce": ("yield_stress", "Q", "beta"),
@@ -115,6 +112,15 @@ class Material:
     sigma_b: float = 0.0
     alpha: list[float] = field(default_factory=list, metadata={"items": "numbers"})  # yld2000: alpha1..alpha8
     a: float = 0.0  # yld2000: the exponent (6 bcc, 8 fcc; >= 2)
+
+
+# The yield functions' keys beyond Hill 1979's r and m (which SheetMaterial takes itself): the
+# numbers (0: unset) and the lists (empty: unset) that Scene.hill79 passes as yield_parameters,
+# in Material's order.
+_CRITERION_KEYS = {k for keys in YIELD_PARAMETERS.values() for k in keys} - {"r", "m"}
+ANISOTROPY_PARAMETERS = tuple(f.name for f in fields(Material) if f.name in _CRITERION_KEYS and f.type is float)
+ANISOTROPY_LISTS = tuple(f.name for f in fields(Material)
+                         if f.name in _CRITERION_KEYS and getattr(f.type, "__origin__", None) is list)
 
 
 @dataclass
@@ -295,8 +301,6 @@ class Scene:
         """The scene's shellform.material.SheetMaterial (its yield function, Hill 1979 by default):
         elastic (hardening "none") unless the effect 'plasticity' is on. Its own validation names
         the field (material.yield_stress, material.r0, ...)."""
-        from shellform.material import SheetMaterial  # numba modules: imported only when needed
-
         mat = self.material
         if "plasticity" not in self.effects:
             return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
@@ -304,8 +308,7 @@ class Scene:
         # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
         n = unset(mat.n) if mat.hardening == "power" else mat.n
         given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
-        if mat.alpha:
-            given["alpha"] = list(mat.alpha)
+        given.update({k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)})
         table = None
         if mat.hardening == "table" and mat.flow_curve:
             from shellform.material.flow_curve import read_csv
