@@ -5,10 +5,14 @@ registration of the yield functions; input errors naming the field."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
+import dataclasses
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
-from shellform import scene
+import shellform.material
+from shellform import effects, scene
 from shellform.errors import InputError
 from shellform.material import CRITERION_
 from shellform.material import (
@@ -106,6 +110,34 @@ def test_each_registered_criterion_is_dispatched_to_its_file():
         own = criteria.CRITERIA[name].yield_function(*s, mat, 2)
         assert criteria.yield_function(*s, mat, 2) == own
         assert mat[CRITERION_] == list(criteria.CRITERIA).index(name)
+
+
+def test_the_dispatch_is_generated_from_the_registry():
+    """criteria.dispatch_source over n modules, run as plain Python over stand-ins: every id
+    0..n-1 reaches its own module (id 0 the fall-through); the registry's modules are those
+    REGISTRY names."""
+    stand_ins = tuple(SimpleNamespace(yield_function=lambda *args, i=i: i) for i in range(5))
+    namespace = {"CRITERION_": CRITERION_, **{f"criterion_{i}": m for i, m in enumerate(stand_ins)}}
+    exec(criteria.dispatch_source(stand_ins), namespace)
+    mat = np.zeros(CRITERION_ + 1)
+    for i in range(len(stand_ins)):
+        mat[CRITERION_] = float(i)
+        assert namespace["yield_function"](0.0, 0.0, 0.0, mat, 2) == i
+    assert criteria.MODULES == tuple(getattr(shellform.material, name) for name in criteria.REGISTRY)
+
+
+def test_the_scene_keys_of_each_criterion_come_from_its_file():
+    """The scene's yield functions and their keys are the registered files' NAME and PARAMETERS;
+    every key is a field of [material] that takes its meaning with the effect 'anisotropy'."""
+    assert scene.YIELD_FUNCTIONS == tuple(criteria.CRITERIA) == tuple(m.NAME for m in criteria.MODULES)
+    assert scene.YIELD_PARAMETERS == {m.NAME: m.PARAMETERS for m in criteria.MODULES}
+    material_fields = {f.name for f in dataclasses.fields(scene.Material)}
+    anisotropy_keys = effects.EFFECTS["anisotropy"].keys
+    for m in criteria.MODULES:
+        for key in m.PARAMETERS:
+            assert key in material_fields, (m.NAME, key)
+            assert f"material.{key}" in anisotropy_keys, (m.NAME, key)
+            assert key in ("r", "m") or key in scene.ANISOTROPY_PARAMETERS + scene.ANISOTROPY_LISTS, (m.NAME, key)
 
 
 DIRECTIONS = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [1.0, -0.3, 0.8],
