@@ -25,10 +25,12 @@ EY = SY / E
 STEEL = {"r0": 1.79, "r45": 1.51, "r90": 2.27}  # NUMISHEET'93 mild steel
 ALUMINIUM = {"r0": 0.71, "r45": 0.58, "r90": 0.70}
 ANGLES = range(0, 91, 15)
-# Barlat et al. 2003, AA2090-T3: the published alpha1..alpha8 (a = 8) and the eight data they
-# were fitted to (sigma over sigma0; r_b = dep22/dep11 in balanced biaxial tension)
+# Barlat et al. 2003, AA2090-T3: the published alpha1..alpha8 (a = 8; as JANCAE's UMMDp and
+# youngung/abaqusPy quote them) and the eight experimental data (sigma over sigma0; r_b =
+# dep22/dep11 in balanced biaxial tension) as stefanSCS/Poly6 matAA2090T3.txt and
+# yossy11/Subroutines Datas/AA2090-T3.csv tabulate them
 AA2090 = [0.4865, 1.3783, 0.7536, 1.0246, 1.0363, 0.9036, 1.2321, 1.4858]
-AA2090_DATA = {"sigma0": 1.0, "sigma45": 0.8110, "sigma90": 0.9102, "sigma_b": 1.0350,
+AA2090_DATA = {"sigma0": 1.0, "sigma45": 0.8114, "sigma90": 0.9102, "sigma_b": 1.0350,
                "r0": 0.2115, "r45": 1.5769, "r90": 0.6923, "r_b": 0.6700}
 
 
