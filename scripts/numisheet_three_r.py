@@ -5,9 +5,10 @@ values").
     python scripts/numisheet_three_r.py N STROKE [STROKE ...]
 
 demos/numisheet93_steel.toml with mesh.n = N drawn to each STROKE (mm) in turn, three times: as
-it is (Hill 1979, m = 2, r = 1.77 = (r0 + 2 r45 + r90)/4), with Hill 1948 from r0 = r45 =
-r90 = 1.77 (the same material written as Hill 1948: a control), and with Hill 1948 from
-r0 = 1.79, r45 = 1.51, r90 = 2.27; the rolling direction along x, the flow curve the rolling
+Hill 1979 (m = 2, r = 1.77 = (r0 + 2 r45 + r90)/4, the scene's model before it took the three
+values), with Hill 1948 from r0 = r45 = r90 = 1.77 (the same material written as Hill 1948: a
+control), and with Hill 1948 from r0 = 1.79, r45 = 1.51, r90 = 2.27 (the scene as it is); the
+rolling direction along x, the flow curve the rolling
 direction's. Per run and stroke: DX, DY, DD, DX - DY, the punch force, the peak thickness strain,
 increments, iterations and the wall time so far.
 """
@@ -28,7 +29,8 @@ def hill48(r0, r45, r90):
 
 n, strokes = int(sys.argv[1]), [float(a) for a in sys.argv[2:]]
 base = scene.load("demos/numisheet93_steel.toml").changed({"mesh.n": n, "process.report": []})
-runs = {"Hill 1979, r 1.77": {}, "Hill 1948, r 1.77 / 1.77 / 1.77": hill48(1.77, 1.77, 1.77),
+runs = {"Hill 1979, r 1.77": {"material.yield_function": "hill79", "material.r": 1.77, "material.m": 2.0,
+                               "material.r0": 0.0, "material.r45": 0.0, "material.r90": 0.0}, "Hill 1948, r 1.77 / 1.77 / 1.77": hill48(1.77, 1.77, 1.77),
         "Hill 1948, r 1.79 / 1.51 / 2.27": hill48(1.79, 1.51, 2.27)}
 for name, changes in runs.items():
     p = DrawingProblem.from_scene(base.changed(changes), verbose=False)

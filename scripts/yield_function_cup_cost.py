@@ -6,6 +6,8 @@
 """
 import sys, json, time
 from shellform import scene, run
+h79 = {"material.yield_function": "hill79", "material.r": 0.6425, "material.m": 2.0,
+       "material.r0": 0.0, "material.r45": 0.0, "material.r90": 0.0}
 h48 = {"material.yield_function": "hill48", "material.r": 1.0, "material.r0": 0.71, "material.r45": 0.58, "material.r90": 0.70}
 y2k = {"material.yield_function": "yld2000", "material.r": 1.0, "material.r0": 0.71, "material.r45": 0.58,
        "material.r90": 0.70, "material.r_b": 1.0, "material.sigma0": 1.0, "material.sigma45": 1.0,
@@ -15,7 +17,7 @@ base = {"mesh.n": 35, "output.vtx": False, "output.vtu": False, "output.png": Fa
         "process.initial_step": 0.0015 * 40 / 3, "process.max_step": 0.006 * 40 / 3, "process.min_step": 1e-5 * 40 / 3}
 rows = []
 for rep in range(2):
-    for name, ch in (("hill79", {}), ("hill48", h48), ("yld2000", y2k)):
+    for name, ch in (("hill79", h79), ("hill48", h48), ("yld2000", y2k)):
         s = scene.load("demos/numisheet93_aluminium.toml").changed({**base, **ch})
         summ = run.run(s, f"/tmp/yield_function_cup_cost_{name}_{rep}")
         t = summ["wall_time_s"]
