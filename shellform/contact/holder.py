@@ -29,20 +29,10 @@ left to spread is S = F - E_in - f E_e >= 0. ``spread`` says how:
 The holder *opens* when the flange off the band pushes it up harder than F holds it down
 (E_in > F), or when riding on its edge would lift it by more than the tolerance: criteria on
 forces per unit length and a physical lift, not on the mesh. Open, it
-is still a rigid tool: a face lifted by `lift` above its closed position, with one unknown
-(the lift z_H) and one equation (its nodal forces sum to F), solved with the sheet in each
-Newton iteration as a bordered system, one more solve with the same factors:
-
-    dq = dq_a + dz_H dq_b,   dq_b the response to the holder's nodes lifted by 1,
-    dz_H = (F - sum p_i - sum (K dq_a)_i) / sum (K dq_b)_i   (sums over the holder's normal rows)
-
-F - sum p_i is the derivative of the energy with respect to the lift: it enters the residual's
-norm and the line search's energy slope. A node under it touches it, the die, or neither, and
-leaves the face it touches when its force turns tensile. With the "area" spread the lifted face conforms
-to the flange's thickness as the closed holder's pressure does (over each node it lies `lift`
-above the node's own top when the node is on the die); with "rigid" it is flat. The holder
-closes again when its lift falls to that closed position and it could ride there. With F = 0
-there is no holder.
+is still a rigid tool: a face whose lift is solved with the sheet (lifted_face.py). A node under
+it touches it, the die, or neither, and leaves the face it touches when its force turns tensile.
+The holder closes again when its lift falls to its closed position and it could ride there.
+With F = 0 there is no holder.
 
 The holder's faces hold the flange flat: under the closed holder the pinched nodes' w is known,
 and their slopes where the faces hold the node's every cell (not on the pinch's boundary, where
@@ -55,10 +45,9 @@ contact set's update (contact_set.py), whose tools its open face joins.
 """
 
 import numpy as np
-from dolfinx import fem
 from mpi4py import MPI
 
-from shellform.assembly.sheet_element import BS
+from shellform.contact.lifted_face import LiftedFace
 from shellform.contact.nodes import W_SLOPES
 from shellform.contact.pinch_edge import edge_weights
 from shellform.nonlinear.parts import Part
@@ -94,7 +83,8 @@ class PinchingHolder(Part):
         self.nodes, self.thickness, self.max_toggles, self.trace = nodes, thickness, max_toggles, trace
         self.area, self.k = np.asarray(nodes.area, dtype=float), np.asarray(stiffness, dtype=float)
         n = nodes.n_owned
-        self.closed, self.lift, self.toggles = False, 0.0, 0
+        self.closed, self.toggles = False, 0
+        self.lifted_face = LiftedFace(tool, force, thickness, spread, comm)
         self.pinched = np.zeros(n, dtype=bool)
         self.pinched_n = self.pinched.copy()  # of the last converged increment
         self.under_now = np.zeros(n, dtype=bool)  # under the holder in this increment (pinch)
@@ -104,12 +94,19 @@ class PinchingHolder(Part):
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
         self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
         self.contact = self.friction = None
-        self._dlift, self._lift0 = 0.0, 0.0
         self.committed = None
 
     def bind(self, driver) -> None:
-        V = driver.model.V
-        self._unit, self._response = fem.Function(V), fem.Function(V)  # the unit lift and its response
+        self.lifted_face.bind(driver.model.V)
+
+    @property
+    def lift(self) -> float:
+        """The open holder's lift above its closed position (mm)."""
+        return self.lifted_face.lift
+
+    @lift.setter
+    def lift(self, value: float) -> None:
+        self.lifted_face.lift = float(value)
 
     def compose(self, contact, friction) -> None:
         """The contact set whose die the holder pinches onto and whose tools its open face joins,
@@ -219,16 +216,11 @@ class PinchingHolder(Part):
         an infinite gap when the holder is closed or has no force."""
         if not self.is_open:
             return np.full(len(x), np.inf), np.tile([0.0, 0.0, -1.0], (len(x), 1))
-        offset = half if self.spread == "rigid" else self.thickness - half
-        return self.tool.gap(x, offset, self.lift)
+        return self.lifted_face.gap(x, half)
 
     def lift_floor(self, tops: np.ndarray) -> float:
-        """The closed position of the lift: 0 for the conforming face, the highest top (all
-        ranks, `tops` of the owned nodes on the die under it) above z_face for the flat one."""
-        if self.spread != "rigid":
-            return 0.0
-        top = self.comm.allreduce(float(np.max(tops, initial=-np.inf)), op=MPI.MAX)
-        return max(top - self.tool.z_face, 0.0)
+        """The closed position of the lift (LiftedFace.floor)."""
+        return self.lifted_face.floor(tops)
 
     def total(self, h: np.ndarray | None = None) -> float:
         """The holder's force on the sheet, all ranks (its face forces, or `h`)."""
@@ -374,43 +366,19 @@ class PinchingHolder(Part):
         return self.force - self._sum(self.contact.net_normal_forces()[on])
 
     def border(self, driver) -> float:
-        """The open holder's lift in this Newton iteration, solved with the sheet (module
-        docstring): dq (frame coordinates, from the solve) becomes dq_a + dz_H dq_b."""
-        self._lift0, self._dlift = self.lift, 0.0
-        if not self.is_open:
-            return 0.0
-        on, count = self.on_face()
+        """The open holder's lift in this Newton iteration, solved with the sheet
+        (LiftedFace.border); none while it is closed or touches nothing."""
+        on, count = self.on_face() if self.is_open else (None, 0)
         if count == 0:
+            self.lifted_face.hold()
             return 0.0
-        n = self.nodes.n_owned
-        rows = BS * np.flatnonzero(on) + 2  # their normal rows (the frame's normal points down)
-        unit = self._unit.x.array
-        unit[:] = 0.0
-        unit[rows] = -1.0  # the face up by 1: each node 1 up, -1 along its normal
-        self._unit.x.scatter_forward()
-        extra = None
-        if self.friction is not None and self.friction.slip_rows is not None:  # dp/dq on these known columns
-            coef, g = self.friction.slip_rows
-            Ku = driver.apply_tangent(unit)[: n * BS].reshape(-1, BS)[:, 2]
-            extra = np.zeros(n * BS)
-            extra.reshape(-1, BS)[:, :2] = (coef * Ku)[:, None] * g
-        if not driver.solve_lifted(unit, self._response, extra):
-            return np.nan
-        dqa, dqb = driver.dq.x.array, self._response.x.array
-        change = self.comm.allreduce(np.array([driver.apply_tangent(dqa)[rows].sum(),
-                                               driver.apply_tangent(dqb)[rows].sum()]), op=MPI.SUM)
-        dz = (self.imbalance() - change[0]) / change[1]
-        dqa += dz * dqb
-        driver.dq.x.scatter_forward()
-        self._dlift = float(dz)
-        return self._dlift
+        return self.lifted_face.border(driver, on, self.imbalance(), self.friction)
 
     def slope(self) -> float:
-        """The lift's share of the energy slope: dz_H (F - sum p)."""
-        return self._dlift * self.imbalance()
+        return self.lifted_face.slope(self.imbalance())
 
     def move(self, alpha: float) -> None:
-        self.lift = self._lift0 + alpha * self._dlift
+        self.lifted_face.move(alpha)
 
     def commit(self, lam: float) -> None:
         self.toggles = 0
