@@ -127,3 +127,5 @@ def test_cup_convergence_quick(tmp_path):
     dx = next(e for e in est if e["case"] == "aluminium" and e["answer"] == "DX_2")
     assert len(dx["values"].split()) == 3 and len(dx["differences"].split()) == 2
     assert (tmp_path / "cup_convergence.png").stat().st_size > 0
+    md = (tmp_path / "cup_convergence.md").read_text()
+    assert md.count("| n (cells) |") == 2 and md.count("| DX_2 |") == 2 and "| 8 (128) |" in md

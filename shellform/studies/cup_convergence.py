@@ -134,6 +134,39 @@ def estimates(rows: list[dict], reports) -> list[dict]:
     return out
 
 
+def _num(x, digits=3) -> str:
+    return "" if x is None or (isinstance(x, float) and np.isnan(x)) else f"{float(x):.{digits}f}"
+
+
+def markdown(rows: list[dict], ests: list[dict]) -> str:
+    """The runs' table and the estimates' table of each case, as docs/cup-convergence.md shows
+    them: draw-ins and force at the first and last report, peak thinning, the holder (opening,
+    largest share, edge load), the late force jump, iterations, cut-backs, wall time."""
+    text = []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        part = [r for r in rows if r["case"] == case]
+        first, last = (f"{x:g}" for x in (CASES[case][2][0], part[0]["stroke_mm"]))
+        text += [f"### {case}", "",
+                 f"| n (cells) | DX {first} | DD {first} | force {first} (kN) | DX {last} | DD {last} | force {last} (kN) "
+                 "| max thickness strain | holder opens at | largest share of F | edge load / F (start, peak) "
+                 "| late force jump | iterations, cut-backs | wall (s) |", "|" + "---|" * 14]
+        for r in part:
+            opens = f"{r['holder_opens_mm']:.1f} mm" if r["holder_opens_mm"] is not None else "never"
+            stopped = "" if r["finished"] else f" (stopped at {r['stroke_mm']:.1f} mm)"
+            text.append(f"| {r['n']} ({r['cells']:,}){stopped} | {_num(r.get('DX_' + first))} | {_num(r.get('DD_' + first))} "
+                        f"| {_num(r.get('force_' + first), 2)} | {_num(r.get('DX_' + last), 2)} | {_num(r.get('DD_' + last), 2)} "
+                        f"| {_num(r.get('force_' + last), 2)} | {_num(r['max_thickness_strain'])} | {opens} "
+                        f"| {_num(r['largest_share'])} | {_num(r['edge_load_start'])}, {_num(r['edge_load_peak'])} "
+                        f"| {100 * r['late_force_jump']:.1f} % | {r['newton_iterations']}, {r['cutbacks']} | {r['wall_s']:.0f} |")
+        text += ["", "| answer | values | successive differences | p | estimate +- uncertainty |", "|---|---|---|---|---|"]
+        for e in ests:
+            if e["case"] == case:
+                text.append(f"| {e['answer']} | {e['values']} | {e['differences']} | {_num(e['p'], 2) or 'none'} "
+                            f"| {_num(e['estimate'], 4) or 'none'} +- {_num(e['uncertainty'])} |")
+        text.append("")
+    return "\n".join(text)
+
+
 def plot(path: Path, rows: list[dict]) -> None:
     """DX, DD and the punch force at each case's end, and the edge load's share of F at the
     start, against the cell size."""
@@ -170,7 +203,8 @@ def run(out: Path, levels=None, cases=tuple(CASES), stroke=None) -> list[dict]:
 
 
 def tables(out: Path, levels: dict, stroke=None) -> list[dict]:
-    """The tables and the plot of the runs in out: levels, per case its mesh levels."""
+    """The tables (cup_convergence.csv, cup_convergence_estimates.csv, and both as markdown in
+    cup_convergence.md) and the plot of the runs in out: levels, per case its mesh levels."""
     out = Path(out)
     rows, ests = [], []
     for case, ns in levels.items():
@@ -182,4 +216,5 @@ def tables(out: Path, levels: dict, stroke=None) -> list[dict]:
     write_csv(out / "cup_convergence_estimates.csv", ests,
               ["case", "answer", "values", "differences", "p", "estimate", "uncertainty"])
     plot(out / "cup_convergence.png", rows)
+    (out / "cup_convergence.md").write_text(markdown(rows, ests))
     return rows
