@@ -94,8 +94,12 @@ def hill48_cup(n: int, stroke: float, r0: float, r45: float, r90: float):
 
 @pytest.mark.slow
 def test_hill48_round_cup_ears_follow_delta_r():
-    """The round cup drawn its whole 30 mm (mesh.n = 8: 127 cells, 14 rim nodes 6.9 degrees
-    apart) with Hill 1948, rolling direction along x. An ear is where the rim is drawn in least:
+    """The round cup drawn its whole 30 mm (mesh.n = 12) with Hill 1948, rolling direction along
+    x. (On mesh.n = 8, 127 cells of about 7 mm = 9 t, the pinch's free boundary slopes let the
+    flange turn a whole cell inside the holder where gmsh's boundary is uneven: the planar
+    isotropic rim varies by 4.3 mm there, against 0.18 mm with the slopes held; on n = 10, 12 and
+    16 by 0.14, 0.07 and 0.018 mm: docs/contact.md, "Which nodes' slopes".) An ear is where the
+    rim is drawn in least:
     the flange's edge stays out there, and the rim stands highest (z; here the rim at 45 degrees
     of sheet (a) has left the holder over the die's shoulder). The classic rule (the ESAFORM 2021
     AA6016-T4 cup, r45 below the mean, measured highest at 0 and 90 degrees and lowest at 45,
@@ -109,7 +113,7 @@ def test_hill48_round_cup_ears_follow_delta_r():
     where its draw-in grows: ears stand high."""
     rims = {}
     for name, r in {"a": (2.0, 1.0, 2.0), "b": (1.0, 2.0, 1.0), "c": (1.5, 1.5, 1.5)}.items():
-        p = DrawingProblem.from_scene(hill48_cup(8, 30.0, *r), verbose=False)
+        p = DrawingProblem.from_scene(hill48_cup(12, 30.0, *r), verbose=False)
         p.driver.run(1.0)
         assert p.stroke == pytest.approx(30.0)
         rims[name] = cup.rim(p)
@@ -141,9 +145,9 @@ def test_numisheet_steel_with_three_r_values_draws_in_less_where_r_across_is_hig
     here; -0.139 mm, 2.6 %, on the 16 x 16 demo mesh, docs/cup.md)."""
     base = scene.load(DEMOS / "numisheet93_steel.toml").changed({"mesh.n": 8, "process.report": []})
     out = {}
-    for name, changes in {"hill79": {}, "hill48": {"material.r": 1.0, "material.yield_function": "hill48",
-                                                   "material.r0": 1.79, "material.r45": 1.51,
-                                                   "material.r90": 2.27}}.items():
+    for name, changes in {"hill79": {"material.yield_function": "hill79", "material.r": 1.77, "material.m": 2.0,
+                                     "material.r0": 0.0, "material.r45": 0.0, "material.r90": 0.0},
+                          "hill48": {}}.items():  # the scene is Hill 1948 with the three r values
         p = DrawingProblem.from_scene(base.changed(changes), verbose=False)
         p.driver.run(15.0 / base.tools.stroke)
         assert p.stroke == pytest.approx(15.0)
