@@ -105,19 +105,24 @@ class SheetNodes(Part):
         sums = self._cell_sums(self._cell_area * (v.max(axis=1) - v.min(axis=1)), self._cell_area)
         return sums[:, 0] / sums[:, 1]
 
+    def _within(self, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((cells, 3), (cells,)): which vertices of each cell are in `region` (a mask of the
+        owned nodes), and which cells lie wholly in it."""
+        inside = self._at_vertices(np.asarray(region, dtype=float)) > 0.5
+        return inside, inside.all(axis=1)
+
     def interior(self, region: np.ndarray) -> np.ndarray:
         """The owned nodes of `region` (a mask) whose cells all lie wholly in it: the region less
         its boundary, the nodes with a cell that reaches outside."""
-        inside = self._at_vertices(np.asarray(region, dtype=float)) > 0.5
-        reaches_out = inside & ~inside.all(axis=1)[:, None]
+        inside, whole = self._within(region)
+        reaches_out = inside & ~whole[:, None]
         return np.asarray(region, dtype=bool) & ~(self._cell_sums(reaches_out.astype(float))[:, 0] > 0.0)
 
     def _weights(self) -> np.ndarray:
         """(cells, 3): the area with which each cell counts at each of its vertices: its area,
         but 0 at a node held flat when the cell does not lie wholly between the faces and the
         node has a cell that does."""
-        held = self._at_vertices(self.flat.astype(float)) > 0.5
-        between = held.all(axis=1)
+        held, between = self._within(self.flat)
         a = np.repeat(self._cell_area[:, None], 3, axis=1)
         inner = self._cell_sums(np.where(between[:, None], a, 0.0))[:, 0] > 0.0
         keep = ~(held & ~between[:, None] & (self._at_vertices(inner.astype(float)) > 0.5))

@@ -130,8 +130,7 @@ class Strip:
         M0 = abs(float(np.interp(0.0, x[1:-1], self.section(D2 @ w)[1])))
         Vh = float(np.sum(np.maximum(ph - self.p0, 0.0)) * hh)
         return {"h_mm": h, "Vh_N_per_mm": Vh, "M0_Nmm_per_mm": M0, "Vh_t_over_M0": Vh * self.t / M0,
-                "C_EDGE": C_EDGE, "peak_holder_MPa": float(ph.max()), "newton": it,
-                "depth_mm": -x[under][::-1], "holder_MPa": np.maximum(ph - self.p0, 0.0)[under][::-1]}
+                "C_EDGE": C_EDGE, "peak_holder_MPa": float(ph.max()), "newton": it}
 
 
 @dataclass(frozen=True)
