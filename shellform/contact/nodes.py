@@ -4,9 +4,9 @@ Reference positions X, the current positions x = X + (u, v, w) of the carrier, t
 x_n at the start of the increment (slip is measured from them), each node's tributary area
 A_i (a third of each cell around it), its local cell size h_i = sqrt(2 a_i) (a_i the
 area-weighted mean area of the cells around it: a right triangle's legs, 0.93 of an equilateral
-one's side) and half thickness h_i = t/2 exp(e33_i) (e33 the
-area-weighted thickness strain of the cells around it, updated with every converged increment:
-the sheet's surface is h_i from its mid-surface) with its plan gradient grad h_i (the area-weighted
+one's side) and half thickness h_i = t/2 exp(e33_i) (e33 recovered at the node from the thickness
+strains of the cells around it, `recover`, updated with every converged increment: the sheet's
+surface is h_i from its mid-surface) with its plan gradient grad h_i (the area-weighted
 mean of the cells' gradients of its linear interpolant, in the reference plan: the slopes of a
 mid-surface whose lower surface lies on a flat face), and the carrier slots a symmetry plane holds.
 A part of its own: it commits and checkpoints x_n and h_i.
@@ -17,6 +17,11 @@ any: at the pinch's edge the cells beyond it bend onto the die's shoulder and th
 average would dip the held node's surface by micrometres over one cell, a curvature ~ dh / h^2
 forced on the flat sheet that grows as the mesh is refined (docs/contact.md, "The flange's
 thickness at the pinch's edge").
+
+The recovery is exact for a linear field, at the blank's edge too: there a node's cells lie on
+one side, and their mean is the field a third of a cell inside the edge, not at the node. Under the
+pinch, whose faces make the mid-surface follow h_i, that lag was a kink of the held flange one
+row inside the blank's edge, carried by forces ~ D grad e33 / h that grow as the mesh is refined.
 """
 
 import numpy as np
@@ -129,17 +134,36 @@ class SheetNodes(Part):
         return np.where(keep, a, 0.0)
 
     def _set_thickness(self, half: np.ndarray | None = None) -> None:
-        """The half thickness (given, or t/2 exp(e33) with e33 the thickness strain of the cells
-        around each node, weighted by _weights) and the slopes of a mid-surface a half thickness
+        """The half thickness (given, or t/2 exp(e33) with e33 recovered from the thickness
+        strains of the cells around each node, weighted by _weights) and the slopes of a mid-surface a half thickness
         above a flat face."""
         m, w = self.model, self._weights()
         if half is None and not m.plastic:
             half = np.full(self.n_owned, 0.5 * m.thickness)
         elif half is None:
-            sums = self._cell_sums(w * m.thickness_strain()[:, None], w)
-            half = 0.5 * m.thickness * np.exp(sums[:, 0] / sums[:, 1])
+            half = 0.5 * m.thickness * np.exp(self.recover(m.thickness_strain(), w))
         self.half_thickness = half
         self.surface_slopes = self.gradient(half, w)
+
+    def recover(self, values: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
+        """(n_owned,): a per-cell field at the nodes, exact for a linear field: at each node the
+        value at the node of the plane fitted by weighted least squares to the cells' values at
+        their centroids (weights: (cells, 3), default the cells' areas). Where the cells around a
+        node do not fix a plane (their centroids nearly on a line), their weighted mean."""
+        w = np.repeat(self._cell_area[:, None], 3, axis=1) if weights is None else weights
+        x = self.model.cell_coords.reshape(-1, 3, 3)[:, :, :2]
+        h = self._at_vertices(self.cell_size)[..., None]
+        d = (x.mean(axis=1)[:, None, :] - x) / h  # centroid from each vertex, in local cell sizes
+        dx, dy, f = d[..., 0], d[..., 1], np.repeat(np.asarray(values, dtype=float)[:, None], 3, axis=1)
+        s = self._cell_sums(w, w * dx, w * dy, w * dx * dx, w * dx * dy, w * dy * dy, w * f, w * f * dx, w * f * dy)
+        mean = s[:, 6] / s[:, 0]
+        M = np.stack([s[:, 0:3], s[:, [1, 3, 4]], s[:, [2, 4, 5]]], axis=1) / s[:, :1, None]
+        cov = M[:, 1:, 1:] - M[:, 1:, :1] * M[:, :1, 1:]
+        fixed = np.linalg.eigvalsh(cov)[:, 0] > 1e-3
+        out = mean.copy()
+        if fixed.any():
+            out[fixed] = np.linalg.solve(M[fixed], (s[fixed, 6:9] / s[fixed, :1])[..., None])[:, 0, 0]
+        return out
 
     def gradient(self, values: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
         """(n_owned, 2): the mean over the cells around each node of the plan gradient of the
