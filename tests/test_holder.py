@@ -188,3 +188,25 @@ def test_a_node_held_flat_takes_the_thickness_of_the_material_between_the_faces(
     assert edge.sum() > 0
     assert (held[edge] - every[edge]).max() > 1e-3  # the bent cells are thinner
     assert np.abs(held[flat & ~edge] - every[flat & ~edge]).max() < 1e-12
+
+
+def test_the_die_presses_the_edge_s_band_with_its_equilibrium_not_the_pinch_s_couple():
+    """On the edge's band the die's face force is the band's equilibrium total, the holder's
+    force there plus the band's net normal force, max(sum (h_i + R0_i), 0), shared as the
+    holder's (d_i / h_i the same on every band node): friction sees that, not the positive
+    lobes of the discrete couple the pinch carries where the sheet turns onto the shoulder
+    (docs/contact.md, "The die's force on the band")."""
+    s = square_cup()
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(12.0 / s.tools.stroke)
+    h = d.holder
+    net = d.net_normal_forces()
+    h.faces(d.nodes.positions(), net, d.contact)
+    band = h.band & h.pinched
+    assert band.sum() > 4 and h.face[band].min() > 0.0
+    die = d.contact.pressure[band]
+    total = float((h.face[band] + net[band]).sum())
+    assert total > 0.0 and abs(die.sum() - total) <= 1e-9 * total
+    ratio = die / h.face[band]
+    assert np.ptp(ratio) <= 1e-12 * max(ratio.max(), 1.0)

@@ -7,8 +7,12 @@ their difference R0 and the holder's total F; their split is a modelling choice.
 presses each pinched node with what holds it down plus a *squeeze* s_i >= 0:
 
     off the edge's band   h_i = s_i + max(-R0_i, 0),   d_i = s_i + max(R0_i, 0)
-    on the edge's band    h_i = s_i + f e_i,           d_i = max(h_i + R0_i, 0)
+    on the edge's band    h_i = s_i + f e_i,           d_i = h_i D / H,  D = max(H + sum R0_j, 0)
                           sum_i h_i = F,  friction pressure d_i + h_i
+
+(H = sum h_j and the sums over the band): on the band the die presses with the band's
+equilibrium total, shared as the holder presses, not node by node with the positive lobes of
+the discrete couple the pinch carries there (their sum grows as 1/h, and friction saw it).
 
 The band is the pinched nodes that carry the couple turning the sheet from the flange onto the
 die's shoulder (within two cells of the holder's inner edge, or drawn past it in this
@@ -92,6 +96,7 @@ class PinchingHolder(Part):
         self.edge_law = edge
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
+        self.band_ratio, self.band_force = 0.0, 0.0  # the die's force on the band over the holder's, the holder's
         self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
         self.contact = self.friction = None
         self.committed = None
@@ -201,13 +206,19 @@ class PinchingHolder(Part):
                 Z = holder_height(all_tops, all_k, S)
                 s[pinched] = self.k[pinched] * np.maximum(tops[pinched] - Z, 0.0)
         h = np.where(pinched, s + np.where(band, f * edge, np.maximum(-net, 0.0)), 0.0)
-        d = np.where(pinched, np.where(band, np.maximum(h + net, 0.0), s + np.maximum(net, 0.0)), 0.0)
+        on_band = pinched & band
+        H, R = self._sum(h[on_band]), self._sum(net[on_band])
+        self.band_ratio = max(H + R, 0.0) / H if H > 0 else 0.0  # the die's force on the band over the holder's
+        self.band_force = H
+        d = np.where(pinched, np.where(band, self.band_ratio * h, s + np.maximum(net, 0.0)), 0.0)
         return d, h
 
     def face_slopes(self, net: np.ndarray) -> np.ndarray:
-        """d(d_i + h_i)/dR0 of the pinched nodes at the last split (F's spread held fixed):
-        sign(R0) off the edge's band; on it 1 where the die's face presses, 0 where it is clear."""
-        return np.where(self.band, (self.face + net > 0.0).astype(float), np.sign(net))
+        """d(d_i + h_i)/dR0_i of the pinched nodes at the last split (F's spread held fixed):
+        sign(R0) off the edge's band; on it h_i / H (d_i + h_i = h_i (1 + D / H), D the band's
+        equilibrium total) while the die presses the band, 0 where it is clear."""
+        own = self.face / self.band_force if self.band_force > 0 and self.band_ratio > 0 else np.zeros_like(self.face)
+        return np.where(self.band, own, np.sign(net))
 
     def face_gap(self, x: np.ndarray, half: np.ndarray):
         """Gap and normal of the open holder's face to the nodes at x with half thicknesses

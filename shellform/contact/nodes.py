@@ -35,6 +35,8 @@ W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
 
 
 class SheetNodes(Part):
+    PLANE_SPREAD = 1e-3  # the centroids fix a plane when their offsets' smallest variance passes this (cell sizes^2)
+
     def __init__(self, model, bcs):
         self.model = model
         V = model.V
@@ -135,8 +137,8 @@ class SheetNodes(Part):
 
     def _set_thickness(self, half: np.ndarray | None = None) -> None:
         """The half thickness (given, or t/2 exp(e33) with e33 recovered from the thickness
-        strains of the cells around each node, weighted by _weights) and the slopes of a mid-surface a half thickness
-        above a flat face."""
+        strains of the cells around each node, weighted by _weights) and the slopes of a
+        mid-surface a half thickness above a flat face."""
         m, w = self.model, self._weights()
         if half is None and not m.plastic:
             half = np.full(self.n_owned, 0.5 * m.thickness)
@@ -159,7 +161,7 @@ class SheetNodes(Part):
         mean = s[:, 6] / s[:, 0]
         M = np.stack([s[:, 0:3], s[:, [1, 3, 4]], s[:, [2, 4, 5]]], axis=1) / s[:, :1, None]
         cov = M[:, 1:, 1:] - M[:, 1:, :1] * M[:, :1, 1:]
-        fixed = np.linalg.eigvalsh(cov)[:, 0] > 1e-3
+        fixed = np.linalg.eigvalsh(cov)[:, 0] > self.PLANE_SPREAD
         out = mean.copy()
         if fixed.any():
             out[fixed] = np.linalg.solve(M[fixed], (s[fixed, 6:9] / s[fixed, :1])[..., None])[:, 0, 0]
