@@ -255,17 +255,13 @@ def test_elastic_law_never_yields():
 
 # ---- hardening -------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("n", [1.0, 2.0, 5.0, 12.0])
+@pytest.mark.parametrize("n", [1.05, 2.0, 5.0, 12.0])
 def test_power_law(n):
-    """The curve passes through (eps_y, sigma_y) and eps_bar = eps_y (s/sigma_y)^n for p > 0;
-    n = 1 is perfectly plastic."""
+    """The curve passes through (eps_y, sigma_y) and eps_bar = eps_y (s/sigma_y)^n for p > 0."""
     mat = power(2.0, 1.0, n)
     assert flow_stress(0.0, mat)[0] == SY
     for p in np.logspace(-6, 0, 13):
         s, slope = flow_stress(p, mat)
-        if n == 1.0:
-            assert (s, slope) == (SY, 0.0)
-            continue
         assert s / E + p == pytest.approx(EY * (s / SY) ** n, rel=1e-13)
         h = 1e-6 * p
         fd = (flow_stress(p + h, mat)[0] - flow_stress(p - h, mat)[0]) / (2 * h)
@@ -273,10 +269,18 @@ def test_power_law(n):
     path = point.uniaxial(mat, 30 * EY, 30)  # one step ends exactly at the yield strain
     assert path.stress[1, 0] == pytest.approx(SY, rel=1e-12) and path.p[1] == 0.0
     for e11, s11 in zip(path.strain[2:, 0], path.stress[2:, 0]):
-        if n == 1.0:
-            assert s11 == pytest.approx(SY, rel=1e-12)
-        else:
-            assert e11 == pytest.approx(EY * (s11 / SY) ** n, rel=1e-10)
+        assert e11 == pytest.approx(EY * (s11 / SY) ** n, rel=1e-10)
+
+
+def test_the_power_law_turns_elastic_as_n_falls_to_1_so_n_1_is_refused():
+    """eps = eps_y (s / sigma_y)^n: as n falls to 1 the stress at a given plastic strain grows
+    without bound (x ln x ~ P / (n - 1)), the elastic limit, not the perfectly plastic one; n = 1
+    is refused naming material.n, with the Swift law's n = 0 as the way to perfect plasticity."""
+    stress = [flow_stress(1e-3, power(2.0, 1.0, n))[0] for n in (2.0, 1.5, 1.2, 1.1, 1.05)]
+    assert all(b > a for a, b in zip(stress, stress[1:])) and stress[-1] > 5 * SY
+    with pytest.raises(InputError) as err:
+        power(2.0, 1.0, 1.0)
+    assert err.value.field == "material.n" and "swift" in str(err.value)
 
 
 def test_swift_law():
@@ -397,6 +401,7 @@ def test_section_tangent_is_derivative(m):
     (dict(hardening="power", n=3.0), "material.yield_stress"),
     (dict(hardening="power", yield_stress=SY), "material.n"),
     (dict(hardening="power", yield_stress=SY, n=0.5), "material.n"),
+    (dict(hardening="power", yield_stress=SY, n=1.0), "material.n"),
     (dict(hardening="swift", K=500.0, n=0.2), "material.eps0"),
     (dict(hardening="swift", K=500.0, eps0=0.0, n=0.2), "material.eps0"),
     (dict(hardening="swift", eps0=0.01, n=0.2), "material.K"),

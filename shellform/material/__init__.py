@@ -62,7 +62,7 @@ class SheetMaterial:
     """Plane-stress elastic-plastic sheet: isotropic elasticity, a yield function, isotropic
     hardening.
 
-    hardening: "none" (elastic), "power" (needs yield_stress, n >= 1), "swift" (needs K,
+    hardening: "none" (elastic), "power" (needs yield_stress, n > 1), "swift" (needs K,
     eps0 > 0, n >= 0), "voce" (yield_stress > 0, Q >= 0, beta > 0), "swift_voce" (all of these
     and the Swift share 0 < swift_weight < 1) or "table" (flow_curve: rows (p, true stress),
     extrapolation one of shellform.material.flow_curve.EXTRAPOLATIONS). yield_function: a name of shellform.material.criteria.CRITERIA (the
@@ -119,7 +119,10 @@ class SheetMaterial:
         if law == LAW_POWER:
             h = [self._curve("yield_stress"), self._curve("n")]
             require(h[0] > 0.0, "material.yield_stress", f"must be positive, got {h[0]}")
-            require(h[1] >= 1.0, "material.n", f"must be >= 1 for the power law, got {h[1]}")
+            require(h[1] > 1.0, "material.n",
+                    f"must be > 1 for the power law, got {h[1]}: its total strain eps_y (s / sigma_y)^n "
+                    "turns elastic as n falls to 1 (n -> infinity is the perfectly plastic limit); a "
+                    "perfectly plastic sheet is hardening = \"swift\" with n = 0 and K = sigma_y")
         if law in (LAW_SWIFT, LAW_SWIFT_VOCE):
             h = [self._curve("K"), self._curve("eps0"), self._curve("n")]
             require(h[0] > 0.0, "material.K", f"must be positive, got {h[0]}")

@@ -2,11 +2,12 @@
 
 p is the equivalent plastic strain (work conjugate to sigma_bar); p < 0 is read as p = 0.
 
-power law (law 1), a = sigma_y, b = n >= 1, eps_y = sigma_y / E:
+power law (law 1), a = sigma_y, b = n > 1, eps_y = sigma_y / E:
     total uniaxial strain eps_bar = s/E + p = eps_y (s/sigma_y)^n  for s >= sigma_y,
     so with x = s/sigma_y and P = p/eps_y:  g(x) = x^n - x - P = 0.
     g is convex and increasing on x >= 1 (n > 1); Newton from a point right of the root decreases
-    monotonically onto it. Slope ds/dp = E / (n x^(n-1) - 1). n = 1: perfectly plastic.
+    monotonically onto it. Slope ds/dp = E / (n x^(n-1) - 1). As n falls to 1 the curve turns
+    elastic (x ln x ~ P / (n - 1)), and n -> infinity is perfectly plastic: n = 1 is refused.
 Swift (law 2), a = K, b = eps0, c = n:  s = K (eps0 + p)^n, slope n K (eps0 + p)^(n-1).
 Voce (law 3), H_.. = sigma0, Q, beta:  s = sigma0 + Q (1 - exp(-beta p)), slope Q beta exp(-beta p).
 Swift-Voce (law 4), H_.. = K, eps0, n, sigma0, Q, beta, w:  s = w Swift(p) + (1 - w) Voce(p).
@@ -27,8 +28,6 @@ from shellform import _jit as jit
 
 @jit.njit
 def _power_law(p, E, sy, n):
-    if n <= 1.0 + 1e-12:
-        return sy, 0.0
     P = p * E / sy
     if P <= 0.0:
         return sy, E / (n - 1.0)

@@ -89,7 +89,7 @@ class Material:
     thickness: float = 0.01
     hardening: str = "none"  # one of HARDENING; its parameters: CURVE_PARAMETERS
     yield_stress: float = 0.0  # power law: sigma_y; Voce: sigma0 (0: unset), MPa
-    n: float = 0.0  # power law: n >= 1; Swift: n >= 0
+    n: float = 0.0  # power law: n > 1; Swift: n >= 0
     K: float = 0.0  # Swift: sigma_bar = K (eps0 + p)^n (0: unset), MPa
     eps0: float = 0.0  # Swift (0: unset)
     Q: float = 0.0  # Voce: sigma_bar = sigma0 + Q (1 - exp(-beta p)), MPa
@@ -305,7 +305,7 @@ class Scene:
         if "plasticity" not in self.effects:
             return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
         unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
-        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n >= 1): unset there
+        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n > 1): unset there
         n = unset(mat.n) if mat.hardening == "power" else mat.n
         given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
         given.update({k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)})
