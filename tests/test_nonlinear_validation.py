@@ -60,6 +60,15 @@ def test_plastic_limit_load_and_springback():
     assert r["residual_deflection_error"] < 1e-8
 
 
+@pytest.mark.parametrize("points, error", [(2, 0.155), (3, -0.139), (4, 0.043), (5, -0.055), (6, 0.020),
+                                            (7, -0.029), (9, -0.018), (11, -0.012)])
+def test_the_thickness_rule_s_plastic_moment_is_the_table_of_docs_material(points, error):
+    """A fully plastic section's moment with `points` Gauss points through the thickness,
+    against the exact t^2/4 sigma: the trade-off table of docs/material.md (5 points: -5.5 %)."""
+    b = plastic.L / 16
+    assert plastic.limit_load(b, thickness_points=points) / plastic.limit_load(b) - 1 == pytest.approx(error, abs=6e-4)
+
+
 def test_plasticity_that_stays_elastic_is_elastic():
     """The same plate with a yield stress never reached: the layered elastic-plastic path
     gives the closed-form elastic path's answer to 1e-10 and never flows."""
