@@ -48,6 +48,14 @@ def run(out: Path, meshes: Path = ROOT / "docs/results/cup_mesh", hard: Path = R
     return figures(out, Path(meshes), Path(hard))
 
 
+def _shown(d: Path) -> str:
+    """A run's folder as the table shows it: from the repository's root when it lies inside."""
+    try:
+        return str(Path(d).resolve().relative_to(ROOT.resolve()))
+    except ValueError:
+        return str(d)
+
+
 def _line(run_dir: Path, which: str):
     with open(run_dir / f"thickness_{which}.csv") as f:
         rows = list(csv.DictReader(f))
@@ -65,7 +73,7 @@ def figures(out: Path, meshes: Path, hard: Path) -> list[dict]:
                      "punch_force_30_kN": s["punch_force_kN"][-1]["force"], "DX": s["draw_in_mm"][-1]["DX"],
                      "DD": s["draw_in_mm"][-1]["DD"], "increments": s["increments"],
                      "newton_iterations": s["newton_iterations"], "wall_s": s["wall_time_s"]["total"],
-                     "stopped": s["stopped"] or "", "run": str(d)})
+                     "stopped": s["stopped"] or "", "run": _shown(d)})
     write_csv(out / "cup_paper.csv", rows, COLUMNS)
     _plots(out, meshes, hard, rows)
     return rows
