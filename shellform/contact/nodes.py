@@ -52,6 +52,8 @@ class SheetNodes(Part):
         self._cell_area = 0.5 * np.abs(np.linalg.det(self._edges))
         sums = self._cell_sums(self._cell_area / 3, self._cell_area**2 / 3)
         self.area, self.cell_size = sums[:, 0], np.sqrt(2.0 * sums[:, 1] / sums[:, 0])
+        # (cells, 3, 2): each cell's centroid from each of its vertices, in the vertex's cell sizes (recover)
+        self._centroid_offsets = (x.mean(axis=1)[:, None, :] - x) / self._at_vertices(self.cell_size)[..., None]
         self.flat = np.zeros(self.n_owned, dtype=bool)
         self._set_thickness()
         self.q = None
@@ -153,9 +155,7 @@ class SheetNodes(Part):
         their centroids (weights: (cells, 3), default the cells' areas). Where the cells around a
         node do not fix a plane (their centroids nearly on a line), their weighted mean."""
         w = np.repeat(self._cell_area[:, None], 3, axis=1) if weights is None else weights
-        x = self.model.cell_coords.reshape(-1, 3, 3)[:, :, :2]
-        h = self._at_vertices(self.cell_size)[..., None]
-        d = (x.mean(axis=1)[:, None, :] - x) / h  # centroid from each vertex, in local cell sizes
+        d = self._centroid_offsets
         dx, dy, f = d[..., 0], d[..., 1], np.repeat(np.asarray(values, dtype=float)[:, None], 3, axis=1)
         s = self._cell_sums(w, w * dx, w * dy, w * dx * dx, w * dx * dy, w * dy * dy, w * f, w * f * dx, w * f * dy)
         mean = s[:, 6] / s[:, 0]
