@@ -210,3 +210,25 @@ def test_the_die_presses_the_edge_s_band_with_its_equilibrium_not_the_pinch_s_co
     assert total > 0.0 and abs(die.sum() - total) <= 1e-9 * total
     ratio = die / h.face[band]
     assert np.ptp(ratio) <= 1e-12 * max(ratio.max(), 1.0)
+
+
+def test_the_pinched_flange_s_taper_carries_no_moment():
+    """The cells whose every node the faces pinch (w and slopes held) take the curvature of
+    their mid-surface, a half thickness above the die, as their taper at every commit: at a
+    converged state they bend by nothing, and carry next to none of the moment that curvature
+    would need as bending (the plastic layers' own moment is what remains). Cells elsewhere keep
+    what they had when they left the pinch (docs/contact.md, "The taper of the held flange")."""
+    s = square_cup()
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(12.0 / s.tools.stroke)
+    m, n = d.model, d.nodes
+    tapered = n.interior(d.holder.pinched)[m.dofs.reshape(-1, 3)].all(axis=1)
+    assert tapered.sum() > 10
+    taper = np.abs(m.taper[tapered]).max()
+    t = s.material.thickness
+    D = s.material.E * t**3 / (12 * (1 - s.material.nu**2))
+    assert taper > 1e-5  # the flange's thickness varies: its mid-surface curves
+    assert np.abs(m.strain[tapered][..., 3:] - m.taper[tapered]).max() == 0.0
+    assert np.abs(m.resultants[tapered][..., 3:]).max() < 0.05 * D * taper
+    assert np.abs(m.resultants[~tapered][..., 3:]).max() > 10 * D * taper  # the wall and the shoulder bend

@@ -114,6 +114,41 @@ def test_patch_constant_curvature(effects):
     assert np.abs(K - np.array([-2 * a, -2 * c, -2 * b])).max() < 1e-8
 
 
+@pytest.mark.parametrize("plastic", [False, True])
+def test_a_followed_taper_carries_no_moment(plastic):
+    """After follow_taper the sections carry no moment at the curvature they had, their membrane
+    forces unchanged (elastic; plastic, within the shift of the layers' yield); the curvature beyond it bends them as before; the taper is checkpointed."""
+    a, b, c = 0.031, -0.072, 0.045
+    s = 1e-3
+    U = lambda X: np.stack([1e-3 * X[:, 0], 0 * X[:, 0], s * (a * X[:, 0] ** 2 + b * X[:, 0] * X[:, 1]  # noqa: E731
+                                                                + c * X[:, 1] ** 2)], axis=1)
+    G = lambda X: np.stack([np.stack([1e-3 + 0 * X[:, 0], 0 * X[:, 0]], axis=1), 0 * X,  # noqa: E731
+                            s * np.stack([2 * a * X[:, 0] + b * X[:, 1], b * X[:, 0] + 2 * c * X[:, 1]], axis=1)],
+                           axis=1)
+    effects = NL + ("plasticity",) if plastic else NL
+    mat = Hill79Material(E=E, nu=NU, hardening="swift", K=2.0, eps0=1e-4, n=0.2).pack() if plastic else MAT
+    msh = distorted_patch(MPI.COMM_WORLD)
+    model = SheetModel(msh, mat, T, effects)
+    q = fem.Function(model.V)
+    q.x.array[:] = carrier_of(model.V, U, G)
+    model.evaluate(q)
+    before = model.resultants.copy()
+    assert np.abs(before[..., 3:]).min() > 0.0
+    model.follow_taper(np.ones(model.num_cells, dtype=bool))
+    model.evaluate(q)
+    M = T**3 / 12 * E / (1 - NU**2) * s * 2 * max(abs(a), abs(b), abs(c))  # the elastic moment's scale
+    assert np.abs(model.resultants[..., 3:]).max() < 1e-12 * M
+    N = np.abs(before[..., :3]).max()  # elastic: N unchanged; plastic: the layers' yield shifts it slightly
+    assert np.abs(model.resultants[..., :3] - before[..., :3]).max() <= (1e-3 if plastic else 1e-12) * N
+    q.x.array[:] *= 2.0  # twice the curvature: bent by the part beyond the taper (and stretched twice)
+    model.evaluate(q)
+    assert np.abs(model.resultants[..., 3:]).max() > 0.5 * np.abs(before[..., 3:]).max()
+    saved = {k: v.copy() for k, v in model.checkpoint().items()}
+    other = SheetModel(msh, mat, T, effects)
+    other.restore(saved)
+    np.testing.assert_array_equal(other.taper, model.taper)
+
+
 def test_patch_homogeneous_large_deformation():
     """U = (F - I) X with F a constant 3 x 2 map (stretch, shear, a 70 degree tilt): the exact
     kinematics give constant E = (F^T F - I)/2 and K = 0, reproduced on the distorted patch."""

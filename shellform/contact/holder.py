@@ -251,7 +251,7 @@ class PinchingHolder(Part):
         self.pinched &= self.closed & on_die
         self.under_now = (self.under_now | under) if grow else under.copy()
         flat = self.flat()
-        self.nodes.hold_flat(flat)
+        self.nodes.hold_flat(flat, self.pinched)
         self.sloped = self.nodes.interior(flat)
 
     def flat(self) -> np.ndarray:

@@ -18,6 +18,10 @@ average would dip the held node's surface by micrometres over one cell, a curvat
 forced on the flat sheet that grows as the mesh is refined (docs/contact.md, "The flange's
 thickness at the pinch's edge").
 
+The cells whose every node the faces pinch, w and slopes held, carry the curvature of their
+thickness's taper without a moment (SheetModel.follow_taper, at every commit): their mid-surface
+curves with h_i while the material between the faces stays flat.
+
 The recovery is exact for a linear field, at the blank's edge too: there a node's cells lie on
 one side, and their mean is the field a third of a cell inside the edge, not at the node. Under the
 pinch, whose faces make the mid-surface follow h_i, that lag was a kink of the held flange one
@@ -54,7 +58,7 @@ class SheetNodes(Part):
         self.area, self.cell_size = sums[:, 0], np.sqrt(2.0 * sums[:, 1] / sums[:, 0])
         # (cells, 3, 2): each cell's centroid from each of its vertices, in the vertex's cell sizes (recover)
         self._centroid_offsets = (x.mean(axis=1)[:, None, :] - x) / self._at_vertices(self.cell_size)[..., None]
-        self.flat = np.zeros(self.n_owned, dtype=bool)
+        self.flat = self.pinched = np.zeros(self.n_owned, dtype=bool)
         self._set_thickness()
         self.q = None
         self.x_n = self.X[: self.n_owned].copy()
@@ -94,10 +98,12 @@ class SheetNodes(Part):
         f.x.scatter_forward()
         return arr[:, 0][self.model.dofs.reshape(-1, 3)]
 
-    def hold_flat(self, held: np.ndarray) -> None:
-        """The owned nodes held flat between two faces (module docstring); their surface follows
+    def hold_flat(self, held: np.ndarray, pinched: np.ndarray) -> None:
+        """The owned nodes held flat between two faces (module docstring), and those of them whose
+        w the faces hold too (`pinched`: their cells' taper is followed); their surface follows
         at the next commit."""
         self.flat = np.asarray(held, dtype=bool).copy()
+        self.pinched = np.asarray(pinched, dtype=bool) & self.flat
 
     def current_area(self) -> np.ndarray:
         """(n_owned,): a third of the current plan area of each cell around each node."""
@@ -180,6 +186,7 @@ class SheetNodes(Part):
     def commit(self, lam: float) -> None:
         self.x_n = self.positions()
         if self.model.plastic:
+            self.model.follow_taper(self._within(self.interior(self.pinched))[1])
             self._set_thickness()
 
     def checkpoint(self) -> dict:

@@ -11,6 +11,8 @@ cuts back, naming which of the two stopped it.
 finite: the layers work in logarithmic strains (shellform.material.hencky); their lever arm is
 t lever_stretch (the thickness of the last converged state), and the trial thickness stretch
 lambda3 = exp(sum_i w_i e33_i) (a uniform stretch across the section) is written to `stretch`.
+``taper`` (cells, points, 3): a curvature the section carries without a moment, subtracted from
+K before the section sees it (SheetModel.follow_taper: a thickness that varies between flat faces).
 ``elastic_tangent`` returns the elastic section tangent with the elastic-plastic stresses: the
 first iteration after a load reversal, where a perfectly plastic tangent is (nearly) singular
 along the very direction in which the sheet unloads elastically.
@@ -26,14 +28,16 @@ from shellform import _jit as jit
 
 
 @jit.njit(parallel=True)
-def section_update(e, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, lever_stretch, ep, p, stretch,
+def section_update(e, taper, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, lever_stretch, ep, p, stretch,
                    S, D, elastic_tangent=False):
     nplastic, nfail, nguard = 0, 0, 0
     for c in numba.prange(e.shape[0]):  # cells are independent: threads share them
         w = np.zeros((4, 16))  # scratch, once per cell
-        zero = np.zeros(3)
+        zero, k = np.zeros(3), np.zeros(3)
         for g in range(e.shape[1]):
-            em, k = e[c, g, :3], e[c, g, 3:]
+            em = e[c, g, :3]
+            for a in range(3):
+                k[a] = e[c, g, 3 + a] - taper[c, g, a]
             Sg, Dg = S[c, g], D[c, g]
             size, real = 0.0, True  # real: every strain finite
             for a in range(3):

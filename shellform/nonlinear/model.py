@@ -133,6 +133,7 @@ class SheetModel:
         self.lever, self._lever_before = np.ones(shape[:2]), np.ones(shape[:2])
         self.z = np.zeros((self.num_cells, el.nz))
         self.strain = np.zeros((self.num_cells, self.nqp, 6))
+        self.taper = np.zeros((self.num_cells, self.nqp, 3))  # curvature carried without a moment (follow_taper)
         self.resultants = np.zeros((self.num_cells, self.nqp, 6))
         self.tangents = np.zeros((self.num_cells, self.nqp, 6, 6))
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
@@ -148,7 +149,7 @@ class SheetModel:
                       self.z, self.strain)
         t1 = time.perf_counter()
         nplastic, nfail, nguard = section_update(
-            self.strain, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
+            self.strain, self.taper, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
             elastic_tangent)
         t2 = time.perf_counter()
@@ -172,14 +173,32 @@ class SheetModel:
         self.lever[...] = self.stretch  # the next increment's lever arm
         self.state_version += 1
 
+    def follow_taper(self, cells: np.ndarray) -> None:
+        """The sections of `cells` (a mask of the owned cells) carry no moment at the curvature of
+        the last evaluated state: it becomes their taper, the curvature K - taper measures bending
+        from.
+
+        A sheet lying between two flat faces whose thickness t varies has its mid-surface a half
+        thickness above the lower face, so that surface curves, K = grad grad (t / 2), although no
+        fibre of the sheet is bent: both faces of the material stay flat, and a solid sheet of that
+        shape carries no moment. The Kirchhoff section, whose normals stay normal to the
+        mid-surface, would read that curvature as bending, and with the thickness's kinks at the
+        plastic fronts resolved ever more sharply it puts moments ~ D grad t / h and nodal forces
+        that grow as the mesh is refined on the faces that hold the sheet (docs/contact.md, "The
+        taper of the held flange"). The taper is part of the committed state: a section that
+        leaves the faces keeps it, as the solid keeps its shape."""
+        self.taper[cells] = self.strain[cells, :, 3:]
+        self.state_version += 1
+
     def checkpoint(self) -> dict:
         """The committed material state; the next increment's lever arm is its stretch."""
-        return {"ep": self.ep_n, "p": self.p_n, "thickness_stretch": self.stretch_n, "lever_before": self._lever_before}
+        return {"ep": self.ep_n, "p": self.p_n, "thickness_stretch": self.stretch_n, "lever_before": self._lever_before,
+                "taper": self.taper}
 
     def restore(self, data) -> None:
         """The committed material state from a checkpoint() (refused if it does not fit)."""
         pairs = (("ep", self.ep_n), ("p", self.p_n), ("thickness_stretch", self.stretch_n),
-                 ("lever_before", self._lever_before))
+                 ("lever_before", self._lever_before), ("taper", self.taper))
         for key, target in pairs:
             if key not in data or data[key].shape != target.shape:
                 raise InputError("resume", f"the checkpoint's {key!r} does not fit this model (another mesh "
@@ -211,7 +230,7 @@ class SheetModel:
         e33 of the layers (mean over the layers and the quadrature points)."""
         if self.finite:
             return np.log(self.stretch_n).mean(axis=1)
-        return _mean_thickness_strain(self.strain, self.ep_n, self.material, self.zeta, self.wz, self.thickness)
+        return _mean_thickness_strain(self.strain, self.taper, self.ep_n, self.material, self.zeta, self.wz, self.thickness)
 
     def volume_change(self) -> float:
         """(V - V0) / V0 of the whole sheet at the last evaluated state: per cell its initial
@@ -226,16 +245,16 @@ class SheetModel:
 
 
 @jit.njit
-def _mean_thickness_strain(strain, ep, mat, zeta, wz, thickness):
+def _mean_thickness_strain(strain, taper, ep, mat, zeta, wz, thickness):
     """Per cell: the thickness strain of every layer (plane_stress.thickness_strain) at strains
-    e_m + zeta t k, weighted through the thickness and averaged over the quadrature points."""
+    e_m + zeta t (k - taper), weighted through the thickness and averaged over the quadrature points."""
     ncells, nqp = strain.shape[0], strain.shape[1]
     e33 = np.zeros(ncells)
     for c in range(ncells):
         acc = 0.0
         for g in range(nqp):
             for k in range(zeta.size):
-                layer = strain[c, g, :3] + zeta[k] * thickness * strain[c, g, 3:]
+                layer = strain[c, g, :3] + zeta[k] * thickness * (strain[c, g, 3:] - taper[c, g])
                 acc += wz[k] * plane_stress.thickness_strain(layer, ep[c, g, k], mat)
         e33[c] = acc / nqp
     return e33
