@@ -118,8 +118,8 @@ def test_short_square_cup_draw():
     def check(d):
         assert abs(p.holder_force() - s.tools.blank_holder_force) <= 1e-9 * s.tools.blank_holder_force
         assert p.holder_share() <= 0.1
-        held, edge = p.holder_held_down()
-        assert 0.0 <= held <= 1.0 and edge >= 0.0  # the closed holder: what it holds down is at most F
+        held, edge, off_band = p.holder_held_down()
+        assert 0.0 <= off_band <= held <= 1.0 and edge >= 0.0  # the closed holder: what it holds down is at most F
         x, y = p.holder_largest_at()
         assert 0 <= x <= s.geometry.lx / 2 and 0 <= y <= s.geometry.ly / 2
         assert p.force_balance() <= 1e-6

@@ -214,9 +214,9 @@ def test_the_die_presses_the_edge_s_band_with_its_equilibrium_not_the_pinch_s_co
 
 def test_the_pinched_flange_s_taper_carries_no_moment():
     """The cells whose every node the faces pinch (w and slopes held) take the curvature of
-    their mid-surface, a half thickness above the die, as their taper at every commit: at a
-    converged state they bend by nothing, and carry next to none of the moment that curvature
-    would need as bending (the plastic layers' own moment is what remains). Cells elsewhere keep
+    their mid-surface, a half thickness above the die, as their taper at every commit (where the
+    next increment holds them): at the converged state they carry next to none of the moment that
+    curvature would need as bending. Cells elsewhere keep
     what they had when they left the pinch (docs/contact.md, "The taper of the held flange")."""
     s = square_cup()
     p = DrawingProblem.from_scene(s, verbose=False)
@@ -229,6 +229,7 @@ def test_the_pinched_flange_s_taper_carries_no_moment():
     t = s.material.thickness
     D = s.material.E * t**3 / (12 * (1 - s.material.nu**2))
     assert taper > 1e-5  # the flange's thickness varies: its mid-surface curves
-    assert np.abs(m.strain[tapered][..., 3:] - m.taper[tapered]).max() == 0.0
-    assert np.abs(m.resultants[tapered][..., 3:]).max() < 0.05 * D * taper
+    # the taper is that of the next increment's start, on the thickness just updated
+    assert np.abs(m.strain[tapered][..., 3:] - m.taper[tapered]).max() < 0.1 * taper
+    assert np.abs(m.resultants[tapered][..., 3:]).max() < 0.01 * D * taper
     assert np.abs(m.resultants[~tapered][..., 3:]).max() > 10 * D * taper  # the wall and the shoulder bend

@@ -180,12 +180,12 @@ class PinchingHolder(Part):
         total = self._sum(self.edge_shares(x, under & contact.on(contact.die))[0])
         return self.rides(self.edge_share(0.0, total), contact.controls.penetration)
 
-    def held_down(self, net: np.ndarray) -> tuple[float, float]:
-        """(E_in + f E_e, E_e) / F of the closed holder at its last split: the part of F that holds
-        the flange down against its own lift, and the edge load's demand (> 1: the holder rides
-        on its edge)."""
+    def held_down(self, net: np.ndarray) -> tuple[float, float, float]:
+        """(E_in + f E_e, E_e, E_in) / F of the closed holder at its last split: the part of F that
+        holds the flange down against its own lift, the edge load's demand (> 1: the holder rides
+        on its edge) and the holding-down off the edge's band."""
         inner, edge = self.demands(self.pinched, net, self.edge, self.band)
-        return (inner + self.edge_share(inner, edge) * edge) / self.force, edge / self.force
+        return (inner + self.edge_share(inner, edge) * edge) / self.force, edge / self.force, inner / self.force
 
     def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray, band: np.ndarray):
         """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed

@@ -19,8 +19,9 @@ forced on the flat sheet that grows as the mesh is refined (docs/contact.md, "Th
 thickness at the pinch's edge").
 
 The cells whose every node the faces pinch, w and slopes held, carry the curvature of their
-thickness's taper without a moment (SheetModel.follow_taper, at every commit): their mid-surface
-curves with h_i while the material between the faces stays flat.
+thickness's taper without a moment (SheetModel.follow_taper, at every commit, at the state where
+the next increment holds them: on the thickness just updated): their mid-surface curves with h_i
+while the material between the faces stays flat.
 
 The recovery is exact for a linear field, at the blank's edge too: there a node's cells lie on
 one side, and their mean is the field a third of a cell inside the edge, not at the node. Under the
@@ -35,6 +36,7 @@ from shellform.assembly.sheet_element import BS, COMPONENTS
 from shellform.nonlinear.parts import Part
 
 
+W = COMPONENTS.index("w")
 W_SLOPES = slice(COMPONENTS.index("w_x"), COMPONENTS.index("w_y") + 1)
 
 
@@ -186,8 +188,15 @@ class SheetNodes(Part):
     def commit(self, lam: float) -> None:
         self.x_n = self.positions()
         if self.model.plastic:
-            self.model.follow_taper(self._within(self.interior(self.pinched))[1])
+            half, slopes = self.half_thickness, self.surface_slopes
             self._set_thickness()
+            held = self.interior(self.pinched)
+            ahead = self.q.copy()  # the held nodes where the next increment puts them: on the new thickness
+            rows = ahead.x.array.reshape(-1, BS)[: self.n_owned]
+            rows[held, W] += (self.half_thickness - half)[held]
+            rows[held, W_SLOPES] += (self.surface_slopes - slopes)[held]
+            ahead.x.scatter_forward()
+            self.model.follow_taper(self._within(held)[1], ahead)
 
     def checkpoint(self) -> dict:
         return {"nodes": {"contact_x_n": self.x_n, "contact_half_thickness": self.half_thickness,

@@ -99,14 +99,14 @@ class DrawingProblem:
             return 0.0
         return d.model.mesh.comm.allreduce(float(d.holder.face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
 
-    def holder_held_down(self) -> tuple[float, float]:
-        """The closed holder's (held down, edge load) as fractions of F (holder.py, held_down):
-        the part of its force that holds pinched nodes down against the sheet's own lift, the
-        edge's band included, and the edge load's demand (> 1: it rides on its edge). (0, 0)
-        when the holder is open."""
+    def holder_held_down(self) -> tuple[float, float, float]:
+        """The closed holder's (held down, edge load, off the band) as fractions of F (holder.py,
+        held_down): the part of its force that holds pinched nodes down against the sheet's own
+        lift, the edge's band included, the edge load's demand (> 1: it rides on its edge), and
+        the holding-down off the edge's band. Zeros when the holder is open."""
         d = self.driver
         if d.holder is None or d.holder.force <= 0 or not d.holder.closed:
-            return 0.0, 0.0
+            return 0.0, 0.0, 0.0
         return d.holder.held_down(d.net_normal_forces())
 
     def holder_largest_at(self) -> tuple[float, float]:

@@ -132,13 +132,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     def on_increment(d):
         h = d.history[-1]
         hx, hy = p.holder_largest_at()
-        held, edge = p.holder_held_down()
+        held, edge, off_band = p.holder_held_down()
         curve.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
                       "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
                       "holder_lift_mm": p.holder_lift(),
                       "max_penetration_mm": p.max_penetration(), "force_balance": p.force_balance(),
                       "holder_largest_share": p.holder_share(), "holder_largest_x_mm": hx, "holder_largest_y_mm": hy,
-                      "holder_held_down": held, "holder_edge_load": edge, "free_under_closed_holder": p.free_under_holder(),
+                      "holder_held_down": held, "holder_edge_load": edge, "holder_off_band": off_band,
+                      "free_under_closed_holder": p.free_under_holder(),
                       "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
         every = s.output.checkpoint_every  # the last converged increment on disk at least this often

@@ -173,10 +173,10 @@ class SheetModel:
         self.lever[...] = self.stretch  # the next increment's lever arm
         self.state_version += 1
 
-    def follow_taper(self, cells: np.ndarray) -> None:
+    def follow_taper(self, cells: np.ndarray, q: fem.Function | None = None) -> None:
         """The sections of `cells` (a mask of the owned cells) carry no moment at the curvature of
-        the last evaluated state: it becomes their taper, the curvature K - taper measures bending
-        from.
+        the carrier state q (default: the last evaluated state): it becomes their taper, the
+        curvature K - taper measures bending from.
 
         A sheet lying between two flat faces whose thickness t varies has its mid-surface a half
         thickness above the lower face, so that surface curves, K = grad grad (t / 2), although no
@@ -187,7 +187,12 @@ class SheetModel:
         that grow as the mesh is refined on the faces that hold the sheet (docs/contact.md, "The
         taper of the held flange"). The taper is part of the committed state: a section that
         leaves the faces keeps it, as the solid keeps its shape."""
-        self.taper[cells] = self.strain[cells, :, 3:]
+        strain = self.strain
+        if q is not None:
+            strain = np.zeros_like(self.strain)
+            self.kernels.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta,
+                                     self.tying, np.zeros_like(self.z), strain)
+        self.taper[cells] = strain[cells, :, 3:]
         self.state_version += 1
 
     def checkpoint(self) -> dict:

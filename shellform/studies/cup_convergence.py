@@ -7,7 +7,8 @@ meshes, n = 16, 24, 35, 50, 71, and the paper's square cup (demos/square_cup.tom
 n = 16, 24, 35, 50. For each run: DX, DY, DD and the punch force at 15 mm and at the end, the
 peak thinning and where it is, the stroke at which the holder opens (if it does), the largest
 nodal share of the holder's force, the peak of what it holds down, the edge load's share of F
-(holder.py, pinch_edge.py) at the start and its peak, and the largest change of the punch force
+(holder.py, pinch_edge.py) at the start and its peak, the holding-down off the edge's band at the
+first report and its peak, and the largest change of the punch force
 between consecutive increments in the last 40 % of the stroke. For each answer, over the three finest finished meshes, the observed order of
 convergence p and the Richardson estimate of the converged value with its uncertainty
 (`richardson`). Writes cup_convergence.csv (one row per run), cup_convergence_estimates.csv
@@ -104,6 +105,9 @@ def row(case: str, n: int, out: Path) -> dict:
          "held_down_peak": max(float(x["holder_held_down"]) for x in curve),
          "edge_load_start": float(curve[0]["holder_edge_load"]),
          "edge_load_peak": max(float(x["holder_edge_load"]) for x in curve),
+         "off_band_first": float(min(curve, key=lambda x: abs(float(x["stroke_mm"]) - s["reports"][0]["stroke_mm"]))
+                                 ["holder_off_band"]),
+         "off_band_peak": max(float(x["holder_off_band"]) for x in curve),
          "late_force_jump": late_jump(curve),
          "max_thickness_strain": s["max_thickness_strain"], "where_x_mm": s["where_initial_xy_mm"][0],
          "where_y_mm": s["where_initial_xy_mm"][1], "stopped": s["stopped"] or ""}
@@ -141,7 +145,7 @@ def _num(x, digits=3) -> str:
 def markdown(rows: list[dict], ests: list[dict]) -> str:
     """The runs' table and the estimates' table of each case, as docs/cup-convergence.md shows
     them: draw-ins and force at the first and last report, peak thinning, the holder (opening,
-    largest share, edge load), the late force jump, iterations, cut-backs, wall time."""
+    largest share, edge load, holding-down off the band), the late force jump, iterations, cut-backs, wall time."""
     text = []
     for case in dict.fromkeys(r["case"] for r in rows):
         part = [r for r in rows if r["case"] == case]
@@ -149,7 +153,8 @@ def markdown(rows: list[dict], ests: list[dict]) -> str:
         text += [f"### {case}", "",
                  f"| n (cells) | DX {first} | DD {first} | force {first} (kN) | DX {last} | DD {last} | force {last} (kN) "
                  "| max thickness strain | holder opens at | largest share of F | edge load / F (start, peak) "
-                 "| late force jump | iterations, cut-backs | wall (s) |", "|" + "---|" * 14]
+                 f"| off the band / F ({first}, peak) | late force jump | iterations, cut-backs | wall (s) |",
+                 "|" + "---|" * 15]
         for r in part:
             opens = f"{r['holder_opens_mm']:.1f} mm" if r["holder_opens_mm"] is not None else "never"
             stopped = "" if r["finished"] else f" (stopped at {r['stroke_mm']:.1f} mm)"
@@ -157,6 +162,7 @@ def markdown(rows: list[dict], ests: list[dict]) -> str:
                         f"| {_num(r.get('force_' + first), 2)} | {_num(r.get('DX_' + last), 2)} | {_num(r.get('DD_' + last), 2)} "
                         f"| {_num(r.get('force_' + last), 2)} | {_num(r['max_thickness_strain'])} | {opens} "
                         f"| {_num(r['largest_share'])} | {_num(r['edge_load_start'])}, {_num(r['edge_load_peak'])} "
+                        f"| {_num(r['off_band_first'], 4)}, {_num(r['off_band_peak'], 4)} "
                         f"| {100 * r['late_force_jump']:.1f} % | {r['newton_iterations']}, {r['cutbacks']} | {r['wall_s']:.0f} |")
         text += ["", "| answer | values | successive differences | p | estimate +- uncertainty |", "|---|---|---|---|---|"]
         for e in ests:
