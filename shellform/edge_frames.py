@@ -220,41 +220,63 @@ def check_symmetry_lines(blank, supports: dict[str, str], tol: float = 1e-9) -> 
 
 
 class SheetEdgeFrames:
-    """Clamped curved edges of the nonlinear sheet (carrier U = (u, v, w) and its gradient).
+    """Supports on curved and oblique edges of the nonlinear sheet (carrier U = (u, v, w) and its
+    gradient), in the edge's frame.
 
-    Clamped holds u = v = w = 0 along the edge, hence grad w = 0 (w,s = 0 and w,n = 0) and the
-    derivatives of u and v along the edge, (u_x, u_y) . s = 0 and (v_x, v_y) . s = 0. Only
-    these two slope pairs need the edge's frame: each turns as (a_x, a_y) = a_1 s + a_2 s_perp,
-    q = Q q', and a_1 is fixed (the pairs' x slots hold it). Vertices where two edges meet fix
-    both components; an axis direction fixes one, unturned. The element arrays are turned before
-    assembly (f' = Q^T f, K' = Q^T K Q on the two pairs), the Newton correction back after the
-    solve; the state stays in x, y components. (Simply supported or sliding curved edges would
-    couple u_n to the tangential derivatives through the edge's curvature: not built.)
+    The carrier's pairs (u, v), (u_x, u_y), (v_x, v_y) and (w_x, w_y) turn as the slope pair of
+    the linear route does (module docstring): per vertex, the directions d its edges fix in a pair
+    (a . d = 0) fix the whole pair (two non-parallel), one axis component, or, turned as
+    (a_x, a_y) = a_1 d + a_2 d_perp (q = Q q'), a_1. w itself is fixed where a support holds it.
+    Per support, the directions fixed (n the edge's outward normal, s its tangent):
+
+        clamped            w;  (u, v): n and s;  (w_x, w_y): n and s;  (u_x, u_y), (v_x, v_y): s
+        clamped_sliding    w;  (u, v): n;        (w_x, w_y): n and s
+        simply_supported   w;  (u, v): s;        (w_x, w_y): s
+
+    Clamped holds u = v = w = 0 along the edge, hence grad w = 0 and the derivatives of u and v
+    along it. The sliding and simply supported edges hold u_n and u_s at the vertices only: along
+    a curved edge their derivatives along it couple to the other component through the edge's
+    curvature (d u_n / ds = n . grad u s - kappa u_s), which no turn of a pair expresses, so the
+    edge's displacement between vertices is the element's, converging with the mesh. The
+    element arrays are turned before assembly (f' = Q^T f, K' = Q^T K Q on the turned pairs),
+    the Newton correction back after the solve; the state stays in x, y components.
     """
 
-    PAIRS = ((3, 4), (5, 6))  # (u_x, u_y), (v_x, v_y) in shellform.assembly.sheet_element.COMPONENTS
-    HELD = (0, 1, 2, 7, 8)  # u, v, w, w_x, w_y
+    PAIRS = ((0, 1), (3, 4), (5, 6), (7, 8))  # (u, v), (u_x, u_y), (v_x, v_y), (w_x, w_y): COMPONENTS
+    W = 2
+    ROLES = {  # support -> (fixes w, per pair the directions fixed: "n", "s")
+        "clamped": (True, ("ns", "s", "s", "ns")),
+        "clamped_sliding": (True, ("n", "", "", "ns")),
+        "simply_supported": (True, ("s", "", "", "s")),
+    }
 
-    def __init__(self, V, blank, groups, tol: float = 1e-10):
+    def __init__(self, V, blank, supports: dict[str, str], tol: float = 1e-10):
         bs = V.dofmap.index_map_bs
         nblocks = V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts
-        self.Q = np.tile(np.eye(2), (nblocks, 1, 1))
-        self.rotated = np.zeros(nblocks, dtype=np.bool_)
+        npairs = len(self.PAIRS)
+        self.Q = np.tile(np.eye(2), (nblocks, npairs, 1, 1))
+        self.rotated = np.zeros((nblocks, npairs), dtype=np.bool_)
         fixed: set[int] = set()
-        directions: dict[int, list[np.ndarray]] = {}
-        for group in groups:
+        directions: dict[tuple[int, int], list[np.ndarray]] = {}
+        for group, support in supports.items():
+            holds_w, pairs = self.ROLES[support]
             for block, n in group_vertex_normals(V, blank, group, ghosts=True).items():
-                fixed.update(block * bs + k for k in self.HELD)
-                directions.setdefault(block, []).append(np.array([-n[1], n[0]]))
-        for block, ds in directions.items():
+                s = np.array([-n[1], n[0]])
+                if holds_w:
+                    fixed.add(block * bs + self.W)
+                for k, dirs in enumerate(pairs):
+                    for d in dirs:
+                        directions.setdefault((block, k), []).append(n if d == "n" else s)
+        for (block, k), ds in directions.items():
             kind, d = pair_constraint(ds, tol)
-            if kind == "turn":
-                self.rotated[block] = True
-                self.Q[block] = [[d[0], -d[1]], [d[1], d[0]]]
-            slots = {"both": (3, 4, 5, 6), "x": (3, 5), "y": (4, 6), "turn": (3, 5)}[kind]  # "turn": a_1 of each
-            fixed.update(block * bs + k for k in slots)
+            ix, iy = self.PAIRS[k]
+            if kind == "turn":  # a_1, the component along d, sits in the x slot
+                self.rotated[block, k] = True
+                self.Q[block, k] = [[d[0], -d[1]], [d[1], d[0]]]
+            fixed.update(block * bs + i for i in {"both": (ix, iy), "x": (ix,), "y": (iy,), "turn": (ix,)}[kind])
         self.dofs = np.array(sorted(fixed), dtype=np.int32)  # local, ghosts included, frame basis
         self.bs = bs
+        self._slots = np.array([i for i, _ in self.PAIRS], dtype=np.int64)
 
     def dirichlet(self, V):
         """Homogeneous conditions on the held slots (frame basis), one per component."""
@@ -265,38 +287,38 @@ class SheetEdgeFrames:
                 if np.any(slot == k)]
 
     def to_frames(self, array: np.ndarray) -> np.ndarray:
-        """q' = Q^T q on the turned blocks (a copy)."""
-        return self._turned(array, np.swapaxes(self.Q, 1, 2))
+        """q' = Q^T q on the turned pairs (a copy)."""
+        return self._turned(array, np.swapaxes(self.Q, 2, 3))
 
     def from_frames(self, array: np.ndarray) -> np.ndarray:
-        """q = Q q' on the turned blocks (a copy)."""
+        """q = Q q' on the turned pairs (a copy)."""
         return self._turned(array, self.Q)
 
     def _turned(self, array: np.ndarray, M: np.ndarray) -> np.ndarray:
         out = array.copy()
         d = out.reshape(-1, self.bs)
-        idx = np.flatnonzero(self.rotated[: d.shape[0]])
-        for i, j in self.PAIRS:
-            d[np.ix_(idx, [i, j])] = np.einsum("nab,nb->na", M[idx], d[np.ix_(idx, [i, j])])
+        for k, (i, j) in enumerate(self.PAIRS):
+            idx = np.flatnonzero(self.rotated[: d.shape[0], k])
+            d[np.ix_(idx, [i, j])] = np.einsum("nab,nb->na", M[idx, k], d[np.ix_(idx, [i, j])])
         return out
 
     def turn_cell_arrays(self, dofs, vectors, matrices, tangent: bool) -> None:
         """In place: f' = Q^T f, K' = Q^T K Q on the turned blocks' pairs."""
-        _turn_pairs(dofs, self.rotated, self.Q, vectors, matrices, tangent, self.bs)
+        _turn_pairs(dofs, self.rotated, self.Q, self._slots, vectors, matrices, tangent, self.bs)
 
 
 @jit.njit
-def _turn_pairs(dofs, rotated, Q, vectors, matrices, tangent, bs):
+def _turn_pairs(dofs, rotated, Q, slots, vectors, matrices, tangent, bs):
     ncells, nv = dofs.shape
     n = vectors.shape[1]
     for c in range(ncells):
         for a in range(nv):
             b = dofs[c, a]
-            if not rotated[b]:
-                continue
-            q00, q01, q10, q11 = Q[b, 0, 0], Q[b, 0, 1], Q[b, 1, 0], Q[b, 1, 1]
-            for i0 in (3, 5):
-                i, j = bs * a + i0, bs * a + i0 + 1
+            for p in range(slots.shape[0]):
+                if not rotated[b, p]:
+                    continue
+                q00, q01, q10, q11 = Q[b, p, 0, 0], Q[b, p, 0, 1], Q[b, p, 1, 0], Q[b, p, 1, 1]
+                i, j = bs * a + slots[p], bs * a + slots[p] + 1
                 fi, fj = vectors[c, i], vectors[c, j]
                 vectors[c, i], vectors[c, j] = q00 * fi + q10 * fj, q01 * fi + q11 * fj
                 if not tangent:

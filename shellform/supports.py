@@ -26,7 +26,7 @@ from dolfinx import fem
 
 from mpi4py import MPI
 
-from shellform.edge_frames import facet_normals
+from shellform.edge_frames import SheetEdgeFrames, facet_normals
 from shellform.errors import InputError
 
 _FIXED = {  # support -> components fixed, in terms of the side's normal (n) and tangent (s)
@@ -78,20 +78,22 @@ def edge_axis(blank, group: str, tol: float = 1e-9) -> str | None:
     return "x" if along[0] else "y" if along[1] else None
 
 
-def split_by_direction(blank, supports) -> tuple[dict[str, str], list[str]]:
-    """The nonlinear sheet's supports: ({group: support} on edges along x or y, [curved or
-    oblique clamped groups]); any other support on a curved or oblique edge is an InputError."""
-    straight, curved = {}, []
+def split_by_direction(blank, supports) -> tuple[dict[str, str], dict[str, str]]:
+    """The nonlinear sheet's supports: ({group: support} on edges along x or y, {group: support}
+    on curved or oblique edges, held in their frames: shellform.edge_frames.SheetEdgeFrames);
+    a support those frames do not hold on a curved or oblique edge is an InputError."""
+    straight, curved = {}, {}
     for group, support in supports.items():
         if support == "free":
             continue
         if edge_axis(blank, group) is not None:
             straight[group] = support
-        elif support == "clamped":
-            curved.append(group)
+        elif support in SheetEdgeFrames.ROLES:
+            curved[group] = support
         else:
-            raise InputError(f"supports.{group}", f"this edge is curved or oblique: the nonlinear sheet holds "
-                             f"such an edge 'clamped' only (in its frame), got {support!r}")
+            raise InputError(f"supports.{group}", f"this edge is curved or oblique: the nonlinear sheet holds such "
+                             f"an edge {', '.join(map(repr, SheetEdgeFrames.ROLES))} (in its frame), got {support!r}"
+                             + (" (a symmetry line is straight)" if support == "symmetry" else ""))
     return straight, curved
 
 

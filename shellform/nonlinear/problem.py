@@ -74,8 +74,8 @@ class SheetProblem:
     def on_blank(cls, rect, material, thickness, effects, supports, loads=None, prescribed=None, controls=None,
                  thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
         """The problem on a meshed blank (shellform.mesh.BlankMesh): supports on edges along x or
-        y fix components; a clamped curved or oblique edge is held in its own frame
-        (shellform.edge_frames.SheetEdgeFrames)."""
+        y fix components; a clamped, sliding or simply supported curved or oblique edge is held in
+        its own frame (shellform.edge_frames.SheetEdgeFrames)."""
         loads = loads or SheetLoads()
         mat = material.pack() if hasattr(material, "pack") else np.asarray(material, dtype=np.float64)
         model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0)

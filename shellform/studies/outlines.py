@@ -61,9 +61,9 @@ DISC_LOADS = (1.488, 4.904)
 DISC_N = (8, 16, 32)
 
 
-def clamped_disc(region: str, n: int, P: float, theta: float = 0.0):
-    """The nonlinear sheet on the unit disc (mesh turned by theta), its rim clamped, under
-    q = P 64 D t / a^4 (E = 1, t = SHEET_T); returns (w0 / t, the SheetProblem)."""
+def clamped_disc(region: str, n: int, P: float, theta: float = 0.0, rim: str = "clamped"):
+    """The nonlinear sheet on the unit disc (mesh turned by theta), its rim clamped (or `rim`),
+    under q = P 64 D t / a^4 (E = 1, t = SHEET_T); returns (w0 / t, the SheetProblem)."""
     from shellform.material import Hill79Material
     from shellform.mesh import outline
     from shellform.nonlinear.driver import Controls
@@ -74,7 +74,7 @@ def clamped_disc(region: str, n: int, P: float, theta: float = 0.0):
     c, sn = math.cos(theta), math.sin(theta)
     x = blank.mesh.geometry.x
     x[:, :2] = x[:, :2] @ np.array([[c, -sn], [sn, c]]).T
-    supports = {"rim": "clamped", **({"left": "symmetry", "bottom": "symmetry"} if region == "quarter" else {})}
+    supports = {"rim": rim, **({"left": "symmetry", "bottom": "symmetry"} if region == "quarter" else {})}
     D = SHEET_T**3 / (12 * (1 - NU**2))
     p = SheetProblem.on_blank(blank, Hill79Material(E=1.0, nu=NU), SHEET_T, SHEET, supports,
                               SheetLoads(pressure=P * 64 * D * SHEET_T),
