@@ -202,3 +202,14 @@ def test_square_cup_demo():
     rows = re.findall(r"^\s+(\d+\.\d)\s+(\d+\.\d+)\s+(\d+\.\d+)\s+(\d+\.\d+)\s+(-\d+\.\d+)\s+\d+\s+\d+\s*$", out, re.M)
     assert [float(r[0]) for r in rows] == [1.2, 2.4, 3.6, 4.8, 6.0], out
     assert out.rstrip().endswith("OK"), out
+
+
+def test_a_simply_supported_curved_rim_can_be_written_in_a_scene(tmp_path):
+    """The clamped disc's scene with `--set supports.rim="simply_supported"`: the nonlinear sheet
+    takes it (in the rim's frames) and deflects as shellform.studies.outlines' disc on the same
+    mesh, w0 = 2.3515 t (docs/outlines.md)."""
+    args = ["run", str(DEMOS / "clamped_disc_large_deflection.toml"), "--out", str(tmp_path),
+            "--set", 'supports.rim="simply_supported"']
+    assert cli.main(args) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["reports"][-1]["w"] / 0.01 == pytest.approx(2.35152, rel=1e-4)
