@@ -40,3 +40,4 @@ class ShellParameters:
     thickness: ufl.core.expr.Expr
     kappa0: ufl.core.expr.Expr | None = None
     pressure: ufl.core.expr.Expr | None = None
+    pressure_field: object = None  # forms.loads.PressureField: how the pressure spreads (None: uniform per plan area)

@@ -56,7 +56,7 @@ def constraints(f: HybridFields, p: ShellParameters, effects, n) -> ufl.Form:
 def external_work(f: HybridFields, p: ShellParameters, effects) -> ufl.Form | None:
     if p.pressure is None or f.w is None:
         return None
-    return loads.pressure_work(f.w, p.pressure)
+    return loads.pressure_work(f.w, p.pressure, p.pressure_field)
 
 
 def hybrid_functional(f: HybridFields, p: ShellParameters, effects, n) -> ufl.Form:

@@ -115,5 +115,6 @@ def weak_hessian_constraint(Psi, H, w, g, n):
 
 
 def dead_pressure(p, U, dx):
-    """Work of a pressure p along +z per unit blank area (a dead load, as in von Karman theory)."""
+    """Work of a pressure p along +z per unit blank area (a dead load, as in von Karman theory);
+    p may vary over the plan (forms.loads.PressureField.density)."""
     return p * U[2] * dx

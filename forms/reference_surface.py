@@ -5,103 +5,39 @@ The shallow-shell strains need only its curvature tensor,
     kappa0 = -grad grad z0                (the paraboloid z0 = -(x^2/R1 + y^2/R2)/2: diag(1/R1, 1/R2)),
 
 and the Kirchhoff-Love sheet its slopes and Hessian: X0 = (x, y, z0), grad X0 = [I; grad z0]^T.
-UFL differentiates the expression; nothing is approximated. The text is Python syntax with
-the names below (``x**2``, ``sin(pi*x/L)``); anything else is refused, so a scene file cannot
-run code. It is checked in bounded time and memory: at most MAX_LENGTH characters and MAX_DEPTH
-nested operations, one argument per function, and its value is computed in floating point
-(numbers as floats), so that ``9**9**9`` overflows at once instead of growing an integer.
+UFL differentiates the expression; nothing is approximated. What the text may hold, and how it
+is checked: forms/plan_field.py.
 """
 
-import ast
-import math
 from dataclasses import dataclass
 
 import ufl
 
-FUNCTIONS = ("sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "exp", "ln", "sqrt")
-_MATH = {**{f: getattr(math, f) for f in FUNCTIONS if f != "ln"}, "ln": math.log, "pi": math.pi}
-_UFL = {**{f: getattr(ufl, f) for f in FUNCTIONS}, "pi": ufl.pi}
-MAX_LENGTH = 1000  # characters of an expression
-MAX_DEPTH = 100  # operations nested in one another (a sum of n terms nests n deep)
-_NODES = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Call, ast.Name, ast.Load, ast.Constant,
-          ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.USub, ast.UAdd)
+from shellform.forms.plan_field import PlanField, first_nonfinite
 
 
 @dataclass(frozen=True)
-class ReferenceSurface:
-    """z0(x, y) from its text; hashable, so compiled kernels are cached per surface."""
+class ReferenceSurface(PlanField):
+    """z0(x, y) from its text (forms.plan_field: what the text may hold); hashable, so compiled
+    kernels are cached per surface."""
 
-    source: str
-
-    def problem(self) -> str | None:
-        """Why the text is no valid expression of x and y (None: it is one)."""
-        if len(self.source) > MAX_LENGTH:
-            return f"longer than {MAX_LENGTH} characters ({len(self.source)})"
-        try:
-            tree = ast.parse(self.source, mode="eval")
-        except SyntaxError as err:
-            return f"not an expression: {err.msg}"
-        except (MemoryError, RecursionError, ValueError):
-            return f"nested too deeply (at most {MAX_DEPTH} levels)"
-        if _depth(tree) > MAX_DEPTH:
-            return f"nested too deeply (at most {MAX_DEPTH} levels)"
-        for node in ast.walk(tree):
-            if not isinstance(node, _NODES):
-                return (f"{type(node).__name__} is not allowed; use numbers, x, y, + - * / **, pi and "
-                        f"{', '.join(FUNCTIONS)}")
-            if isinstance(node, ast.Name) and node.id not in ("x", "y", *_MATH):
-                return f"unknown name {node.id!r}; known: x, y, pi, {', '.join(FUNCTIONS)}"
-            if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS):
-                return "only the functions " + ", ".join(FUNCTIONS) + " may be called"
-            if isinstance(node, ast.Call) and (len(node.args) != 1 or node.keywords):
-                return f"{node.func.id} takes one argument, got {len(node.args) + len(node.keywords)}"
-            if isinstance(node, ast.Constant) and (isinstance(node.value, bool) or
-                                                   not isinstance(node.value, int | float)):
-                return f"{node.value!r} is no number"
-        return None
-
-    def quoted(self, most: int = 60) -> str:
-        """The text as messages quote it: in full up to `most` characters, else its start and
-        its length (an error message stays one line)."""
-        if len(self.source) <= most:
-            return repr(self.source)
-        return f"{self.source[:most]!r}... ({len(self.source):,} characters)"
-
-    def value(self, x, y):
-        """z0 at a point in floating point, every number of the text taken as a float, so that
-        no power grows an unbounded integer (for checks and plots)."""
-        tree = _Floats().visit(ast.parse(self.source, mode="eval"))
-        code = compile(ast.fix_missing_locations(tree), "surface.z0", "eval")
-        return float(eval(code, {"__builtins__": {}}, {**_MATH, "x": x, "y": y}))
+    FIELD = "surface.z0"
 
     def nonfinite_point(self, mesh) -> tuple[str, tuple[float, float]] | None:
         """Where on the mesh z0, its slopes or its second derivatives (UFL's, as the forms take
-        them) are not finite: (which of them, (x, y)); None where all are finite. Evaluated at
-        each cell's vertices and at the points of its degree-4 Gauss rule, the nonlinear sheet's
-        quadrature; collective over the mesh's ranks."""
-        import basix
-        import dolfinx.fem
-        import numpy as np
-
+        them) are not finite: (which of them, (x, y)); None where all are finite (first_nonfinite:
+        at each cell's vertices and the nonlinear sheet's quadrature points; collective)."""
         x = ufl.SpatialCoordinate(mesh)
         g, H = self.slopes(x), self.hessian(x)
-        values = ufl.as_vector([self.z0(x), g[0], g[1], H[0, 0], H[0, 1], H[1, 1], x[0], x[1]])
-        rule, _ = basix.make_quadrature(basix.CellType.triangle, 4)
-        points = np.vstack([[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], rule])
-        cells = np.arange(mesh.topology.index_map(2).size_local, dtype=np.int32)
-        v = dolfinx.fem.Expression(values, points, comm=mesh.comm).eval(mesh, cells).reshape(-1, 8)
-        bad = np.flatnonzero(~np.isfinite(v[:, :6]).all(axis=1))
-        mine = None
-        if bad.size:
-            row = v[bad[0]]
-            what = "z0" if not np.isfinite(row[0]) else "its slopes" if not np.isfinite(row[1:3]).all() \
-                else "its second derivatives"
-            mine = (what, (float(row[6]), float(row[7])))
-        return next((b for b in mesh.comm.allgather(mine) if b is not None), None)
+        bad = first_nonfinite(mesh, [self.z0(x), g[0], g[1], H[0, 0], H[0, 1], H[1, 1]])
+        if bad is None:
+            return None
+        k, where = bad
+        return ("z0" if k == 0 else "its slopes" if k < 3 else "its second derivatives"), where
 
     def z0(self, x):
         """The UFL expression of z0 at the spatial coordinate x."""
-        return self._eval(_UFL, x[0], x[1])
+        return self.ufl(x)
 
     def slopes(self, x):
         return ufl.grad(self.z0(x))
@@ -111,20 +47,3 @@ class ReferenceSurface:
 
     def kappa0(self, x):
         return -self.hessian(x)
-
-    def _eval(self, names, x, y):
-        return eval(compile(self.source, "surface.z0", "eval"), {"__builtins__": {}}, {**names, "x": x, "y": y})
-
-
-def _depth(tree) -> int:
-    deepest, stack = 0, [(tree, 1)]
-    while stack:
-        node, d = stack.pop()
-        deepest = max(deepest, d)
-        stack.extend((child, d + 1) for child in ast.iter_child_nodes(node))
-    return deepest
-
-
-class _Floats(ast.NodeTransformer):
-    def visit_Constant(self, node):
-        return ast.Constant(float(node.value)) if isinstance(node.value, int) else node

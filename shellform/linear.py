@@ -80,7 +80,8 @@ def parameters(mesh, scene: Scene) -> ShellParameters:
     if isinstance(kappa0, np.ndarray):
         kappa0 = fem.Constant(mesh, kappa0)
     pressure = c(scene.loads.pressure) if "bending" in scene.effects else None
-    return ShellParameters(E=c(m.E), nu=c(m.nu), thickness=c(m.thickness), kappa0=kappa0, pressure=pressure)
+    return ShellParameters(E=c(m.E), nu=c(m.nu), thickness=c(m.thickness), kappa0=kappa0, pressure=pressure,
+                           pressure_field=scene.pressure_field() if pressure is not None else None)
 
 
 def mesh(scene: Scene, comm=MPI.COMM_WORLD):

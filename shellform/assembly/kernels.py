@@ -31,6 +31,7 @@ from ufl.algorithms import expand_derivatives
 
 from shellform.forms import functional
 from shellform.forms.fields import HybridFields, ShellParameters
+from shellform.forms.loads import PressureField
 from shellform.forms.reference_surface import ReferenceSurface
 from shellform.assembly import condensation, slope_map
 from shellform.assembly.hybrid_element import HybridElement
@@ -96,7 +97,7 @@ class CompiledForm:
         return np.concatenate(idx).astype(np.int64) if idx else np.zeros(0, dtype=np.int64)
 
 
-_PARAMETERS = ("E", "nu", "thickness", "kappa0", "pressure")
+_PARAMETERS = ("E", "nu", "thickness", "kappa0", "pressure", "pressure_field")
 
 
 def _signature_of(params: ShellParameters) -> tuple:
@@ -104,7 +105,7 @@ def _signature_of(params: ShellParameters) -> tuple:
     sig = []
     for name in _PARAMETERS:
         c = getattr(params, name)
-        if isinstance(c, ReferenceSurface):  # kappa0 = -grad grad z0, compiled into the kernels
+        if isinstance(c, ReferenceSurface | PressureField):  # kappa0 = -grad grad z0, p's field: compiled in
             sig.append((name, c))
         elif c is not None:
             sig.append((name, tuple(c.ufl_shape)))
@@ -133,9 +134,10 @@ class ElementKernels:
         self.element, self.mapped = element, mapped
         domain = ufl.Mesh(basix.ufl.element("Lagrange", "triangle", 1, shape=(2,)))
         placeholders = {name: ufl.Constant(domain, shape=shape) for name, shape in param_signature
-                        if not isinstance(shape, ReferenceSurface)}
+                        if not isinstance(shape, ReferenceSurface | PressureField)}
         x = ufl.SpatialCoordinate(domain)
-        surfaces = {name: s.kappa0(x) for name, s in param_signature if isinstance(s, ReferenceSurface)}
+        surfaces = {name: s.kappa0(x) if isinstance(s, ReferenceSurface) else s for name, s in param_signature
+                    if isinstance(s, ReferenceSurface | PressureField)}
         params = ShellParameters(**{n: placeholders.get(n, surfaces.get(n)) for n in _PARAMETERS})
         z, fields = part_fields(element, domain)
         n = ufl.FacetNormal(domain)

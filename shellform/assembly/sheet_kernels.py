@@ -120,6 +120,8 @@ class SheetKernels:
         self.tangent_offsets = packed_offsets(ufcx_t, ftangent, [z, Sq, Dq])
         p = ufl.Constant(domain)
         self.pressure, _ = _cell_kernel(comm, ufl.derivative(kl.dead_pressure(p, U, dx), z, dz))
+        self._pressure_form = lambda field: ufl.derivative(kl.dead_pressure(field.density(x), U, dx), z, dz)
+        self._pressure_fields, self._comm = {}, comm
         ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS,
                                 jit_options=JIT_OPTIONS)
         self.strain = ufcx_e.tabulate_tensor_float64
@@ -141,17 +143,23 @@ class SheetKernels:
         self.nconst = 4 if shallow is True else 0  # a constant kappa0 in every kernel that sees it
         self.edge_gradients = assumed_membrane.cubic_gradients()  # reference, at the edge points
 
-        self.setup = self._setup_loop()
         self.strain_loop = self._strain_loop()
         self.tensor_loop = self._tensor_loop()
 
     # -- the loops, bound to this configuration's kernels and tables -----------------------------
-    def _setup_loop(self):
+    def setup(self, cells_coords, P_out, F_out, pressure_field=None) -> None:
+        """Per cell P (H = P q_c) and the element pressure vector for p = 1, spread by
+        `pressure_field` (forms.loads.PressureField: its kernel compiled once per field)."""
+        kernel = self.pressure
+        if pressure_field is not None:
+            if pressure_field not in self._pressure_fields:
+                self._pressure_fields[pressure_field] = _cell_kernel(self._comm, self._pressure_form(pressure_field))[0]
+            kernel = self._pressure_fields[pressure_field]
         el = self.element
         he = el.hessian
-        return functools.partial(setup_loop, kernel_address(self.hessian_cell), kernel_address(self.hessian_facet),
-                                 kernel_address(self.pressure), he.q, he.eps, he.lam, *el.hessian_tables,
-                                 *el.q_map(), el.component_columns(), he.dim, el.nz, el.sym_dim)
+        setup_loop(kernel_address(self.hessian_cell), kernel_address(self.hessian_facet), kernel_address(kernel),
+                   he.q, he.eps, he.lam, *el.hessian_tables, *el.q_map(), el.component_columns(), he.dim, el.nz,
+                   el.sym_dim, cells_coords, P_out, F_out)
 
     def _strain_loop(self):
         el = self.element

@@ -310,7 +310,22 @@ def blank(comm, scene, points=()) -> BlankMesh:
         out = from_file(comm, g.file, m.n, m.refine)
     check_symmetry_lines(out, scene.supports)
     _check_reference_surface(out.mesh, scene)
+    _check_pressure_shape(out.mesh, scene)
     return out
+
+
+def _check_pressure_shape(msh, scene) -> None:
+    """The pressure's shape is finite on the scene's mesh, before any form integrates it."""
+    from shellform.forms.plan_field import PlanField
+
+    if not scene.loads.pressure_shape:
+        return
+    shape = PlanField(scene.loads.pressure_shape)
+    bad = shape.nonfinite_point(msh)
+    if bad is not None:
+        x, y = bad[1]
+        raise InputError("loads.pressure_shape", f"{shape.quoted()} is not finite at ({x:.6g}, {y:.6g}) of the "
+                         "blank's mesh")
 
 
 def _check_reference_surface(msh, scene) -> None:

@@ -37,6 +37,7 @@ class EdgeMoment:
 @dataclass
 class SheetLoads:
     pressure: float = 0.0
+    pressure_field: object = None  # forms.loads.PressureField (None: uniform per unit plan area)
     points: list[PointForce] = field(default_factory=list)
     moments: list[EdgeMoment] = field(default_factory=list)
 

@@ -76,7 +76,7 @@ class SheetModel:
     components = COMPONENTS
 
     def __init__(self, mesh, material, thickness: float, effects=("geometric_nonlinearity",),
-                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4):
+                 thickness_points: int = 5, kappa0=None, quadrature_degree: int = 4, pressure_field=None):
         check_mesh(mesh)
         if not np.isfinite(thickness):
             raise InputError("material.thickness", f"must be finite, got {thickness}")
@@ -116,8 +116,8 @@ class SheetModel:
         el = self.kernels.element
         self.nqp = el.nqp
         self.P = np.zeros((self.num_cells, el.sym_dim, 9))
-        self.pressure_vectors = np.zeros((self.num_cells, NDOF))  # a unit dead pressure along +z
-        self.kernels.setup(self.cell_coords, self.P, self.pressure_vectors)
+        self.pressure_vectors = np.zeros((self.num_cells, NDOF))  # a unit dead pressure along +z (spread by pressure_field)
+        self.kernels.setup(self.cell_coords, self.P, self.pressure_vectors, pressure_field)
         # Material state: committed (n) and trial, per cell, quadrature point and layer.
         nz = thickness_points if self.plastic else 1
         if self.plastic:

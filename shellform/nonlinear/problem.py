@@ -52,7 +52,7 @@ class SheetProblem:
         material, supports, pressure, point forces and edge moments, initial curvature, and
         the controls of its [process] (scene_controls)."""
         loads = SheetLoads(
-            pressure=s.loads.pressure,
+            pressure=s.loads.pressure, pressure_field=s.pressure_field(),
             points=[PointForce(p.x, p.y, (p.fx, p.fy, p.fz)) for p in s.loads.point],
             moments=[EdgeMoment(mo.side, mo.m) for mo in s.loads.moment])
         controls, kappa0 = scene_controls(s), s.curvature()
@@ -78,7 +78,8 @@ class SheetProblem:
         its own frame (shellform.edge_frames.SheetEdgeFrames)."""
         loads = loads or SheetLoads()
         mat = material.pack() if hasattr(material, "pack") else np.asarray(material, dtype=np.float64)
-        model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0)
+        model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0,
+                           pressure_field=loads.pressure_field)
         V, comps = model.V, model.components
         straight, curved = named_supports.split_by_direction(rect, supports)
         bcs = named_supports.boundary_conditions(V, comps, rect, straight,

@@ -17,8 +17,8 @@ from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
                                     DIAGONALS, HARDENING, MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS,
-                                    MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, REGIONS, SIDES, SUPPORTS, Scene,
-                                    bounds)
+                                    MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES,
+                                    SUPPORTS, Scene, bounds)
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
@@ -226,6 +226,20 @@ def _plausible_stiffness(material) -> None:
 def _validate_loads(s: Scene) -> None:
     g, loads = s.geometry, s.loads
     require(math.isfinite(loads.pressure), "loads.pressure", "must be finite")
+    require(loads.pressure_per in PRESSURE_PER, "loads.pressure_per",
+            f"must be one of {', '.join(map(repr, PRESSURE_PER))}, got {loads.pressure_per!r}")
+    if loads.pressure_shape:
+        from shellform.forms.plan_field import PlanField
+
+        shape = PlanField(loads.pressure_shape)
+        problem = shape.problem()
+        require(problem is None, "loads.pressure_shape", f"{shape.quoted()}: {problem}")
+        require(s.tools is None, "loads.pressure_shape", "tool scenes take no pressure")
+        try:
+            value = shape.value(0.123, 0.456)
+        except (ArithmeticError, ValueError) as err:
+            raise InputError("loads.pressure_shape", f"{shape.quoted()} cannot be evaluated: {err}") from None
+        require(math.isfinite(value), "loads.pressure_shape", f"{shape.quoted()} is not finite at (0.123, 0.456)")
     for i, p in enumerate(loads.point):
         for name in ("x", "y", "fx", "fy", "fz"):
             require(math.isfinite(getattr(p, name)), f"loads.point[{i}].{name}", "must be finite")

@@ -38,6 +38,7 @@ SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
 NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
 SIDES = ("left", "right", "bottom", "top")
+PRESSURE_PER = ("plan", "surface")  # the pressure per unit plan area or per unit area of the curved surface
 # what a mirror line needs (u_n = 0, w,n = 0; shellform/supports.py): symmetry, or a support holding more
 MIRROR_SUPPORTS = ("symmetry", "clamped", "clamped_sliding")
 MAY_BE_INFINITE = ("surface.R1", "surface.R2")  # inf: flat along that direction
@@ -140,7 +141,9 @@ class EdgeMoment:
 
 @dataclass
 class Loads:
-    pressure: float = 0.0  # uniform, along +w
+    pressure: float = 0.0  # along +w, per unit plan area (uniform unless pressure_shape says otherwise)
+    pressure_shape: str = ""  # p(x, y) = pressure * pressure_shape, an expression in x, y (forms/plan_field.py)
+    pressure_per: str = "plan"  # "plan": per unit plan area; "surface": per unit area of the curved surface (self weight)
     point: list[PointLoad] = field(default_factory=list)
     moment: list[EdgeMoment] = field(default_factory=list)  # nonlinear scenes only
 
@@ -278,6 +281,24 @@ class Scene:
         if self.surface.z0:
             return ReferenceSurface(self.surface.z0)
         return np.diag(self.kappa0).astype(np.float64)
+
+    def pressure_field(self):
+        """How the pressure spreads (forms.loads.PressureField): its shape over the plan and, per
+        unit surface area, the curved surface it is measured on; None for a uniform pressure per
+        unit plan area (or on a flat sheet, where the two are the same)."""
+        import numpy as np
+
+        from shellform.forms.loads import PressureField
+        from shellform.forms.reference_surface import ReferenceSurface
+
+        surface = None
+        if self.loads.pressure_per == "surface" and self.surface.z0:
+            surface = ReferenceSurface(self.surface.z0)
+        elif self.loads.pressure_per == "surface" and any(k != 0 for k in self.kappa0):
+            surface = tuple(float(v) for v in np.diag(self.kappa0).ravel())
+        if not self.loads.pressure_shape and surface is None:
+            return None
+        return PressureField(self.loads.pressure_shape, surface)
 
     @property
     def symmetry_copies(self) -> int:
