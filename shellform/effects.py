@@ -65,6 +65,10 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            ("bending", "membrane"), why="is an effect of the nonlinear sheet, a full shell",
            doc="exact (total-Lagrangian Kirchhoff-Love) membrane and bending strains and the "
                "initial-stress stiffness"),
+    Effect("deep_shell", "sheet part", "shellform.forms.kirchhoff_love", (SHEET, TOOLS), ("bending", "membrane"),
+           why="is an effect of the nonlinear sheet, a full shell",
+           doc="the Kirchhoff-Love sheet on the exact reference surface X0 = (x, y, z0), not shallow theory; "
+               "its strains linearised unless geometric_nonlinearity is on: the linear deep shell"),
     Effect("plasticity", "sheet part", "shellform.material.section", (SHEET, TOOLS), ("bending", "membrane"),
            why="is an effect of the nonlinear sheet, a full shell",
            keys=("material.hardening", "material.yield_stress", "material.n", "material.K", "material.eps0",

@@ -127,6 +127,23 @@ def test_scordelis_lo_roof_scene(tmp_path):
     assert w["at"] == pytest.approx([0.0, 25.0 * np.sin(np.radians(40.0))], abs=1e-9)
 
 
+def test_scordelis_lo_roof_deep_scene_converges_towards_the_deep_shell(tmp_path):
+    """demos/scordelis_lo_roof_deep.toml: the linear sheet on the exact cylinder under its weight
+    per unit roof area (deep_shell, pressure_per = "surface"). On n = 16 and 32 the free edge's
+    midpoint deflects -0.2855 and -0.2959: towards MacNeal and Harder's -0.3024, the error falling
+    by 2.7, and nowhere near the shallow panel's -0.3487; the shallow theory is not in it."""
+    w = {}
+    for n in (16, 32):
+        out = tmp_path / f"n{n}"
+        assert cli.main(["run", str(DEMOS / "scordelis_lo_roof_deep.toml"), "--out", str(out),
+                         "--set", f"mesh.n={n}"]) == 0
+        e = json.loads((out / "summary.json").read_text())["reports"][-1]["extremes"]["w"]
+        assert e["at_initial_xy"] == pytest.approx([0.0, 25.0 * np.sin(np.radians(40.0))], abs=1e-9)
+        w[n] = e["value"]
+    errors = [abs(w[n] / -0.3024 - 1) for n in (16, 32)]
+    assert -0.3024 < w[32] < w[16] < 0 and errors[1] < 0.025 and errors[0] / errors[1] > 2.2, (w, errors)
+
+
 def test_curved_beam_scene(tmp_path):
     """demos/curved_beam.toml, MacNeal and Harder's 6 x 1 mesh with cubic_membrane: the tip
     deflection along the in-plane load within 1.5 % of the published 0.08734 (0.99 of it)."""
