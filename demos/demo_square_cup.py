@@ -100,7 +100,7 @@ rows = []
 for stroke in np.linspace(0.0, args.stroke, 6)[1:]:
     p.driver.run(stroke / s.tools.stroke)
     d, thin = cup.draw_in(p), cup.peak_thinning(p)
-    rows.append((p.stroke, d["DX"], d["DD"], p.punch_force() / 1e3, thin["max_thickness_strain"],
+    rows.append((p.stroke, d["DX"], d["DD"], p.punch_force() / 1e3, thin["min_thickness_strain"],
                  len(p.driver.history), sum(h.iterations for h in p.driver.history)))
 
 print(f"{'stroke_mm':>10} {'DX_mm':>7} {'DD_mm':>7} {'punch_kN':>9} {'thickness_strain':>17} "

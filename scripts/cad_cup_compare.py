@@ -29,7 +29,7 @@ for name in ("numisheet93_aluminium", "numisheet93_aluminium_cad"):
     d = draw_in(p)
     times = ", ".join(f"{k} {v:.2f}" for k, v in p.driver.times.items())
     print(f"{name}: increments {len(h)}, iterations {sum(x.iterations for x in h)}, force {p.punch_force():.6g} N, "
-          f"DX {d['DX']:.10g}, DD {d['DD']:.10g}, thinning {peak_thinning(p)['max_thickness_strain']:.8g}, "
+          f"DX {d['DX']:.10g}, DD {d['DD']:.10g}, thinning {peak_thinning(p)['min_thickness_strain']:.8g}, "
           f"run {run:.2f} s ({times})", flush=True)
     for tool_name, (tool, _, _) in p.tool_placements().items():
         if hasattr(tool, "counts"):

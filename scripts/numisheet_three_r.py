@@ -42,5 +42,5 @@ for name, changes in runs.items():
         d = draw_in(p)
         print(f"{name}: stroke {p.stroke:.3f} mm, DX {d['DX']:.4f}, DY {d['DY']:.4f}, DD {d['DD']:.4f} mm, "
               f"DX - DY {d['DX'] - d['DY']:+.4f} mm, punch force {p.punch_force() / 1e3:.3f} kN, "
-              f"peak thickness strain {peak_thinning(p)['max_thickness_strain']:.4f}, {len(h)} increments, "
+              f"peak thickness strain {peak_thinning(p)['min_thickness_strain']:.4f}, {len(h)} increments, "
               f"{sum(x.iterations for x in h)} iterations, {wall:.1f} s", flush=True)

@@ -107,7 +107,7 @@ def test_tools_route_summary(tmp_path):
     assert summary.closing_line() == (
         f"shellform: {s.title}: {summary['cells']} cells, stroke 0.20 mm, draw-in (mm) DX {last['DX']:.3f}, "
         f"DY {last['DY']:.3f}, DD {last['DD']:.3f}, punch force {summary['punch_force_kN'][-1]['force']:.2f} kN, "
-        f"largest thinning (thickness strain) {summary['max_thickness_strain']:.4f}, "
+        f"largest thinning (thickness strain) {summary['min_thickness_strain']:.4f}, "
         f"{summary['wall_time_s']['total']:.1f} s; results in {tmp_path}")
     assert summary.exit_status() == 0
 

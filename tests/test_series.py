@@ -98,7 +98,7 @@ def test_the_cup_series_opens_in_pyvista_as_the_drawn_cup(tmp_path):
     for name in ("equivalent_plastic_strain", "major_strain", "minor_strain", "fld_margin"):
         assert np.all(np.isfinite(cup.cell_data[name])), name
     assert cup.cell_data["equivalent_plastic_strain"].max() > 0
-    np.testing.assert_allclose(cup.point_data["thickness_strain"].min(), summary["max_thickness_strain"], rtol=1e-12)
+    np.testing.assert_allclose(cup.point_data["thickness_strain"].min(), summary["min_thickness_strain"], rtol=1e-12)
     assert set(np.unique(cup.point_data["contact_state"])) <= {0, 1, 2, 3, 4}
     assert (cup.point_data["contact_state"] == 1).any()  # nodes on the punch
     free = cup.point_data["contact_state"] == 0

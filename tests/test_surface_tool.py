@@ -272,7 +272,7 @@ def _drawn(path, n, stroke):
     s = scene.load(path).changed({"mesh.n": n})
     p = DrawingProblem.from_scene(s, verbose=False)
     p.driver.run(stroke / s.tools.stroke)
-    return {**draw_in(p), "force": p.punch_force(), "thinning": peak_thinning(p)["max_thickness_strain"],
+    return {**draw_in(p), "force": p.punch_force(), "thinning": peak_thinning(p)["min_thickness_strain"],
             "iterations": sum(h.iterations for h in p.driver.history),
             "increments": len(p.driver.history), "balance": p.force_balance()}
 

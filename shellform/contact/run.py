@@ -2,7 +2,7 @@
 
 Writes into the output folder (forces and draw-in for the whole blank, pictures included):
     summary.json             stroke_mm, draw_in_mm (DX, DY, DD) and punch_force_kN at every
-                             reported stroke; max_thickness_strain and where; the sheet's
+                             reported stroke; min_thickness_strain and where; the sheet's
                              volume change (V - V0)/V0 (elastic only, with finite strains); increments,
                              Newton iterations, contact passes, element evaluations (run,
                              reused, and how many computed a tangent); wall_time_s and its split;

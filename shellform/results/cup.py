@@ -130,7 +130,7 @@ def peak_thinning(p) -> dict:
     X, x, e33 = p.nodal_values()
     X, x, e33 = _gather(p.model.mesh.comm, X, x, e33)
     i = int(np.argmin(e33))
-    return {"max_thickness_strain": float(e33[i]), "where_initial_xy_mm": X[i].tolist(),
+    return {"min_thickness_strain": float(e33[i]), "where_initial_xy_mm": X[i].tolist(),
             "where_current_xyz_mm": x[i].tolist(), "max_thickening_strain": float(e33.max())}
 
 

@@ -62,4 +62,4 @@ class DrawingSummary(Summary):
         force = self["punch_force_kN"][-1]["force"] if self.get("punch_force_kN") else float("nan")
         return (f"shellform: {self['title']}: {self['cells']} cells, stroke {self['stroke_mm']:.2f} mm, "
                 f"draw-in (mm) {draw_in}, punch force {force:.2f} kN, largest thinning (thickness strain) "
-                f"{self['max_thickness_strain']:.4f}, {self['wall_time_s']['total']:.1f} s; results in {self.outdir}")
+                f"{self['min_thickness_strain']:.4f}, {self['wall_time_s']['total']:.1f} s; results in {self.outdir}")

@@ -33,7 +33,7 @@ def table(out: Path, runs, finest: str, reports: tuple[str, ...], measures=MEASU
         for at in summary["reports"]:
             mm = next((m for m in reports if abs(at["stroke_mm"] - float(m)) < 1e-6), None)
             if mm is not None:
-                values = {"force": at["punch_force_kN"], **at["draw_in_mm"], "thinning": at["max_thickness_strain"]}
+                values = {"force": at["punch_force_kN"], **at["draw_in_mm"], "thinning": at["min_thickness_strain"]}
                 r.update({f"{q}_{mm}": values[q] for q in measures})
         rows.append(r)
     ref = next(r for r in rows if r["case"] == finest)

@@ -102,7 +102,7 @@ def row(out: Path, n: int, ranks: int, rtol: float | None = None, one_core: bool
         mm = next((m for m in REPORTS if abs(at["stroke_mm"] - m) < 1e-6), None)
         if mm is not None:
             r.update({f"force_{mm:g}": at["punch_force_kN"], f"DX_{mm:g}": at["draw_in_mm"]["DX"],
-                      f"DD_{mm:g}": at["draw_in_mm"]["DD"], f"thinning_{mm:g}": at["max_thickness_strain"]})
+                      f"DD_{mm:g}": at["draw_in_mm"]["DD"], f"thinning_{mm:g}": at["min_thickness_strain"]})
     return r
 
 

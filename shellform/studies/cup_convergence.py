@@ -109,7 +109,7 @@ def row(case: str, n: int, out: Path) -> dict:
                                  ["holder_off_band"]),
          "off_band_peak": max(float(x["holder_off_band"]) for x in curve),
          "late_force_jump": late_jump(curve),
-         "max_thickness_strain": s["max_thickness_strain"], "where_x_mm": s["where_initial_xy_mm"][0],
+         "min_thickness_strain": s["min_thickness_strain"], "where_x_mm": s["where_initial_xy_mm"][0],
          "where_y_mm": s["where_initial_xy_mm"][1], "stopped": s["stopped"] or ""}
     for rep in s["reports"]:
         at = f"{rep['stroke_mm']:g}"
@@ -125,7 +125,7 @@ def estimates(rows: list[dict], reports) -> list[dict]:
     finished meshes (cell size h ~ cells^-1/2)."""
     done = [r for r in rows if r["finished"]]
     out = []
-    keys = [f"{a}_{rep:g}" for rep in reports for a in ANSWERS] + ["max_thickness_strain"]
+    keys = [f"{a}_{rep:g}" for rep in reports for a in ANSWERS] + ["min_thickness_strain"]
     for key in keys:
         have = [r for r in done if r.get(key) is not None]
         e = {"case": rows[0]["case"], "answer": key, "values": " ".join(f"{r[key]:.6g}" for r in have),
@@ -152,7 +152,7 @@ def markdown(rows: list[dict], ests: list[dict]) -> str:
         first, last = (f"{x:g}" for x in (CASES[case][2][0], part[0]["stroke_mm"]))
         text += [f"### {case}", "",
                  f"| n (cells) | DX {first} | DD {first} | force {first} (kN) | DX {last} | DD {last} | force {last} (kN) "
-                 "| max thickness strain | holder opens at | largest share of F | edge load / F (start, peak) "
+                 "| min thickness strain | holder opens at | largest share of F | edge load / F (start, peak) "
                  f"| off the band / F ({first}, peak) | late force jump | iterations, cut-backs | wall (s) |",
                  "|" + "---|" * 15]
         for r in part:
@@ -160,7 +160,7 @@ def markdown(rows: list[dict], ests: list[dict]) -> str:
             stopped = "" if r["finished"] else f" (stopped at {r['stroke_mm']:.1f} mm)"
             text.append(f"| {r['n']} ({r['cells']:,}){stopped} | {_num(r.get('DX_' + first))} | {_num(r.get('DD_' + first))} "
                         f"| {_num(r.get('force_' + first), 2)} | {_num(r.get('DX_' + last), 2)} | {_num(r.get('DD_' + last), 2)} "
-                        f"| {_num(r.get('force_' + last), 2)} | {_num(r['max_thickness_strain'])} | {opens} "
+                        f"| {_num(r.get('force_' + last), 2)} | {_num(r['min_thickness_strain'])} | {opens} "
                         f"| {_num(r['largest_share'])} | {_num(r['edge_load_start'])}, {_num(r['edge_load_peak'])} "
                         f"| {_num(r['off_band_first'], 4)}, {_num(r['off_band_peak'], 4)} "
                         f"| {100 * r['late_force_jump']:.1f} % | {r['newton_iterations']}, {r['cutbacks']} | {r['wall_s']:.0f} |")

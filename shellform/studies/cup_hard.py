@@ -23,7 +23,7 @@ from shellform.results.tables import write_csv
 
 ROOT = Path(__file__).resolve().parents[2]
 COLUMNS = ["case", "n", "stroke_mm", "target_mm", "finished", "increments", "newton_iterations", "cutbacks",
-           "wall_s", "peak_punch_force_kN", "max_thickness_strain", "stopped"]
+           "wall_s", "peak_punch_force_kN", "min_thickness_strain", "stopped"]
 
 
 def variant(n: int, name: str = "square_cup.toml", **changes) -> scene.Scene:
@@ -59,7 +59,7 @@ def row(name: str, s: scene.Scene, out: Path) -> dict:
             "finished": summary["stopped"] is None, "increments": summary["increments"],
             "newton_iterations": summary["newton_iterations"], "cutbacks": summary["cutbacks"],
             "wall_s": summary["wall_time_s"]["total"], "peak_punch_force_kN": max(curve, default=0.0),
-            **summary["draw_in_mm"][-1], "max_thickness_strain": summary["max_thickness_strain"],
+            **summary["draw_in_mm"][-1], "min_thickness_strain": summary["min_thickness_strain"],
             "stopped": summary["stopped"] or ""}
 
 

@@ -27,7 +27,7 @@ from shellform.studies.cup_hard import ROOT, draw, folder, variant
 
 FRICTION = (0.0, 0.05, 0.1, 0.15, 0.2)
 MESHES = ("n 12", "n 16", "n 24")
-COLUMNS = ["friction", "stroke_mm", "max_thickness_strain", "where_initial_xy_mm", "punch_force_30_kN",
+COLUMNS = ["friction", "stroke_mm", "min_thickness_strain", "where_initial_xy_mm", "punch_force_30_kN",
            "DX", "DD", "increments", "newton_iterations", "wall_s", "stopped", "run"]
 
 
@@ -68,7 +68,7 @@ def figures(out: Path, meshes: Path, hard: Path) -> list[dict]:
     for mu in FRICTION:
         d = demo if mu == 0.1 else folder(out, f"mu {mu:g}")
         s = json.loads((d / "summary.json").read_text())
-        rows.append({"friction": mu, "stroke_mm": s["stroke_mm"], "max_thickness_strain": s["max_thickness_strain"],
+        rows.append({"friction": mu, "stroke_mm": s["stroke_mm"], "min_thickness_strain": s["min_thickness_strain"],
                      "where_initial_xy_mm": " ".join(f"{v:.1f}" for v in s["where_initial_xy_mm"]),
                      "punch_force_30_kN": s["punch_force_kN"][-1]["force"], "DX": s["draw_in_mm"][-1]["DX"],
                      "DD": s["draw_in_mm"][-1]["DD"], "increments": s["increments"],
@@ -103,7 +103,7 @@ def _plots(out: Path, meshes: Path, hard: Path, rows: list[dict]) -> None:
         fig.savefig(out / f"{fig_name}.png", dpi=120)
         plt.close(fig)
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot([r["friction"] for r in rows], [r["max_thickness_strain"] for r in rows], "o-")
+    ax.plot([r["friction"] for r in rows], [r["min_thickness_strain"] for r in rows], "o-")
     ax.set_xlabel("Coulomb friction coefficient")
     ax.set_ylabel("peak thinning at 30 mm (thickness strain)")
     ax.set_title("Peak thickness strain (punch corner) against friction, 16 x 16", fontsize=9)

@@ -17,7 +17,7 @@ from shellform.results.log import say
 from shellform.results.tables import write_csv
 from shellform.studies.cup_hard import draw, folder, variant
 
-COLUMNS = ["case", "stroke_mm", "punch_force_kN", "DX", "DY", "DD", "max_thickness_strain",
+COLUMNS = ["case", "stroke_mm", "punch_force_kN", "DX", "DY", "DD", "min_thickness_strain",
            "max_thickening_strain", "volume_change", "increments", "newton_iterations", "wall_s", "stopped"]
 
 
@@ -42,7 +42,7 @@ def table(out: Path, n: int = 16) -> list[dict]:
         summary = json.loads((folder(out, name) / "summary.json").read_text())
         for r in summary["reports"]:
             rows.append({"case": name, "stroke_mm": r["stroke_mm"], "punch_force_kN": r["punch_force_kN"],
-                         **r["draw_in_mm"], "max_thickness_strain": r["max_thickness_strain"],
+                         **r["draw_in_mm"], "min_thickness_strain": r["min_thickness_strain"],
                          "max_thickening_strain": r["max_thickening_strain"], "volume_change": r["volume_change"],
                          "increments": summary["increments"], "newton_iterations": summary["newton_iterations"],
                          "wall_s": summary["wall_time_s"]["total"], "stopped": summary["stopped"] or ""})

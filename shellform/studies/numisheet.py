@@ -19,7 +19,7 @@ from shellform.results.tables import write_csv
 from shellform.studies.cup_hard import draw, folder, variant
 
 CUPS = {"aluminium": "numisheet93_aluminium.toml", "mild steel": "numisheet93_steel.toml"}
-COLUMNS = ["cup", "stroke_mm", "DX", "DY", "DD", "punch_force_kN", "max_thickness_strain",
+COLUMNS = ["cup", "stroke_mm", "DX", "DY", "DD", "punch_force_kN", "min_thickness_strain",
            "where_initial_xy_mm", "where_current_xyz_mm", "min_margin", "increments", "newton_iterations",
            "cutbacks", "wall_s", "stopped"]
 
@@ -39,7 +39,7 @@ def table(out: Path) -> list[dict]:
         s = json.loads((folder(out, name) / "summary.json").read_text())
         for r in s["reports"]:
             rows.append({"cup": name, "stroke_mm": r["stroke_mm"], **r["draw_in_mm"],
-                         "punch_force_kN": r["punch_force_kN"], "max_thickness_strain": r["max_thickness_strain"],
+                         "punch_force_kN": r["punch_force_kN"], "min_thickness_strain": r["min_thickness_strain"],
                          "where_initial_xy_mm": " ".join(f"{v:.1f}" for v in r["where_initial_xy_mm"]),
                          "where_current_xyz_mm": " ".join(f"{v:.1f}" for v in r["where_current_xyz_mm"]),
                          "min_margin": s.get("min_margin", "") if r is s["reports"][-1] else "",
