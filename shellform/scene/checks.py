@@ -39,15 +39,7 @@ def validate(s: Scene) -> None:
     if s.surface.z0:
         from shellform.forms.reference_surface import ReferenceSurface
 
-        surface = ReferenceSurface(s.surface.z0)
-        problem = surface.problem()
-        require(problem is None, "surface.z0", f"{surface.quoted()}: {problem}")
-        require(s.tools is None, "surface.z0", "tool scenes draw a flat blank")
-        try:
-            value = surface.value(0.123, 0.456)
-        except (ArithmeticError, ValueError) as err:
-            raise InputError("surface.z0", f"{surface.quoted()} cannot be evaluated: {err}") from None
-        require(math.isfinite(value), "surface.z0", f"{surface.quoted()} is not finite at (0.123, 0.456)")
+        _check_plan_field(ReferenceSurface(s.surface.z0), s, "tool scenes draw a flat blank")
     require(m.kind in MESH_KINDS, "mesh.kind", f"must be one of {MESH_KINDS}, got {m.kind!r}")
     require(m.n >= 1, "mesh.n", f"must be >= 1, got {m.n}")
     require(m.refine >= 0, "mesh.refine", f"must be >= 0, got {m.refine}")
@@ -223,6 +215,20 @@ def _plausible_stiffness(material) -> None:
             f"2000: are E and the stresses in the same unit (MPa with lengths in mm)?"), stacklevel=2)
 
 
+def _check_plan_field(f, s: Scene, no_tools: str, key: str | None = None) -> None:
+    """A field's text (forms.plan_field) is an expression of x and y, finite at a sample point,
+    and the scene draws no tools (`no_tools` says why); errors name `key` (default f.FIELD)."""
+    key = key or f.FIELD
+    problem = f.problem()
+    require(problem is None, key, f"{f.quoted()}: {problem}")
+    require(s.tools is None, key, no_tools)
+    try:
+        value = f.value(0.123, 0.456)
+    except (ArithmeticError, ValueError) as err:
+        raise InputError(key, f"{f.quoted()} cannot be evaluated: {err}") from None
+    require(math.isfinite(value), key, f"{f.quoted()} is not finite at (0.123, 0.456)")
+
+
 def _validate_loads(s: Scene) -> None:
     g, loads = s.geometry, s.loads
     require(math.isfinite(loads.pressure), "loads.pressure", "must be finite")
@@ -231,15 +237,7 @@ def _validate_loads(s: Scene) -> None:
     if loads.pressure_shape:
         from shellform.forms.plan_field import PlanField
 
-        shape = PlanField(loads.pressure_shape)
-        problem = shape.problem()
-        require(problem is None, "loads.pressure_shape", f"{shape.quoted()}: {problem}")
-        require(s.tools is None, "loads.pressure_shape", "tool scenes take no pressure")
-        try:
-            value = shape.value(0.123, 0.456)
-        except (ArithmeticError, ValueError) as err:
-            raise InputError("loads.pressure_shape", f"{shape.quoted()} cannot be evaluated: {err}") from None
-        require(math.isfinite(value), "loads.pressure_shape", f"{shape.quoted()} is not finite at (0.123, 0.456)")
+        _check_plan_field(PlanField(loads.pressure_shape), s, "tool scenes take no pressure", "loads.pressure_shape")
     for i, p in enumerate(loads.point):
         for name in ("x", "y", "fx", "fy", "fz"):
             require(math.isfinite(getattr(p, name)), f"loads.point[{i}].{name}", "must be finite")
