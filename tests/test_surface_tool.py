@@ -193,6 +193,20 @@ def test_inward_normals_turn_gap_and_normal(cad, tmp_path):
     assert np.abs(turned.shape(x) + cad["die"].shape(x)).max() < 1e-9
 
 
+def test_a_sphere_s_poles_do_not_stop_the_search():
+    """A sphere's OCC face has a degenerated edge, a point with no curve, at each pole; the tool
+    leaves those out (the face holds the points), so points near and around the poles get the
+    sphere's exact distance and normal (they raised 'curve is null in projection' before)."""
+    tool = SurfaceTool.from_builder(lambda gmsh: gmsh.model.occ.addSphere(0.0, 0.0, 0.0, 10.0))
+    rng = np.random.default_rng(3)
+    x = np.vstack([[[0.0, 0.0, 10.3], [0.0, 0.0, -9.6], [0.01, -0.02, 11.0], [0.0, 0.0, 0.5]],
+                   rng.normal(size=(200, 3)) * 8.0])
+    g, n = tool.gap(x, 0.0, 0.0)
+    r = np.linalg.norm(x, axis=1)
+    np.testing.assert_allclose(g, r - 10.0, atol=1e-9)
+    np.testing.assert_allclose(n, x / r[:, None], atol=1e-9)  # the outward normal, inside too
+
+
 def test_bad_files_are_named(tmp_path):
     """A missing file, a file that is no CAD file by its name, a file OCC cannot read and a
     file with no surface: each an InputError naming the field given."""

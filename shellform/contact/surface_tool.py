@@ -136,6 +136,16 @@ class _Projections:
         return ref, delta
 
 
+def _degenerate(gmsh, edge: int) -> bool:
+    """Whether an edge of the model is a point with no curve: OCC's degenerated edge at a
+    sphere's pole or a cone's apex (its bounding box is a point grown by OCC's tolerance). It
+    has nothing to project onto, and the face around it holds that point, so the tool leaves it
+    out."""
+    box = np.array(gmsh.model.getBoundingBox(1, edge))
+    extent = float(np.max(box[3:] - box[:3]))
+    return gmsh.model.getType(1, edge) == "Unknown" and extent <= 1e-6 * (1.0 + float(np.abs(box).max()))
+
+
 class SurfaceTool:
     """A rigid tool: the faces of the OCC model `model` (a gmsh model's name), placed by
     `translation` (mm), its faces' normals pointing to the sheet (`normals` "outward") or away
@@ -150,7 +160,7 @@ class SurfaceTool:
         self.translation = np.asarray(translation, dtype=float).reshape(3)
         with _Current(model) as gmsh:
             self.faces = [t for _, t in gmsh.model.getEntities(2)]
-            self.edges = [t for _, t in gmsh.model.getEntities(1)]
+            self.edges = [t for _, t in gmsh.model.getEntities(1) if not _degenerate(gmsh, t)]
             if not self.faces:
                 raise ValueError("the model holds no surface")
             self._face_adjacent = {e: sorted(set(int(f) for f in gmsh.model.getAdjacencies(1, e)[0]))
@@ -161,7 +171,8 @@ class SurfaceTool:
             self._index = {de: k for k, de in enumerate(self._ents)}
             self._is_face = np.array([d == 2 for d, _ in self._ents])
             self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
-                                                               for e in gmsh.model.getAdjacencies(2, f)[1]], dtype=int)
+                                                               for e in gmsh.model.getAdjacencies(2, f)[1]
+                                                               if (1, abs(int(e))) in self._index], dtype=int)
                                 for f in self.faces}
 
     # -- construction ------------------------------------------------------------------------
