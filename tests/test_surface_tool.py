@@ -7,6 +7,7 @@ the normal, 1e-5 of the largest curvature in H (measured: 3e-8 mm, 1e-7 and 2e-6
 nose corner, a torus onto which OCC projects iteratively; 1e-14 on the die's planes, cylinders and tori)."""
 
 import importlib.util
+import json
 from pathlib import Path
 
 import numpy as np
@@ -347,3 +348,22 @@ def test_step_tools_on_two_ranks(tmp_path):
     assert parallel["iterations"] == serial["iterations"]
     assert parallel["force"] == pytest.approx(serial["force"], rel=1e-6)
     assert parallel["DX"] == pytest.approx(serial["DX"], rel=1e-6)
+
+
+def test_the_dome_cup_stretches_the_sheet_over_the_hemispherical_punch(tmp_path):
+    """demos/dome_cup.toml (a CAD hemisphere in the CAD square die) on 8 x 8 x 2 cells, 4 mm:
+    no cut-back, no penetration, the tools' forces balanced, and the sheet thins most at the
+    dome's tip, where it follows the punch down the stroke (docs/tools.md, "A dome cup")."""
+    from shellform import cli
+
+    scene_file = ROOT / "demos" / "dome_cup.toml"
+    args = ["run", str(scene_file), "-o", str(tmp_path), "--set", "mesh.n=8", "--set", "tools.stroke=4.0",
+            "--set", "process.initial_step=0.02", "--set", "process.max_step=0.05", "--set", "process.report=[]"]
+    assert cli.main(args) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["stopped"] is None and s["cutbacks"] == 0
+    worst = s["over_the_stroke"]
+    assert worst["force_balance"] < 2e-6 and worst["max_penetration_mm"] < 0.01 * 0.81
+    x, y, z = s["where_current_xyz_mm"]
+    assert np.hypot(x, y) < 1e-6 and z == pytest.approx(-4.0, abs=0.02)
+    assert s["min_thickness_strain"] < -0.005 and s["punch_force_kN"][-1]["force"] > 0.5
