@@ -60,7 +60,7 @@ class SheetNodes(Part):
         self.area, self.cell_size = sums[:, 0], np.sqrt(2.0 * sums[:, 1] / sums[:, 0])
         # (cells, 3, 2): each cell's centroid from each of its vertices, in the vertex's cell sizes (recover)
         self._centroid_offsets = (x.mean(axis=1)[:, None, :] - x) / self._at_vertices(self.cell_size)[..., None]
-        self.flat = self.pinched = np.zeros(self.n_owned, dtype=bool)
+        self.flat, self.pinched = np.zeros(self.n_owned, dtype=bool), np.zeros(self.n_owned, dtype=bool)
         self._set_thickness()
         self.q = None
         self.x_n = self.X[: self.n_owned].copy()

@@ -179,7 +179,7 @@ class SheetModel:
         curvature K - taper measures bending from.
 
         A sheet lying between two flat faces whose thickness t varies has its mid-surface a half
-        thickness above the lower face, so that surface curves, K = grad grad (t / 2), although no
+        thickness above the lower face, so that surface curves, K = -grad grad (t / 2), although no
         fibre of the sheet is bent: both faces of the material stay flat, and a solid sheet of that
         shape carries no moment. The Kirchhoff section, whose normals stay normal to the
         mid-surface, would read that curvature as bending, and with the thickness's kinks at the
