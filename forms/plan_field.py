@@ -73,10 +73,10 @@ class PlanField:
         return float(eval(code, {"__builtins__": {}}, {**_MATH, "x": x, "y": y}))
 
     def nonfinite_point(self, mesh) -> tuple[str, tuple[float, float]] | None:
-        """Where on the mesh the field is not finite: (its name, (x, y)); None where it is finite
-        everywhere (first_nonfinite; collective)."""
+        """Where on the mesh the field is not finite: (what is not, as a message says it: "it is",
+        (x, y)); None where it is finite everywhere (first_nonfinite; collective)."""
         bad = first_nonfinite(mesh, [self.ufl(ufl.SpatialCoordinate(mesh))])
-        return None if bad is None else (self.FIELD, bad[1])
+        return None if bad is None else ("it is", bad[1])
 
     def ufl(self, x):
         """The UFL expression of the field at the spatial coordinate x."""

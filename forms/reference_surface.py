@@ -25,7 +25,8 @@ class ReferenceSurface(PlanField):
 
     def nonfinite_point(self, mesh) -> tuple[str, tuple[float, float]] | None:
         """Where on the mesh z0, its slopes or its second derivatives (UFL's, as the forms take
-        them) are not finite: (which of them, (x, y)); None where all are finite (first_nonfinite:
+        them) are not finite: (which of them, as a message says it: "z0 is", "its slopes are", ...,
+        (x, y)); None where all are finite (first_nonfinite:
         at each cell's vertices and the nonlinear sheet's quadrature points; collective)."""
         x = ufl.SpatialCoordinate(mesh)
         g, H = self.slopes(x), self.hessian(x)
@@ -33,7 +34,7 @@ class ReferenceSurface(PlanField):
         if bad is None:
             return None
         k, where = bad
-        return ("z0" if k == 0 else "its slopes" if k < 3 else "its second derivatives"), where
+        return ("z0 is" if k == 0 else "its slopes are" if k < 3 else "its second derivatives are"), where
 
     def z0(self, x):
         """The UFL expression of z0 at the spatial coordinate x."""

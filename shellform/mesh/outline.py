@@ -309,36 +309,24 @@ def blank(comm, scene, points=()) -> BlankMesh:
     else:
         out = from_file(comm, g.file, m.n, m.refine)
     check_symmetry_lines(out, scene.supports)
-    _check_reference_surface(out.mesh, scene)
-    _check_pressure_shape(out.mesh, scene)
+    _check_fields_finite(out.mesh, scene)
     return out
 
 
-def _check_pressure_shape(msh, scene) -> None:
-    """The pressure's shape is finite on the scene's mesh, before any form integrates it."""
+def _check_fields_finite(msh, scene) -> None:
+    """The scene's fields given as text are finite on its mesh, before any form takes them: z0 of
+    a curved scene with its first and second derivatives (sqrt(x) on a blank with x < 0 would fail
+    in the linear solve), and the pressure's shape."""
     from shellform.forms.plan_field import PlanField
-
-    if not scene.loads.pressure_shape:
-        return
-    shape = PlanField(scene.loads.pressure_shape)
-    bad = shape.nonfinite_point(msh)
-    if bad is not None:
-        x, y = bad[1]
-        raise InputError("loads.pressure_shape", f"{shape.quoted()} is not finite at ({x:.6g}, {y:.6g}) of the "
-                         "blank's mesh")
-
-
-def _check_reference_surface(msh, scene) -> None:
-    """z0 of a curved scene and its first and second derivatives are finite on its mesh, before
-    any form takes them (sqrt(x) on a blank with x < 0 would fail in the linear solve)."""
     from shellform.forms.reference_surface import ReferenceSurface
 
-    surface = scene.curvature()
-    if not isinstance(surface, ReferenceSurface):
-        return
-    bad = surface.nonfinite_point(msh)
-    if bad is not None:
-        what, (x, y) = bad
-        verb = "is" if what == "z0" else "are"
-        raise InputError("surface.z0", f"{surface.quoted()}: {what} {verb} not finite at ({x:.6g}, {y:.6g}) of the "
-                         "blank's mesh")
+    fields, surface = [], scene.curvature()
+    if isinstance(surface, ReferenceSurface):
+        fields.append((surface, "surface.z0"))
+    if scene.loads.pressure_shape:
+        fields.append((PlanField(scene.loads.pressure_shape), "loads.pressure_shape"))
+    for field, key in fields:
+        bad = field.nonfinite_point(msh)
+        if bad is not None:
+            what, (x, y) = bad
+            raise InputError(key, f"{field.quoted()}: {what} not finite at ({x:.6g}, {y:.6g}) of the blank's mesh")
