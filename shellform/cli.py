@@ -43,6 +43,7 @@ STUDIES = {
     "locking": "membrane locking: thin roll-ups and a curved roof",
     "cup-convergence": "the aluminium and the square cup on a sequence of meshes: observed orders, Richardson estimates",
     "pinch-edge": "the holder's edge load resolved below the thickness: a plane-strain strip",
+    "nakajima": "the Nakajima test: specimens of eleven widths stretched to the forming limit, their strain paths",
 }
 
 SCENE_HELP = "the scene's TOML file (docs/scenes.md)"

@@ -23,6 +23,8 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 class FlatTool:
     """A rigid flat face at z_face over |x| <= a (and |y| <= b), pushing along `sign` z."""
 
+    axis = np.array([0.0, 0.0, 1.0])  # it travels by dz along z
+
     def __init__(self, z_face, a, b=np.inf, sign=-1.0):
         self.z_face, self.a, self.b, self.sign = z_face, a, b, sign
 

@@ -4,22 +4,29 @@ placement around the blank at the start."""
 
 import numpy as np
 
+from shellform.contact.placement import UP, Placed, rotation
 from shellform.contact.surface_tool import SurfaceTool
 from shellform.errors import InputError
 
 
 def cad_cup_tools(spec, thickness: float) -> dict:
     """Punch, die and blank holder of a scene's [tools] with shape = "cad" around a sheet of that
-    thickness whose mid-surface is z = 0: the punch and the die from their files, placed by
-    their translations; the holder the flat analytic one (tools.BlankHolder) with its face on
+    thickness whose mid-surface is z = 0: the punch and the die from their files, turned by
+    their rotations and moved by their translations (placement.Placed), the punch travelling
+    along punch_direction; the holder the flat analytic one (tools.BlankHolder) with its face on
     the sheet's upper surface over the plan outside the rounded square (holder_half_width,
     holder_corner_radius): it pinches the flange onto the die's flat top, which check_start
     asks to lie on the sheet's lower surface there."""
     from shellform.contact.tools import BlankHolder
 
+    def placed(name, axis=UP):
+        tool = SurfaceTool.from_file(getattr(spec, f"{name}_file"), normals=getattr(spec, f"{name}_normals"),
+                                     field=f"tools.{name}_file")
+        return Placed(tool, rotation(getattr(spec, f"{name}_rotation")), getattr(spec, f"{name}_translation"), axis)
+
     return dict(
-        punch=SurfaceTool.from_file(spec.punch_file, spec.punch_translation, spec.punch_normals, "tools.punch_file"),
-        die=SurfaceTool.from_file(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file"),
+        punch=placed("punch", -np.asarray(spec.punch_direction, dtype=float)),  # it travels -stroke along its axis
+        die=placed("die"),
         holder=BlankHolder(spec.holder_half_width, spec.holder_corner_radius, thickness / 2),
     )
 

@@ -7,7 +7,8 @@ normal contact force R0 is *unknown*, the residual of that known row (the paper'
     K11 dq1 = dp1 - K12 dq*      (27)  free increments, the known ones lifted to the right
     dp*     = K21 dq1 + K22 dq*  (28)  contact forces: the residual on the known rows
 
-The tools are given in contact order (punch, die); tool k moves by lambda travel[k] along z.
+The tools are given in contact order (punch, die); tool k moves by lambda travel[k] along its
+axis (tool.axis: +z for the analytic tools, any direction for a placed one, placement.py).
 The open holder's face is one more tool (holder.py), the last. Each tool gives its gap,
 normal and shape operator H = dn/dx (tools.py). A node moving along a curved tool turns its
 frame; its tangential rows t_a . R, with R ~ R0 n, then change by R0 n . dt_a = -R0 W_ab dx_b,
@@ -54,6 +55,7 @@ class ContactSet(Part):
 
     def __init__(self, nodes, tools, travel, controls: ContactControls, thickness: float, die=None, holder=None):
         self.nodes, self.tools, self.travel = nodes, list(tools), np.asarray(travel, dtype=float)
+        self.axes = np.array([tool.axis for tool in self.tools], dtype=float).reshape(-1, 3)
         self.controls, self.thickness = controls, thickness
         self.die = len(self.tools) - 1 if die is None else int(die)
         self.holder = holder
@@ -66,7 +68,7 @@ class ContactSet(Part):
         self.early_step = self.EARLY_STEP
         self.lam_n = 0.0
         self.curvature = np.zeros((n, 2, 2))  # W of each node's tool in its tangent slots
-        self.shift = np.zeros(n)  # z-travel of each node's tool in this increment
+        self.shift = np.zeros((n, 3))  # the travel of each node's tool in this increment
         self.slid_off = np.zeros(n, dtype=bool)  # nodes that slid off their tool's extent (this iterate)
         self.switched = np.zeros(n, dtype=bool)  # nodes that switched in the last update
         self.net = np.zeros(n)  # the net normal forces of the last refresh
@@ -162,7 +164,7 @@ class ContactSet(Part):
         self._x = x
         gaps = self.gaps(x, lam)
         self.curvature = np.zeros((x.shape[0], 2, 2))
-        self.shift = np.zeros(x.shape[0])
+        self.shift = np.zeros((x.shape[0], 3))
         self.slid_off = np.zeros(x.shape[0], dtype=bool)
         for k in range(len(gaps)):
             off = (self.tool == k) & ~np.isfinite(gaps[k][0])  # slid off the tool's extent
@@ -180,7 +182,7 @@ class ContactSet(Part):
             H = self.tools[k].shape(x[on], 0.0, lam * self.travel[k])  # dn/dx
             t = c.frames[on][:, :2]
             self.curvature[on] = np.einsum("nai,nij,nbj->nab", t, H, t)  # W_ab = t_a . H t_b
-            self.shift[on] = (lam - self.lam_n) * self.travel[k]
+            self.shift[on] = (lam - self.lam_n) * self.travel[k] * self.axes[k]
 
     def add_tangent(self, K, R, fixed) -> None:
         """K_ab += -R0 W_ab on the tangent slots of the nodes on curved tools (module

@@ -213,7 +213,7 @@ class CoulombFriction(Part):
     # -- one iterate ---------------------------------------------------------------------------
     def slip(self, idx, shift, x, x_n, F, normal) -> None:
         """The return mapping on the rubbing nodes idx at positions x (x_n: at the start of the
-        increment; shift: their tool's z-travel in it; F: their frames, normal F[:, 2]) with the
+        increment; shift: their tool's travel in it, (m, 3); F: their frames, normal F[:, 2]) with the
         normal forces `normal` (all nodes); every other node carries no friction."""
         self.force[:] = 0.0
         self.rate[:] = 0.0
@@ -222,7 +222,7 @@ class CoulombFriction(Part):
             return
         n = F[:, 2]
         ds = x[idx] - x_n[idx]
-        ds[:, 2] -= shift
+        ds -= shift
         ds -= np.sum(ds * n, axis=1)[:, None] * n  # tangential slip increment
         h = self.history[idx]
         f_old = h - np.sum(h * n, axis=1)[:, None] * n

@@ -77,9 +77,10 @@ class DrawingProblem:
         return self.symmetry * total
 
     def punch_force(self) -> float:
-        """The force the punch pushes with (N, > 0 when drawing), whole blank. In-plane
-        components cancel by symmetry; a quarter model reports only z."""
-        return -float(self.tool_force(PUNCH)[2])
+        """The force the punch pushes with along its travel (N, > 0 when drawing), whole blank:
+        the sheet's force from it along its axis, negated (the punch travels down its axis,
+        +z for the analytic punch)."""
+        return -float(self.tool_force(PUNCH) @ self.driver.tools[PUNCH].axis)
 
     def holder_force(self) -> float:
         """The sum of the holder's nodal forces on the sheet (N, pressing down), whole blank: the
@@ -228,8 +229,8 @@ class DrawingProblem:
         return state, force / d.nodes.area
 
     def tool_placements(self) -> dict:
-        """The tools where they are now: name -> (tool, its z-shift from its initial position,
-        whether it lies above the sheet). The punch has moved by its share of the stroke; the
+        """The tools where they are now: name -> (tool, its travel along its axis from its initial
+        position, whether it lies above the sheet). The punch has moved by its share of the stroke; the
         holder's face rests on the sheet's highest top under it (holder_height), or lies at its
         lift when open."""
         d = self.driver

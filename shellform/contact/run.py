@@ -33,6 +33,14 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
     fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
                              Keeler-Brazier forming-limit curve, each cell's margin to it;
                              cup_margin.png the cup coloured by that margin (results/fld.py)
+    strain_path.csv          ([output] fld) the major and minor true strains along the stroke
+                             (every stroke/200 and at the reports) of the element whose margin is
+                             smallest at the end: its strain path (after a resume, from the
+                             resumed stroke); summary.json "strain_path":
+                             where it is and where it ends. With [process] stop_at_forming_limit
+                             the stroke ends at the increment where the smallest margin reaches
+                             0; summary.json "forming_limit_reached": the stroke interpolated to
+                             margin 0 and the increment's (results/fld.py)
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
                              after the tools withdraw (contact/springback.py; the picture: after
                              minus before); summary.json: wall angle, flange edge, re-yield,
@@ -59,7 +67,7 @@ from shellform.errors import InputError
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
-from shellform.results import cup, run_folder
+from shellform.results import cup, fld, run_folder
 from shellform.results.log import Progress
 from shellform.results.summary import DrawingSummary
 from shellform.results.tables import write_csv, write_json
@@ -70,6 +78,10 @@ from shellform.scene import Scene
 STEPPING = {"process.initial_step", "process.min_step", "process.max_step", "process.max_iterations", "process.rtol"}
 # worst values over all increments, in summary.json: the balances and the pinch
 CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
+
+
+class FormingLimitReached(Exception):
+    """The stroke ends: an element's margin to the forming-limit curve reached 0."""
 
 
 def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list, dict]:
@@ -128,6 +140,11 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if s.output.vtx or s.output.vtu else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
     saved_at = [time.monotonic()]  # when the last checkpoint was written
+    paths = watch = None
+    if p.model.plastic and (s.output.fld or s.process.stop_at_forming_limit):
+        (curve_of_limits, _), _ = fld.curves(s.material)
+        paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
+        watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
 
     def on_increment(d):
         h = d.history[-1]
@@ -145,6 +162,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         every = s.output.checkpoint_every  # the last converged increment on disk at least this often
         if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
             checkpoint_now()
+        if paths is not None or watch is not None:
+            f = p.model.cell_fields()
+            if paths is not None:
+                paths.record(p.stroke, f["major_strain"], f["minor_strain"])
+            if watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"]):
+                raise FormingLimitReached
 
     def write_curve():
         write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
@@ -162,6 +185,9 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
 
     def report():
         reports.append(state())
+        if paths is not None:
+            f = p.model.cell_fields()
+            paths.record(p.stroke, f["major_strain"], f["minor_strain"], final=True)
         write_json(outdir / "reports.json", reports)  # what a resumed run takes over
         if series is not None:
             series.write(p.stroke)
@@ -173,6 +199,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             p.driver.run(target, on_increment=on_increment)
             report()
             checkpoint_now()
+    except FormingLimitReached:  # the stroke ends here, drawn as far as the sheet can go
+        p.driver.progress.note(f"shellform: the forming-limit curve is reached at {watch.limit['stroke_mm']:.4g} mm")
+        report()
+        checkpoint_now()
     except ConvergenceFailure as err:
         stopped = str(err)
         p.driver.progress.note(f"shellform: stopped: {err}")
@@ -194,6 +224,16 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
     limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
+    if paths is not None:
+        path = paths.critical(p.model.cell_coords.reshape(-1, 3, 3).mean(axis=1)[:, :2])
+        if path:
+            rows = [dict(zip(("stroke_mm", "major", "minor", "margin"), r))
+                    for r in zip(path["stroke_mm"], path["major"], path["minor"], path["margin"])]
+            write_csv(outdir / "strain_path.csv", rows, ["stroke_mm", "major", "minor", "margin"])
+            limits["strain_path"] = {"initial_xy_mm": path["initial_xy_mm"], "points": len(rows),
+                                     "end": {k: path[k][-1] for k in ("stroke_mm", "major", "minor", "margin")}}
+    if watch is not None:
+        limits["forming_limit_reached"] = watch.limit
     sprung = None
     if s.process.springback and stopped is None:
         before = cup.profiles(p.initial_positions(), p.driver.displacements(), comm)

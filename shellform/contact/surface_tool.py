@@ -152,6 +152,7 @@ class SurfaceTool:
     from it ("inward": turned). Build it with from_file or from_builder."""
 
     _count = 0
+    axis = np.array([0.0, 0.0, 1.0])  # its travel dz is along z (placement.py turns and moves it)
 
     def __init__(self, model: str, translation=(0.0, 0.0, 0.0), normals: str = "outward"):
         if normals not in NORMALS:

@@ -106,6 +106,8 @@ class Punch:
     d_core = sqrt(max(s, 0)^2 + max(h, 0)^2),  s = its plan sdf,  h = z_face + rp - z.
     """
 
+    axis = UP  # its travel dz is along z (placement.py: the contract's axis)
+
     half_width: float
     corner_radius: float
     profile_radius: float
@@ -159,6 +161,8 @@ class Die:
     O = rounded square (a + rd, rc + rd); core: plan outside O, z <= z_top - rd.
     d_core = sqrt(max(-s, 0)^2 + max(h, 0)^2),  s = sdf of O,  h = z - (z_top - rd).
     """
+
+    axis = UP  # its travel dz is along z (placement.py: the contract's axis)
 
     half_width: float
     corner_radius: float
@@ -215,6 +219,8 @@ class BlankHolder:
     (inner_half_width, inner_corner_radius): the die's flat top. Signed distance z_face - z
     there, +inf over the opening (the holder never reaches over it)."""
 
+    axis = UP  # its travel dz is along z (placement.py: the contract's axis)
+
     inner_half_width: float
     inner_corner_radius: float
     z_face: float
@@ -259,7 +265,7 @@ def square_cup_tools(spec, thickness: float) -> dict:
 
 
 def surface_mesh(tool, dz: float, bounds, z_range, above: bool, n: int = 96):
-    """A triangulated surface of `tool` moved by dz along z, over the plan rectangle
+    """A triangulated surface of `tool` moved by dz along its axis, over the plan rectangle
     bounds = (x0, x1, y0, y1), for pictures and ParaView: (points (k, 3), triangles (m, 3)).
 
     Each point of an n x n plan grid takes the height where the tool's signed distance

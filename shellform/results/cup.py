@@ -271,7 +271,8 @@ class CupSeries:
         t = p.scene.tools
         span = t.stroke + max(t.punch_profile_radius, t.die_profile_radius)  # the walls, as deep as the stroke
         for name, (tool, dz, above) in placements.items():
-            z_range = (dz - span, dz + span)
+            z = dz * tool.axis[2]  # the height it has moved by
+            z_range = (z - span, z + span)
             points, tris = surface_mesh(tool, dz, (x0, x1, y0, y1), z_range, above, self.TOOL_GRID)
             self.series[name].write(stroke, points, tris)
 

@@ -145,3 +145,67 @@ def plot(path, major, minor, curve, title: str, label: str, beside=None) -> None
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+class FormingLimitWatch:
+    """Where a stroke reaches the forming-limit curve: after each increment the smallest margin
+    over the elements (every rank's); `reached` once it is <= 0. The stroke at which it is 0 is
+    interpolated linearly in the stroke between the last increment with a positive margin and
+    the first without (the margin of the element that is worst at each: a lower bound of the
+    limit's stroke where the worst element changes between them)."""
+
+    def __init__(self, curve, comm):
+        self.curve, self.comm = curve, comm
+        self.last = None  # (stroke, smallest margin) of the last increment
+        self.limit = None  # what reached() found, or None
+
+    def reached(self, stroke: float, major, minor) -> bool:
+        margin = margins(major, minor, self.curve)
+        least = self.comm.allreduce(float(margin.min(initial=np.inf)), op=MPI.MIN)
+        if least <= 0.0 and self.limit is None:
+            at = stroke
+            if self.last is not None and self.last[1] > 0.0:
+                s0, m0 = self.last
+                at = s0 + (stroke - s0) * m0 / (m0 - least)
+            self.limit = {"stroke_mm": at, "increment_stroke_mm": stroke, "margin": least}
+        self.last = (stroke, least)
+        return self.limit is not None
+
+
+class StrainPaths:
+    """The elements' major and minor true strains along the stroke (each rank its own elements),
+    recorded where the stroke has moved by at least `spacing` since the last record and at the
+    end (`final`): a bounded record, about stroke / spacing copies of two strains per element.
+    `critical` gives the path of the element whose margin to the curve is smallest at the last
+    record: the strain path that ends nearest the forming limit (or past it)."""
+
+    def __init__(self, curve, comm, spacing: float):
+        self.curve, self.comm, self.spacing = curve, comm, spacing
+        self.strokes, self.major, self.minor = [], [], []
+
+    def record(self, stroke: float, major, minor, final: bool = False) -> None:
+        if self.strokes and not final and stroke - self.strokes[-1] < self.spacing:
+            return
+        if self.strokes and stroke == self.strokes[-1]:  # recorded already
+            return
+        self.strokes.append(float(stroke))
+        self.major.append(np.asarray(major, dtype=np.float32).copy())
+        self.minor.append(np.asarray(minor, dtype=np.float32).copy())
+
+    def critical(self, centres) -> dict:
+        """{"initial_xy_mm", "stroke_mm", "major", "minor", "margin"} of that element (centres:
+        the local elements' initial centres, (cells, 2)), on every rank; {} before any record."""
+        if not self.strokes:
+            return {}
+        margin = margins(self.major[-1], self.minor[-1], self.curve)
+        local = (float(margin.min()), self.comm.rank) if margin.size else (np.inf, self.comm.rank)
+        _, owner = min(self.comm.allgather(local))
+        path = None
+        if self.comm.rank == owner:
+            i = int(np.argmin(margin))
+            major = [float(a[i]) for a in self.major]
+            minor = [float(b[i]) for b in self.minor]
+            path = {"initial_xy_mm": [float(c) for c in centres[i]], "stroke_mm": list(self.strokes),
+                    "major": major, "minor": minor,
+                    "margin": [float(m) for m in margins(np.array(major), np.array(minor), self.curve)]}
+        return self.comm.bcast(path, root=owner)

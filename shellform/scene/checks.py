@@ -167,7 +167,10 @@ def _validate_material(s: Scene) -> None:
                     f"(its parameters: {', '.join(CURVE_PARAMETERS[mat.hardening])})")
     if plastic:
         _plausible_stiffness(s.hill79())  # SheetMaterial validates the curve and names the field
-    if plastic and (mat.forming_limit_curve or (s.tools is not None and s.output.fld)):
+    if s.process.stop_at_forming_limit:
+        require(s.tools is not None and plastic, "process.stop_at_forming_limit",
+                "ends a tool scene's stroke at the forming-limit curve: it needs the effects contact and plasticity")
+    if plastic and (mat.forming_limit_curve or (s.tools is not None and (s.output.fld or s.process.stop_at_forming_limit))):
         from shellform.results import fld
 
         fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n

@@ -30,7 +30,8 @@ SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width",
 # the analytic tools' keys, which shape = "cad" does not take (its punch and die are files)
 ANALYTIC_TOOL_KEYS = (*SQUARE_TOOL_KEYS, "punch_profile_radius", "die_profile_radius", "punch_radius", "die_radius",
                       "punch_gap")
-CAD_TOOL_KEYS = ("punch_file", "die_file", "punch_translation", "die_translation", "punch_normals", "die_normals",
+CAD_TOOL_KEYS = ("punch_file", "die_file", "punch_translation", "die_translation", "punch_rotation", "die_rotation",
+                 "punch_direction", "punch_normals", "die_normals",
                  "holder_half_width", "holder_corner_radius")
 TOOL_NORMALS = ("outward", "inward")  # which way a CAD tool's faces' normals point: to the sheet, or away
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
@@ -166,6 +167,9 @@ class Process:
     path: list[float] = field(default_factory=lambda: [1.0])  # load factors to step through, in order
     report: list[float] = field(default_factory=list)  # load factors at which results are recorded
     springback: bool = False  # tool scenes: after the stroke the tools withdraw (contact/springback.py)
+    # tool scenes with plasticity: the stroke ends where an element's margin to the forming-limit
+    # curve reaches 0 (results/fld.py, FormingLimitWatch): a Nakajima test's limit dome height
+    stop_at_forming_limit: bool = False
 
 
 @dataclass
@@ -201,6 +205,10 @@ class ToolsSpec:
     # cad: mm, moving the file's frame into the scene's
     punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     die_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    # cad: degrees, turning the file's frame about the scene's x, then y, then z (before the translation)
+    punch_rotation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    die_rotation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    punch_direction: list[float] = field(default_factory=lambda: [0.0, 0.0, -1.0])  # cad: the way the punch travels
     punch_normals: str = "outward"  # cad: "outward" (the faces' normals point to the sheet) or "inward"
     die_normals: str = "outward"
     holder_half_width: float = 0.0  # cad: the holder's inner edge, a rounded square (where the die's flat top begins)

@@ -56,6 +56,7 @@ def validate_tools(s: Scene) -> None:
         require(getattr(t, name) >= 0, f"tools.{name}", f"must be >= 0, got {getattr(t, name)}")
     if t.shape == "cad":
         flat, corner = _validate_cad_tools(t), t.holder_corner_radius
+        _validate_punch_travel(s, t)
     else:
         flat, corner = _validate_analytic_tools(s, t), t.die_corner_radius + t.die_profile_radius
     g = s.geometry
@@ -121,6 +122,20 @@ def _validate_analytic_tools(s: Scene, t) -> float:
     return t.die_half_width + t.die_profile_radius
 
 
+def _validate_punch_travel(s: Scene, t) -> None:
+    """A punch travelling aslant keeps the blank's mirror symmetry only within the mirror planes:
+    along x = 0 (the `left` edge) no x component, along y = 0 (`bottom`) no y component, along any
+    other symmetry line none in the plane."""
+    d = t.punch_direction
+    for group, support in s.supports.items():
+        if support != "symmetry":
+            continue
+        across = {"left": (0,), "bottom": (1,)}.get(group, (0, 1))
+        require(all(d[i] == 0 for i in across), "tools.punch_direction",
+                f"{d} leaves the mirror plane of the symmetry line {group!r}: a punch travelling aslant needs "
+                "the blank modelled without that symmetry")
+
+
 def _validate_cad_tools(t) -> float:
     """CAD tools: their files exist (what they hold is checked when they are read:
     shellform.contact.surface_tool), their placements and the holder's inner edge; returns
@@ -129,10 +144,16 @@ def _validate_cad_tools(t) -> float:
         v = getattr(t, name)
         require(bool(v), f"tools.{name}", "shape = 'cad' needs the tool's STEP, IGES or BREP file")
         require(Path(v).is_file(), f"tools.{name}", f"no such file: {v}")
-    for name in ("punch_translation", "die_translation"):
+    for name, what in (("punch_translation", "[x, y, z] (mm)"), ("die_translation", "[x, y, z] (mm)"),
+                       ("punch_rotation", "angles about x, y, z (degrees)"),
+                       ("die_rotation", "angles about x, y, z (degrees)"), ("punch_direction", "[x, y, z]")):
         v = getattr(t, name)
-        require(len(v) == 3 and all(math.isfinite(c) for c in v), f"tools.{name}",
-                f"must be three finite numbers [x, y, z] (mm), got {v}")
+        require(len(v) == 3 and all(isinstance(c, (int, float)) and math.isfinite(c) for c in v), f"tools.{name}",
+                f"must be three finite numbers {what}, got {v}")
+    d = np.asarray(t.punch_direction, dtype=float)
+    require(np.linalg.norm(d) > 0, "tools.punch_direction", "must be a non-zero vector, the way the punch travels")
+    require(d[2] < 0, "tools.punch_direction", f"must point down into the die (a negative z component): the punch "
+                                               f"draws the sheet into the die below it, got {t.punch_direction}")
     for name in ("punch_normals", "die_normals"):
         require(getattr(t, name) in TOOL_NORMALS, f"tools.{name}",
                 f"must be one of {TOOL_NORMALS}, got {getattr(t, name)!r}")
