@@ -44,8 +44,7 @@ def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
     F = s.tools.blank_holder_force
     tol = 0.01 * s.material.thickness
     h = p.driver.holder
-    edge = h.edge_load * 4 * (2 * (h.tool.inner_half_width - h.tool.inner_corner_radius)
-                              + np.pi / 2 * h.tool.inner_corner_radius)  # V_e times the edge's length
+    edge = h.edge_load * h.tool.edge.length()  # V_e times the edge's length
     assert h.edge_law.riding_lift(F / edge) > tol
 
     def check(d):

@@ -8,12 +8,13 @@ from scipy.spatial import cKDTree
 
 from shellform.contact.tools import (BlankHolder, Die, Punch, rounded_square_hessian, rounded_square_sdf,
                                      square_cup_tools)
+from shellform.contact.holder_edge import RoundedSquareEdge
 from shellform.scene import ToolsSpec
 
 H = 0.04  # sampling spacing of the brute-force surfaces (mm)
 PUNCH = Punch(half_width=10.0, corner_radius=4.0, profile_radius=2.0, z_face=0.3)
 DIE = Die(half_width=12.0, corner_radius=5.0, profile_radius=3.0, z_top=-0.4)
-HOLDER = BlankHolder(inner_half_width=15.0, inner_corner_radius=8.0, z_face=0.4)
+HOLDER = BlankHolder(RoundedSquareEdge(half_width=15.0, corner_radius=8.0), z_face=0.4)
 RNG = np.random.default_rng(7)
 
 
@@ -199,7 +200,7 @@ def test_sheet_on_the_faces_has_zero_gap():
     tools = square_cup_tools(ToolsSpec(), t)
     punch, die, holder = tools["punch"], tools["die"], tools["holder"]
     assert (punch.z_face, die.z_top, holder.z_face) == (0.4, -0.4, 0.4)
-    assert (holder.inner_half_width, holder.inner_corner_radius) == (42.0, 17.0)
+    assert (holder.edge.half_width, holder.edge.corner_radius) == (42.0, 17.0)
     x = np.c_[RNG.uniform(-25, 25, (200, 2)), np.zeros(200)]  # mid-surface under the punch face
     assert np.abs(punch.gap(x, t / 2)[0]).max() < 1e-14
     flange = np.c_[RNG.uniform(42.5, 60, 200), RNG.uniform(-60, 60, 200), np.zeros(200)]

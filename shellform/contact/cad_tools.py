@@ -4,6 +4,7 @@ placement around the blank at the start."""
 
 import numpy as np
 
+from shellform.contact.holder_edge import OutlineEdge, RoundedSquareEdge
 from shellform.contact.placement import UP, Placed, rotation
 from shellform.contact.surface_tool import SurfaceTool
 from shellform.errors import InputError
@@ -13,7 +14,9 @@ def cad_cup_tools(spec, thickness: float) -> dict:
     """Punch, die and blank holder of a scene's [tools] with shape = "cad" around a sheet of that
     thickness whose mid-surface is z = 0: the punch and the die from their files, turned by
     their rotations and moved by their translations (placement.Placed), the punch travelling
-    along punch_direction; the holder the flat analytic one (tools.BlankHolder) with its face on
+    along punch_direction; the holder's inner edge the rounded square (holder_half_width,
+    holder_corner_radius), or where holder_half_width is 0 the inner boundary of the die's flat
+    top (die_opening); the holder the flat analytic one (tools.BlankHolder) with its face on
     the sheet's upper surface over the plan outside the rounded square (holder_half_width,
     holder_corner_radius): it pinches the flange onto the die's flat top, which check_start
     asks to lie on the sheet's lower surface there."""
@@ -24,11 +27,32 @@ def cad_cup_tools(spec, thickness: float) -> dict:
                                      field=f"tools.{name}_file")
         return Placed(tool, rotation(getattr(spec, f"{name}_rotation")), getattr(spec, f"{name}_translation"), axis)
 
+    die = placed("die")
+    if spec.holder_half_width > 0:
+        edge = RoundedSquareEdge(spec.holder_half_width, spec.holder_corner_radius)
+    else:
+        edge = die_opening(die)
     return dict(
         punch=placed("punch", -np.asarray(spec.punch_direction, dtype=float)),  # it travels -stroke along its axis
-        die=placed("die"),
-        holder=BlankHolder(spec.holder_half_width, spec.holder_corner_radius, thickness / 2),
+        die=die,
+        holder=BlankHolder(edge, thickness / 2),
     )
+
+
+def die_opening(die: Placed) -> OutlineEdge:
+    """The holder's inner edge from the die: the inner boundary loop of its flat top
+    (SurfaceTool.flat_top_boundary), placed, in plan; InputError naming tools.die_file where the
+    die has no flat top or its top has not exactly one opening."""
+    try:
+        loops = die.tool.flat_top_boundary()
+    except ValueError as exc:
+        raise InputError("tools.die_file", f"the holder covers the die's flat top: {exc}") from None
+    plans = [(loop @ die.R.T + die.translation)[:, :2] for loop in loops]
+    area = [abs(0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])) for p in plans]
+    if len(plans) != 2:
+        raise InputError("tools.die_file", f"the die's flat top has {len(plans) - 1} openings: the holder's inner "
+                         "edge is taken from a top with one opening (or give holder_half_width)")
+    return OutlineEdge(plans[int(np.argmin(area))])
 
 
 def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
@@ -58,6 +82,9 @@ def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
             raise InputError(f"tools.{name}_translation", f"the {name} overlaps the blank at the start: a node "
                              f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
     under = np.isfinite(tools["holder"].gap(x, 0.0, 0.0)[0])
+    if comm.allreduce(int(under.sum()), op=MPI.SUM) == 0:
+        raise InputError("geometry", "the blank does not reach the blank holder: no node of it lies over the die's "
+                                     "flat top, where the holder pinches the flange")
     g, n = tools["die"].gap(x[under], half[under] if np.ndim(half) else half, 0.0)
     off = comm.allreduce(float(np.abs(g).max(initial=0.0)), op=MPI.MAX)
     tilt = comm.allreduce(float(np.abs(n[:, 2] - 1.0).max(initial=0.0)), op=MPI.MAX)

@@ -52,7 +52,7 @@ def shoulder_curvature(die, holder, thickness: float) -> float:
     """The curvature 1/(R_d + t/2) of a sheet wrapped on the die's shoulder at the holder's inner
     edge: the largest principal curvature of the die's distance at the sheet's mid-surface, just
     inside the edge along x."""
-    x = np.array([[holder.inner_half_width - 1e-3 * thickness, 0.0, 0.0]])
+    x = np.array([[holder.edge.reach() - 1e-3 * thickness, 0.0, 0.0]])
     H = die.shape(x, thickness / 2)[0]
     return float(np.linalg.eigvalsh(0.5 * (H + H.T)).max())
 

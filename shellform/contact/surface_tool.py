@@ -771,3 +771,56 @@ class SurfaceTool:
         H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
         H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
         return H0 @ np.linalg.inv(np.eye(3) + d[:, None, None] * H0)
+
+    # -- the binder ----------------------------------------------------------------------------
+    def flat_top_boundary(self, spacing: float = 0.25) -> list[np.ndarray]:
+        """The boundary loops, in the model's frame ((m, 3) points every `spacing` mm or closer,
+        each loop closed by its first point), of the highest planar face whose (turned) normal
+        is +z: a die's flat top, on which the holder pinches the flange. Its loops bound the die's
+        opening (the inner ones) and the die (the outer one)."""
+        with _Current(self.model) as gmsh:
+            m = gmsh.model
+            top, height = None, -np.inf
+            for f in self.faces:
+                if m.getType(2, f) != "Plane":
+                    continue
+                b0, b1 = (np.asarray(v, dtype=float) for v in m.getParametrizationBounds(2, f))
+                n = self.sign * np.asarray(m.getNormal(f, 0.5 * (b0 + b1)))
+                z = m.getBoundingBox(2, f)[5]
+                if n[2] > 1.0 - 1e-9 and z > height:
+                    top, height = f, z
+            if top is None:
+                raise ValueError("the model has no flat face whose normal is +z (a die's flat top)")
+            pieces = []
+            for _, c in m.getBoundary([(2, top)], combined=False, oriented=False, recursive=False):
+                c = abs(int(c))
+                if _degenerate(gmsh, c):
+                    continue
+                t0, t1 = (float(np.ravel(v)[0]) for v in m.getParametrizationBounds(1, c))
+                x0, x1 = (np.asarray(m.getValue(1, c, [t])) for t in (t0, t1))
+                steps = max(int(np.ceil(_curve_length(m, c, t0, t1) / spacing)), 2)
+                pieces.append(np.asarray(m.getValue(1, c, np.linspace(t0, t1, steps + 1))).reshape(-1, 3))
+        return _chain(pieces, 1e-6 * self.size)
+
+
+def _curve_length(m, c, t0, t1, n=64):
+    x = np.asarray(m.getValue(1, c, np.linspace(t0, t1, n + 1))).reshape(-1, 3)
+    return float(np.linalg.norm(np.diff(x, axis=0), axis=1).sum())
+
+
+def _chain(pieces, tol):
+    """Closed loops from curve pieces (each (k, 3), from one end to the other) that meet end to
+    end within tol: each loop's points in order, its last piece's end (its first point) left out."""
+    pieces, loops = list(pieces), []
+    while pieces:
+        loop = [pieces.pop(0)]
+        while np.linalg.norm(loop[-1][-1] - loop[0][0]) > tol:
+            end = loop[-1][-1]
+            k = next((i for i, p in enumerate(pieces)
+                      if min(np.linalg.norm(p[0] - end), np.linalg.norm(p[-1] - end)) <= tol), None)
+            if k is None:
+                raise ValueError("the flat top's boundary does not close into loops")
+            p = pieces.pop(k)
+            loop.append(p if np.linalg.norm(p[0] - end) <= tol else p[::-1])
+        loops.append(np.vstack([loop[0]] + [p[1:] for p in loop[1:]])[:-1])
+    return loops

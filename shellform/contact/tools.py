@@ -215,34 +215,28 @@ class Die:
 
 @dataclass
 class BlankHolder:
-    """A flat face at z_face (its bottom) over the plan region outside O = rounded square
-    (inner_half_width, inner_corner_radius): the die's flat top. Signed distance z_face - z
-    there, +inf over the opening (the holder never reaches over it)."""
+    """A flat face at z_face (its bottom) over the plan region outside its inner edge `edge`
+    (holder_edge.py: a rounded square, or the inner boundary of a CAD die's flat top): the
+    die's flat top. Signed distance z_face - z there, +inf over the opening (the holder never
+    reaches over it)."""
 
     axis = UP  # its travel dz is along z (placement.py: the contract's axis)
 
-    inner_half_width: float
-    inner_corner_radius: float
+    edge: object
     z_face: float
-
-    def __post_init__(self):
-        if not 0 <= self.inner_corner_radius <= self.inner_half_width:
-            raise ValueError(f"blank holder: needs 0 <= inner_corner_radius <= inner_half_width, got {self}")
 
     def gap(self, x, offset=0.0, dz: float = 0.0):
         x, offset = _points(x, offset)
-        s, _, _ = rounded_square_sdf(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)
+        s = self.edge.distance(x[:, 0], x[:, 1])
         sd = np.where(s >= 0.0, (self.z_face + dz) - x[:, 2], np.inf)
         return sd - offset, np.tile(DOWN, (len(x), 1))
 
     def edge_offset(self, x):
         """(s, j) of points x: s their plan distance from the face's inner edge (> 0 under the
-        face), j the length of the edge per unit length of the offset line through them,
-        1 - s tr(Hs) = rc / (rc + s) beside a corner arc, 1 beside a side."""
+        face), j the length of the edge per unit length of the offset line through them
+        (holder_edge.py)."""
         x, _ = _points(x, 0.0)
-        s = rounded_square_sdf(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)[0]
-        Hs = rounded_square_hessian(x[:, 0], x[:, 1], self.inner_half_width, self.inner_corner_radius)
-        return s, 1.0 - s * np.trace(Hs, axis1=1, axis2=2)
+        return self.edge.offset(x[:, 0], x[:, 1])
 
     def shape(self, x, offset=0.0, dz: float = 0.0):
         """H = dn/dx = 0: a flat face (and nothing over the opening)."""
@@ -254,13 +248,15 @@ def square_cup_tools(spec, thickness: float) -> dict:
     """Punch, die and blank holder of a scene's ToolsSpec around a sheet of that thickness whose
     mid-surface is z = 0: the die's top touches the sheet's lower surface, the holder rests on
     its upper surface, the punch face lies spec.punch_gap above it."""
+    from shellform.contact.holder_edge import RoundedSquareEdge
+
     die = Die(spec.die_half_width, spec.die_corner_radius, spec.die_profile_radius, -thickness / 2)
     rd = spec.die_profile_radius
     return dict(
         punch=Punch(spec.punch_half_width, spec.punch_corner_radius, spec.punch_profile_radius,
                     thickness / 2 + spec.punch_gap),
         die=die,
-        holder=BlankHolder(spec.die_half_width + rd, spec.die_corner_radius + rd, thickness / 2),
+        holder=BlankHolder(RoundedSquareEdge(spec.die_half_width + rd, spec.die_corner_radius + rd), thickness / 2),
     )
 
 

@@ -157,8 +157,8 @@ def _validate_cad_tools(t) -> float:
     for name in ("punch_normals", "die_normals"):
         require(getattr(t, name) in TOOL_NORMALS, f"tools.{name}",
                 f"must be one of {TOOL_NORMALS}, got {getattr(t, name)!r}")
-    require(math.isfinite(t.holder_half_width) and t.holder_half_width > 0, "tools.holder_half_width",
-            f"shape = 'cad' needs the holder's inner edge (where the die's flat top begins) > 0, got "
+    require(math.isfinite(t.holder_half_width) and t.holder_half_width >= 0, "tools.holder_half_width",
+            f"must be >= 0: the holder's inner edge (where the die's flat top begins), 0 for the die's own, got "
             f"{t.holder_half_width}")
     require(math.isfinite(t.holder_corner_radius) and 0 <= t.holder_corner_radius <= t.holder_half_width,
             "tools.holder_corner_radius", f"must lie in [0, holder_half_width], got {t.holder_corner_radius}")
