@@ -1,9 +1,13 @@
 """The square cup's tools from a scene's [tools] with shape = "cad": the punch and the die as
-CAD surfaces (surface_tool.py), the blank holder the flat analytic one, and the checks of their
-placement around the blank at the start."""
+CAD surfaces (surface_tool.py) or surface meshes (.stl, .msh: mesh_tool.py, by the file's
+suffix), the blank holder the flat analytic one, and the checks of their placement around the
+blank at the start."""
+
+from pathlib import Path
 
 import numpy as np
 
+from shellform.contact.mesh_tool import MESH_SUFFIXES, MeshTool
 from shellform.contact.surface_tool import SurfaceTool
 from shellform.errors import InputError
 
@@ -18,10 +22,17 @@ def cad_cup_tools(spec, thickness: float) -> dict:
     from shellform.contact.tools import BlankHolder
 
     return dict(
-        punch=SurfaceTool.from_file(spec.punch_file, spec.punch_translation, spec.punch_normals, "tools.punch_file"),
-        die=SurfaceTool.from_file(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file"),
+        punch=_tool(spec.punch_file).from_file(spec.punch_file, spec.punch_translation, spec.punch_normals,
+                                               "tools.punch_file"),
+        die=_tool(spec.die_file).from_file(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file"),
         holder=BlankHolder(spec.holder_half_width, spec.holder_corner_radius, thickness / 2),
     )
+
+
+def _tool(path):
+    """The tool class of a file by its suffix: a surface mesh (.stl, .msh) a MeshTool, else a
+    SurfaceTool (CAD)."""
+    return MeshTool if Path(path).suffix.lower() in MESH_SUFFIXES else SurfaceTool
 
 
 def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
