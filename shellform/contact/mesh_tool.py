@@ -34,12 +34,14 @@ and c = 0 (a straight edge) where the normals are parallel or opposite (1 - g^2 
 PARALLEL). A feature edge takes the crease's tangents instead: at each end the direction
 t = n_1 x n_2 of the two fans' normals there (turned along d; d itself where they are parallel),
 and the c whose end tangents are nearest those, (d . t_b) t_b and (d . t_a) t_a: c = ((d . t_b) t_b
-- (d . t_a) t_a) / 2. Then c's part along d is dropped (c <- c - (c . d) d / |d|^2). It changes
-nothing on a circular arc (whose c is orthogonal to its chord) and little on a smooth curve, but
-where a vertex normal leans along the edge (a vertex on a tangent seam between a plane and a
-fillet, whose averaged normal leans towards the fillet) Nagata's c is d itself, a straight edge
-with a zero tangent at one end: a degenerate patch. Without that part the edge is straight and
-its parametrisation regular, and a plane stays a plane up to its seam. Every edge's c depends only
+- (d . t_a) t_a) / 2. Then only c's part along the edge's mean normal is kept: c <- (c . m) m, m
+the unit part of n_a + n_b orthogonal to d (a crease: of d x ((n_a + n_b) x d)). It changes
+nothing on a circular arc (whose c is that) and little on a smooth curve (its other parts bend
+the parametrisation, not the surface). But where a vertex normal leans along the edge (a vertex
+on a tangent seam between a plane and a fillet, whose mean normal leans towards the fillet)
+Nagata's c is large and tangential to the surface (c = d itself for an edge that leaves the seam
+at a right angle: a straight edge with a zero tangent at one end), and such parts fold a patch
+over itself in its plane, its normal turned over where it folds. Every edge's c depends only
 on its own two vertices and normals, so two triangles that share an edge share its curve: the
 surface has no cracks.
 
@@ -398,7 +400,14 @@ def nagata_patches(vertices, triangles, feature_angle: float = FEATURE_ANGLE):
             t *= np.where(np.einsum("ij,ij->i", t, d[crease]) < 0, -1.0, 1.0)[:, None]
             tangents.append(t)
         c[crease] = crease_coefficient(d[crease], *tangents)
-    c -= (np.einsum("ij,ij->i", c, d) / np.einsum("ij,ij->i", d, d))[:, None] * d  # c's part along d dropped
+    # only c's part along the edge's mean normal, made orthogonal to d, is kept
+    mean = na + nb
+    if crease.size:
+        mean[crease] = np.cross(d[crease], np.cross(na[crease] + nb[crease], d[crease]))
+    m = mean - (np.einsum("ij,ij->i", mean, d) / np.einsum("ij,ij->i", d, d))[:, None] * d
+    size = np.linalg.norm(m, axis=1)
+    m = np.where(size[:, None] > 1e-12, m / np.maximum(size, 1e-300)[:, None], 0.0)
+    c = np.einsum("ij,ij->i", c, m)[:, None] * m
     c01, c12, c02 = c[inverse[:, 0]], c[inverse[:, 1]], c[inverse[:, 2]]
     x = vertices[triangles]
     return np.stack([x[:, 0], x[:, 1] - x[:, 0] - c01, x[:, 2] - x[:, 0] - c02, c01, c02, c01 + c02 - c12], axis=1) \
