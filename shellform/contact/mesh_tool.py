@@ -100,6 +100,7 @@ MESH_SUFFIXES = (".stl", ".msh")  # any case
 MAX_MESH_BYTES = 200_000_000  # a tool's mesh file larger than this is refused
 MERGE_TOLERANCE = 1e-8  # vertices nearer than this times the model's size are one
 FEATURE_ANGLE = 45.0  # degrees: facets whose normals differ by more meet at a crease
+PLANE_ANGLE = 150.0  # degrees: coplanar facets spanning this much at a vertex make its normal the plane's
 PARALLEL = 1e-12  # 1 - (n_a . n_b)^2 below this: Nagata's c = 0 (parallel or opposite normals)
 NEWTON_ITERATIONS = 30  # the most Newton iterations of a projection
 NEAREST_SAMPLES = 4  # samples whose triangles give each point's first upper bound
@@ -303,7 +304,7 @@ def corner_normals(vertices, triangles, feature_angle: float = FEATURE_ANGLE):
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    normal, _ = facet_normals(vertices, triangles)
+    normal, angles = facet_normals(vertices, triangles)
     directed, unique, inverse, counts = _edges(triangles)
     T = len(triangles)
     owner = np.full((len(unique), 2), -1)  # the (up to) two triangle-edges of each unique edge
@@ -338,6 +339,21 @@ def corner_normals(vertices, triangles, feature_angle: float = FEATURE_ANGLE):
     sums = np.zeros((label.max() + 1, 3))
     np.add.at(sums, label, weighted)
     sums /= np.linalg.norm(sums, axis=1)[:, None]
+    # a fan with exactly one plane in it (facets with the same normal, to 1e-12, whose angles at the
+    # vertex add up to PLANE_ANGLE or more: a vertex on a tangent seam between a plane and a
+    # fillet, not two facets of a cylinder's strip): the plane's normal
+    facet = np.repeat(normal, 3, axis=0)
+    groups, first, inverse = np.unique(np.c_[label, np.round(facet, 12)], axis=0, return_index=True,
+                                       return_inverse=True)
+    spread = np.zeros(len(groups))
+    np.add.at(spread, inverse.ravel(), angles.ravel())
+    wide = spread >= np.radians(PLANE_ANGLE)
+    planes = groups[wide, 0].astype(np.int64)
+    fans, how_many = np.unique(planes, return_counts=True)
+    single = fans[how_many == 1]
+    if single.size:
+        at = first[wide][np.isin(planes, single)]
+        sums[label[at]] = facet[at]
     return sums[label].reshape(T, 3, 3), feature
 
 
