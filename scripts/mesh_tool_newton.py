@@ -5,12 +5,12 @@ against flat facets against the analytic tools (docs/tools.md, "Tools from surfa
 
 demos/numisheet93_aluminium.toml with mesh.n = N drawn STROKE mm by its analytic tools, then for
 each PER_TURN by its punch and die meshed by gmsh (scripts/cup_tools_stl.py: PER_TURN triangles
-along a full turn of a curved face, at most 10 mm; the holder's edge at HOLDER) and read as MeshTool: once as Nagata patches
-(the tool a scene gets), once as flat facets (the same triangles, c = 0: facet normals). For each
-run: increments, Newton iterations, cut-backs, punch force, draw-in, peak thinning, wall time and
-the driver's parts_s (the contact passes, tools included); the residual's decay: the median over
-the iterates with |R| below 0.1 of the increment's first of the observed order log|R_k+1| / log|R_k| (2: quadratic), and
-the increments' iterations.
+along a full turn of a curved face, at most 10 mm; the holder's edge at HOLDER) and read as
+MeshTool: once as Nagata patches (the tool a scene gets), once as flat facets (the same
+triangles, c = 0: facet normals). For each run: increments, Newton iterations, cut-backs, punch
+force, draw-in, peak thinning, wall time and the driver's parts_s (the contact passes, tools
+included); the residual's decay: the median over the iterates with |R| below 0.1 of the
+increment's first of the observed order log|R_k+1| / log|R_k| (2: quadratic), and the increments' iterations.
 
 The flat facets are for this comparison only: a scene's .stl tool is always Nagata's.
 """
@@ -91,7 +91,8 @@ with tempfile.TemporaryDirectory() as folder:
 
         def faceted(spec, thickness):
             tools = nagata(spec, thickness)
-            tools["punch"] = flat_facets(spec.punch_file, spec.punch_translation, spec.punch_normals, "tools.punch_file")
+            tools["punch"] = flat_facets(spec.punch_file, spec.punch_translation, spec.punch_normals,
+                                         "tools.punch_file")
             tools["die"] = flat_facets(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file")
             return tools
 

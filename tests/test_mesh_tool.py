@@ -91,7 +91,8 @@ def _edge_normal_jump(V, F):
     """The largest angle (rad) between the two patches' normals at points along their shared
     edges (the edges' quarter and middle points)."""
     A = nagata_patches(V, F)
-    local = {(0, 1): (np.array([1.0, 0.0]), np.array([0.0, 0.0])), (1, 2): (np.array([-1.0, 1.0]), np.array([1.0, 0.0])),
+    local = {(0, 1): (np.array([1.0, 0.0]), np.array([0.0, 0.0])),
+             (1, 2): (np.array([-1.0, 1.0]), np.array([1.0, 0.0])),
              (0, 2): (np.array([0.0, 1.0]), np.array([0.0, 0.0]))}
     normals = {}
     for t, tri in enumerate(F):

@@ -631,7 +631,8 @@ class MeshTool:
             huv = guv + np.einsum("ij,ij->i", r, S[i, 2])
             det = huu * hvv - huv * huv
             indefinite = (det <= 1e-12 * (guu * gvv)) | (huu <= 0)
-            huu, huv, hvv = np.where(indefinite, guu, huu), np.where(indefinite, guv, huv), np.where(indefinite, gvv, hvv)
+            huu, hvv = np.where(indefinite, guu, huu), np.where(indefinite, gvv, hvv)
+            huv = np.where(indefinite, guv, huv)
             det = huu * hvv - huv * huv
             du = -(hvv * g[:, 0] - huv * g[:, 1]) / det
             dv = -(huu * g[:, 1] - huv * g[:, 0]) / det
