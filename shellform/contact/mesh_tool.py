@@ -16,7 +16,11 @@ J. Graphics Tools 4 (1999): the facet normal times sin(angle) / (|x_a - x| |x_b 
 for vertices on a sphere, docs/tools.md has the angle-weighted mean's numbers). An edge whose facets'
 normals differ by more than FEATURE_ANGLE is a feature edge (a crease, a box's rim): the facets
 around a vertex are split by the feature edges into fans, each fan with its own normal, so that a
-crease stays sharp. A feature edge is not a smoothed one: its curve is the crease's (below).
+crease stays sharp. A feature edge is not a smoothed one: its curve is the crease's (below). A fan
+with exactly one plane in it (facets of one normal, to 1e-12, whose angles at the vertex add up
+to PLANE_ANGLE or more: a vertex on the tangent seam between a flat face and a fillet) takes the
+plane's normal, the true one there: the flat face stays flat up to its seam (the mean would lean
+towards the fillet and bulge the face's first row of triangles).
 
 Nagata patches (T. Nagata, Simple local interpolation of surfaces using normal vectors, CAGD 22
 (2005) 327-347). An edge from x_a to x_b, d = x_b - x_a, is the quadratic curve
