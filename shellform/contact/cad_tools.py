@@ -1,10 +1,14 @@
 """The square cup's tools from a scene's [tools] with shape = "cad": the punch and the die as
-CAD surfaces (surface_tool.py), the blank holder the flat analytic one, and the checks of their
-placement around the blank at the start."""
+CAD surfaces (surface_tool.py) or surface meshes (.stl, .msh: mesh_tool.py, by the file's
+suffix), the blank holder the flat analytic one, and the checks of their placement around the
+blank at the start."""
+
+from pathlib import Path
 
 import numpy as np
 
 from shellform.contact.holder_edge import OutlineEdge, RoundedSquareEdge
+from shellform.contact.mesh_tool import MESH_SUFFIXES, MeshTool
 from shellform.contact.placement import UP, Placed, rotation
 from shellform.contact.surface_tool import SurfaceTool
 from shellform.errors import InputError
@@ -14,17 +18,17 @@ def cad_cup_tools(spec, thickness: float) -> dict:
     """Punch, die and blank holder of a scene's [tools] with shape = "cad" around a sheet of that
     thickness whose mid-surface is z = 0: the punch and the die from their files, turned by
     their rotations and moved by their translations (placement.Placed), the punch travelling
-    along punch_direction; the holder's inner edge the rounded square (holder_half_width,
-    holder_corner_radius), or where holder_half_width is 0 the inner boundary of the die's flat
-    top (die_opening); the holder the flat analytic one (tools.BlankHolder) with its face on
-    the sheet's upper surface over the plan outside the rounded square (holder_half_width,
-    holder_corner_radius): it pinches the flange onto the die's flat top, which check_start
-    asks to lie on the sheet's lower surface there."""
+    along punch_direction. A file is a CAD model or a surface mesh by its suffix (_tool). The
+    holder is the flat analytic one (tools.BlankHolder) with its face on the sheet's upper
+    surface outside its inner edge: the rounded square (holder_half_width, holder_corner_radius),
+    or where holder_half_width is 0 the inner boundary of the die's flat top (die_opening). It
+    pinches the flange onto the die's flat top, which check_start asks to lie on the sheet's
+    lower surface there."""
     from shellform.contact.tools import BlankHolder
 
     def placed(name, axis=UP):
-        tool = SurfaceTool.from_file(getattr(spec, f"{name}_file"), normals=getattr(spec, f"{name}_normals"),
-                                     field=f"tools.{name}_file")
+        path = getattr(spec, f"{name}_file")
+        tool = _tool(path).from_file(path, normals=getattr(spec, f"{name}_normals"), field=f"tools.{name}_file")
         return Placed(tool, rotation(getattr(spec, f"{name}_rotation")), getattr(spec, f"{name}_translation"), axis)
 
     die = placed("die")
@@ -53,6 +57,12 @@ def die_opening(die: Placed) -> OutlineEdge:
         raise InputError("tools.die_file", f"the die's flat top has {len(plans) - 1} openings: the holder's inner "
                          "edge is taken from a top with one opening (or give holder_half_width)")
     return OutlineEdge(plans[int(np.argmin(area))])
+
+
+def _tool(path):
+    """The tool class of a file by its suffix: a surface mesh (.stl, .msh) a MeshTool, else a
+    SurfaceTool (CAD)."""
+    return MeshTool if Path(path).suffix.lower() in MESH_SUFFIXES else SurfaceTool
 
 
 def check_start(tools: dict, x, half, comm, tolerance: float) -> None:

@@ -128,3 +128,21 @@ class OutlineEdge:
         if x.size == 0:
             raise ValueError("holder edge: the outline does not cross the +x axis")
         return float(x.min())
+
+
+def closed_loops(pieces, tol):
+    """Closed loops from curve pieces (each (k, 3), from one end to the other) that meet end to
+    end within tol: each loop's points in order, its last piece's end (its first point) left out."""
+    pieces, loops = list(pieces), []
+    while pieces:
+        loop = [pieces.pop(0)]
+        while np.linalg.norm(loop[-1][-1] - loop[0][0]) > tol:
+            end = loop[-1][-1]
+            k = next((i for i, p in enumerate(pieces)
+                      if min(np.linalg.norm(p[0] - end), np.linalg.norm(p[-1] - end)) <= tol), None)
+            if k is None:
+                raise ValueError("the boundary does not close into loops")
+            p = pieces.pop(k)
+            loop.append(p if np.linalg.norm(p[0] - end) <= tol else p[::-1])
+        loops.append(np.vstack([loop[0]] + [p[1:] for p in loop[1:]])[:-1])
+    return loops

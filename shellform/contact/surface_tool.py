@@ -78,6 +78,7 @@ from pathlib import Path
 import numpy as np
 
 from shellform.contact.cad_files import probe
+from shellform.contact.holder_edge import closed_loops
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
@@ -800,27 +801,10 @@ class SurfaceTool:
                 x0, x1 = (np.asarray(m.getValue(1, c, [t])) for t in (t0, t1))
                 steps = max(int(np.ceil(_curve_length(m, c, t0, t1) / spacing)), 2)
                 pieces.append(np.asarray(m.getValue(1, c, np.linspace(t0, t1, steps + 1))).reshape(-1, 3))
-        return _chain(pieces, 1e-6 * self.size)
+        return closed_loops(pieces, 1e-6 * self.size)
 
 
 def _curve_length(m, c, t0, t1, n=64):
     x = np.asarray(m.getValue(1, c, np.linspace(t0, t1, n + 1))).reshape(-1, 3)
     return float(np.linalg.norm(np.diff(x, axis=0), axis=1).sum())
 
-
-def _chain(pieces, tol):
-    """Closed loops from curve pieces (each (k, 3), from one end to the other) that meet end to
-    end within tol: each loop's points in order, its last piece's end (its first point) left out."""
-    pieces, loops = list(pieces), []
-    while pieces:
-        loop = [pieces.pop(0)]
-        while np.linalg.norm(loop[-1][-1] - loop[0][0]) > tol:
-            end = loop[-1][-1]
-            k = next((i for i, p in enumerate(pieces)
-                      if min(np.linalg.norm(p[0] - end), np.linalg.norm(p[-1] - end)) <= tol), None)
-            if k is None:
-                raise ValueError("the flat top's boundary does not close into loops")
-            p = pieces.pop(k)
-            loop.append(p if np.linalg.norm(p[0] - end) <= tol else p[::-1])
-        loops.append(np.vstack([loop[0]] + [p[1:] for p in loop[1:]])[:-1])
-    return loops

@@ -200,7 +200,7 @@ class ToolsSpec:
     die_corner_radius: float = 12.0
     die_profile_radius: float = 5.0  # die shoulder radius
     punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
-    punch_file: str = ""  # cad: the punch's STEP, IGES or BREP file, relative to the scene's folder
+    punch_file: str = ""  # cad: the punch's STEP, IGES or BREP file (or an .stl, .msh surface mesh), relative to the scene's folder
     die_file: str = ""  # cad: the die's
     # cad: mm, moving the file's frame into the scene's
     punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])

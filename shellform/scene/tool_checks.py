@@ -142,7 +142,7 @@ def _validate_cad_tools(t) -> float:
     holder_half_width."""
     for name in ("punch_file", "die_file"):
         v = getattr(t, name)
-        require(bool(v), f"tools.{name}", "shape = 'cad' needs the tool's STEP, IGES or BREP file")
+        require(bool(v), f"tools.{name}", "shape = 'cad' needs the tool's STEP, IGES or BREP file (or .stl, .msh surface mesh)")
         require(Path(v).is_file(), f"tools.{name}", f"no such file: {v}")
     for name, what in (("punch_translation", "[x, y, z] (mm)"), ("die_translation", "[x, y, z] (mm)"),
                        ("punch_rotation", "angles about x, y, z (degrees)"),

@@ -1,0 +1,736 @@
+"""A rigid tool whose surface is a triangle mesh (an STL file, or a gmsh .msh file's triangles),
+interpolated by Nagata patches.
+
+The tool gives what the analytic tools give (tools.py) and the CAD tool (surface_tool.py): for
+points x, placed by a translation and moved by dz along z,
+
+    gap(x, offset, dz)    the signed distance to the surface minus offset (> 0 clear), and the
+                          unit normal pointing from the tool towards the point;
+    shape(x, offset, dz)  H = dn/dx (n, 3, 3), the Hessian of the signed distance.
+
+Vertex normals. Each triangle's facet normal comes from its vertices' order (right-handed:
+outward on a solid written as STL asks); ``normals = "inward"`` turns them all. A vertex's normal
+is the normalised sum over its facets of (x_a - x) x (x_b - x) / (|x_a - x|^2 |x_b - x|^2), x_a,
+x_b the facet's other vertices (N. Max, Weights for computing vertex normals from facet normals,
+J. Graphics Tools 4 (1999): the facet normal times sin(angle) / (|x_a - x| |x_b - x|); exact
+for vertices on a sphere, docs/tools.md has the angle-weighted mean's numbers). An edge whose facets'
+normals differ by more than FEATURE_ANGLE is a feature edge (a crease, a box's rim): the facets
+around a vertex are split by the feature edges into fans, each fan with its own normal, so that a
+crease stays sharp. A feature edge is not a smoothed one: its curve is the crease's (below). A fan
+with exactly one plane in it (facets of one normal, to 1e-12, whose angles at the vertex add up
+to PLANE_ANGLE or more: a vertex on the tangent seam between a flat face and a fillet) takes the
+plane's normal, the true one there: the flat face stays flat up to its seam (the mean would lean
+towards the fillet and bulge the face's first row of triangles).
+
+Nagata patches (T. Nagata, Simple local interpolation of surfaces using normal vectors, CAGD 22
+(2005) 327-347). An edge from x_a to x_b, d = x_b - x_a, is the quadratic curve
+
+    x(t) = x_a + d t - c t (1 - t),   t in [0, 1],
+
+whose tangents at its ends, d - c and d + c, are orthogonal to the normals n_a and n_b there:
+n_a . c = n_a . d, n_b . c = -n_b . d. Nagata takes the c of least norm, in the plane of n_a and
+n_b: with g = n_a . n_b,
+
+    c = alpha n_a + beta n_b,  alpha = (n_a . d + g n_b . d) / (1 - g^2),
+                               beta = -(n_b . d + g n_a . d) / (1 - g^2),
+
+and c = 0 (a straight edge) where the normals are parallel or opposite (1 - g^2 below
+PARALLEL). A feature edge takes the crease's tangents instead: at each end the direction
+t = n_1 x n_2 of the two fans' normals there (turned along d; d itself where they are parallel),
+and the c whose end tangents are nearest those, (d . t_b) t_b and (d . t_a) t_a: c = ((d . t_b) t_b
+- (d . t_a) t_a) / 2. Then only c's part along the edge's mean normal is kept: c <- (c . m) m, m
+the unit part of n_a + n_b orthogonal to d (a crease: of d x ((n_a + n_b) x d)). It changes
+nothing on a circular arc (whose c is that) and little on a smooth curve (its other parts bend
+the parametrisation, not the surface). But where a vertex normal leans along the edge (a vertex
+on a tangent seam between a plane and a fillet, whose mean normal leans towards the fillet)
+Nagata's c is large and tangential to the surface (c = d itself for an edge that leaves the seam
+at a right angle: a straight edge with a zero tangent at one end), and such parts fold a patch
+over itself in its plane, its normal turned over where it folds. Every edge's c depends only
+on its own two vertices and normals, so two triangles that share an edge share its curve: the
+surface has no cracks.
+
+A triangle with vertices x_0, x_1, x_2 and barycentric coordinates (1 - u - v, u, v) on u, v >= 0,
+u + v <= 1 is the quadratic patch
+
+    X(u, v) = x_0 (1 - u - v) + x_1 u + x_2 v - c_01 (1 - u - v) u - c_12 u v - c_02 (1 - u - v) v
+            = a_0 + a_1 u + a_2 v + a_3 u^2 + a_4 v^2 + a_5 u v,
+
+a_0 = x_0, a_1 = x_1 - x_0 - c_01, a_2 = x_2 - x_0 - c_02, a_3 = c_01, a_4 = c_02,
+a_5 = c_01 + c_02 - c_12; its edges are the edges' curves. The tool is the set of these patches
+(a MeshTool is made from any such coefficients: flat facets are c = 0). The patches meet along
+their edges (C0); their normals across an edge differ a little (Nagata's patches are not G1).
+
+Closest point. For a point y, a k-d tree of points sampled on every flat triangle (a barycentric
+grid no coarser than the mesh's median edge) gives the triangles that can hold its closest
+point: each patch lies within b_T of its flat triangle (b_T <= max|c| / 3, the largest of the
+products (1-u-v) u etc. summing to 1/3), so the distance to the patch lies within b_T of the flat
+triangle's. The least upper bound over the triangles of the nearest samples bounds the
+distance; every triangle whose lower bound lies within it is a candidate. On each candidate,
+Newton minimises |X(u, v) - y|^2 in (u, v) from the flat triangle's closest point (the Hessian
+J^T J + (X - y) . X_ij, or J^T J where that is not positive). A point whose minimiser leaves the
+triangle is projected onto its three edge curves instead (Newton in t, clamped to [0, 1]). The
+nearest of all candidates' points is the closest point c.
+
+Signed distance, normal and shape operator. On a patch's inside, n_c = X_u x X_v / |X_u x X_v|
+(turned for "inward"), d = (y - c) . n_c, n = n_c and H = H0 (I + d H0)^-1 from the patch's
+derivatives (surface_geometry.distance_hessian). On an edge curve (the point lies beside the
+edge, where the two patches' normals fans leave a gap, or beside a crease), d = +/-|y - c| with
+the sign of (y - c) . n_c, n = (y - c) / d, and H the Hessian of the distance to the curve:
+(I - n n^T - x' x'^T / (|x'|^2 - (y - c) . x'')) / d; at a vertex (I - n n^T) / d.
+
+The last call's points are remembered with their answers: a point given again (in the tool's
+frame: the same x and dz) takes its answer without a search (the contact set asks gap about three
+times and shape once per iterate at the same points).
+
+Reading a file: STL (binary, or ASCII), or a gmsh .msh in its ASCII format (2.2 or 4.1: its
+3-node triangles; the corners of 6-node ones), parsed here without gmsh, so no script (a FILE.opt
+beside it) runs. At most MAX_MESH_BYTES. Vertices nearer than MERGE_TOLERANCE of the model's
+size are one; triangles that collapse are dropped. Refused (InputError naming the field): a
+missing file, another kind, a file with no triangles, an edge shared by more than two triangles
+(non-manifold), two triangles whose orders disagree across their edge (inconsistent
+orientation). An open surface is taken as it is (beside its boundary the distance is to the
+boundary curve). Lengths are in the file's units, mm.
+"""
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from shellform.contact.holder_edge import closed_loops
+from shellform.contact.surface_geometry import distance_hessian
+from shellform.errors import InputError
+
+MESH_SUFFIXES = (".stl", ".msh")  # any case
+MAX_MESH_BYTES = 200_000_000  # a tool's mesh file larger than this is refused
+MERGE_TOLERANCE = 1e-8  # vertices nearer than this times the model's size are one
+FEATURE_ANGLE = 45.0  # degrees: facets whose normals differ by more meet at a crease
+PLANE_ANGLE = 150.0  # degrees: coplanar facets spanning this much at a vertex make its normal the plane's
+PARALLEL = 1e-12  # 1 - (n_a . n_b)^2 below this: Nagata's c = 0 (parallel or opposite normals)
+NEWTON_ITERATIONS = 30  # the most Newton iterations of a projection
+NEAREST_SAMPLES = 4  # samples whose triangles give each point's first upper bound
+NORMALS = ("outward", "inward")
+
+
+# -- reading ---------------------------------------------------------------------------------
+def read_surface_mesh(path, field: str = "tools.file"):
+    """The vertices (V, 3) and triangles (T, 3) of an STL or ASCII gmsh .msh file, vertices
+    merged, collapsed triangles dropped (module docstring). InputError naming `field`."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(field, f"no such file: {path}")
+    suffix = path.suffix.lower()
+    if suffix not in MESH_SUFFIXES:
+        raise InputError(field, f"{path.name} is not a surface mesh: a tool's mesh file must end in .stl or .msh")
+    size = path.stat().st_size
+    if size > MAX_MESH_BYTES:
+        raise InputError(field, f"{path} is larger than {MAX_MESH_BYTES:,} bytes")
+    data = path.read_bytes()
+    corners = _stl(data, path, field) if suffix == ".stl" else _msh(data, path, field)
+    if len(corners) == 0:
+        raise InputError(field, f"{path} holds no triangles")
+    if not np.all(np.isfinite(corners)):
+        raise InputError(field, f"{path} holds a vertex that is not a finite number")
+    vertices, triangles = merge_vertices(corners.reshape(-1, 3))
+    triangles = triangles.reshape(-1, 3)
+    e1 = vertices[triangles[:, 1]] - vertices[triangles[:, 0]]
+    e2 = vertices[triangles[:, 2]] - vertices[triangles[:, 0]]
+    scale = float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
+    area = np.linalg.norm(np.cross(e1, e2), axis=1)
+    keep = (triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2]) \
+        & (triangles[:, 0] != triangles[:, 2]) & (area > 1e-14 * scale ** 2)
+    triangles = triangles[keep]
+    if len(triangles) == 0:
+        raise InputError(field, f"{path} holds no triangles of nonzero area")
+    _check_topology(vertices, triangles, path, field)
+    return vertices, triangles
+
+
+def _stl(data: bytes, path, field):
+    """The corners (T, 3, 3) of a binary or ASCII STL file."""
+    if len(data) >= 84:
+        count = int(np.frombuffer(data, dtype="<u4", count=1, offset=80)[0])
+        if len(data) == 84 + 50 * count:  # binary: 80-byte header, count, 50 bytes a facet
+            rows = np.frombuffer(data, dtype=np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)),
+                                                        ("attribute", "<u2")]), count=count, offset=84)
+            return rows["corners"].astype(float)
+    if not data.lstrip()[:5].lower() == b"solid":
+        raise InputError(field, f"{path} is neither a binary STL (its size does not match its facet count) nor an "
+                         "ASCII one (it does not begin with 'solid')")
+    text = data.decode("ascii", errors="replace")
+    found = re.findall(r"\bvertex\s+(\S+)\s+(\S+)\s+(\S+)", text)
+    try:
+        corners = np.array(found, dtype=float).reshape(-1, 3)
+    except ValueError:
+        raise InputError(field, f"{path}: a vertex of its facets is not three numbers") from None
+    if len(corners) % 3:
+        raise InputError(field, f"{path}: its facets hold {len(corners)} vertices, not three each")
+    return corners.reshape(-1, 3, 3)
+
+
+def _msh(data: bytes, path, field):
+    """The triangles' corners (T, 3, 3) of an ASCII gmsh .msh file, format 2.2 or 4.1."""
+    text = data.decode("ascii", errors="replace")
+
+    def section(name):
+        m = re.search(rf"^\${name}\s*$(.*?)^\$End{name}\s*$", text, re.M | re.S)
+        if m is None:
+            raise InputError(field, f"{path} has no ${name} section: not a gmsh mesh")
+        return m.group(1).split()
+
+    head = section("MeshFormat")
+    if len(head) < 3 or head[1] != "0":
+        raise InputError(field, f"{path} is not an ASCII gmsh mesh (write it with Mesh.Binary = 0)")
+    version = head[0]
+    try:
+        if version.startswith("2"):
+            nodes, elements = section("Nodes"), section("Elements")
+            count = int(nodes[0])
+            table = np.array(nodes[1:1 + 4 * count], dtype=float).reshape(count, 4)
+            tags, xyz = table[:, 0].astype(np.int64), table[:, 1:]
+            triangles, i = [], 1
+            for _ in range(int(elements[0])):
+                kind, ntags = int(elements[i + 1]), int(elements[i + 2])
+                width = {2: 3, 9: 6}.get(kind, _MSH_NODES.get(kind, -1))
+                if width < 0:
+                    raise InputError(field, f"{path}: element type {kind} is not read (triangles, lines, points)")
+                start = i + 3 + ntags
+                if kind in (2, 9):
+                    triangles.append([int(t) for t in elements[start:start + 3]])
+                i = start + width
+        elif version.startswith("4"):
+            nodes, elements = section("Nodes"), section("Elements")
+            blocks, i = int(nodes[0]), 4
+            tag_list, xyz_list = [], []
+            for _ in range(blocks):
+                dim, parametric, count = int(nodes[i]), int(nodes[i + 2]), int(nodes[i + 3])
+                i += 4
+                tag_list.append(np.array(nodes[i:i + count], dtype=np.int64))
+                i += count
+                width = 3 + (dim if parametric else 0)
+                xyz_list.append(np.array(nodes[i:i + width * count], dtype=float).reshape(count, width)[:, :3])
+                i += width * count
+            tags = np.concatenate(tag_list) if tag_list else np.zeros(0, dtype=np.int64)
+            xyz = np.vstack(xyz_list) if xyz_list else np.zeros((0, 3))
+            blocks, i = int(elements[0]), 4
+            triangles = []
+            for _ in range(blocks):
+                kind, count = int(elements[i + 2]), int(elements[i + 3])
+                i += 4
+                width = {2: 3, 9: 6}.get(kind, _MSH_NODES.get(kind, -1))
+                if width < 0:
+                    raise InputError(field, f"{path}: element type {kind} is not read (triangles, lines, points)")
+                rows = np.array(elements[i:i + (width + 1) * count], dtype=np.int64).reshape(count, width + 1)
+                i += (width + 1) * count
+                if kind in (2, 9):
+                    triangles.extend(rows[:, 1:4].tolist())
+        else:
+            raise InputError(field, f"{path}: gmsh mesh format {version} is not read (2.2 or 4.1)")
+    except (ValueError, IndexError):
+        raise InputError(field, f"{path}: its $Nodes or $Elements section is not as gmsh writes it") from None
+    triangles = np.array(triangles, dtype=np.int64).reshape(-1, 3)
+    if len(triangles) == 0:
+        return np.zeros((0, 3, 3))
+    order = np.argsort(tags)
+    at = np.searchsorted(tags[order], triangles)
+    at = np.minimum(at, len(tags) - 1)
+    if not np.all(tags[order][at] == triangles):
+        raise InputError(field, f"{path}: a triangle names a node that is not in $Nodes")
+    return xyz[order][at]
+
+
+_MSH_NODES = {1: 2, 15: 1, 8: 3}  # the other element kinds skipped: lines, points, 3-node lines
+
+
+def merge_vertices(points, tolerance: float = MERGE_TOLERANCE):
+    """Points (N, 3) as unique vertices (V, 3) and each point's vertex (N): points nearer than
+    `tolerance` times the points' bounding-box diagonal are one vertex (the first of them)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    points = np.asarray(points, dtype=float)
+    scale = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))) or 1.0
+    pairs = cKDTree(points).query_pairs(tolerance * scale, output_type="ndarray")
+    n = len(points)
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max() + 1, n)
+    np.minimum.at(first, label, np.arange(n))
+    return points[first], label
+
+
+def _edges(triangles):
+    """The triangles' edges (T, 3, 2) in the patch's order (0-1, 1-2, 0-2), the unique edges'
+    sorted vertex pairs (E, 2), each triangle edge's unique edge (T, 3) and how many triangles
+    share each unique edge (E)."""
+    local = np.array([[0, 1], [1, 2], [0, 2]])
+    directed = triangles[:, local]  # (T, 3, 2)
+    key = np.sort(directed, axis=2).reshape(-1, 2)
+    unique, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    return directed, unique, inverse.reshape(-1, 3), counts
+
+
+def _check_topology(vertices, triangles, path, field):
+    """Non-manifold edges and inconsistent orientation refused (InputError naming `field`)."""
+    directed, unique, inverse, counts = _edges(triangles)
+    if counts.max() > 2:
+        e = unique[np.argmax(counts)]
+        raise InputError(field, f"{path}: the edge between vertices at {np.round(vertices[e[0]], 6).tolist()} and "
+                         f"{np.round(vertices[e[1]], 6).tolist()} is shared by {counts.max()} triangles "
+                         "(a non-manifold surface)")
+    # the triangles' own order of their edges: 0->1, 1->2, 2->0
+    ring = triangles[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)
+    _, repeated = np.unique(ring, axis=0, return_counts=True)
+    if repeated.max() > 1:
+        raise InputError(field, f"{path}: two triangles run along a shared edge the same way (their vertices' "
+                         "orders, which give their normals, disagree: the surface's orientation is inconsistent)")
+
+
+# -- patches ---------------------------------------------------------------------------------
+def facet_normals(vertices, triangles):
+    """Unit facet normals (T, 3) by the vertices' order, and each triangle's angles at its
+    corners (T, 3)."""
+    x = vertices[triangles]
+    normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    angles = np.zeros((len(triangles), 3))
+    for k in range(3):
+        a = x[:, (k + 1) % 3] - x[:, k]
+        b = x[:, (k + 2) % 3] - x[:, k]
+        angles[:, k] = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+    return normal, angles
+
+
+def corner_normals(vertices, triangles, feature_angle: float = FEATURE_ANGLE):
+    """Each triangle corner's vertex normal (T, 3, 3): the angle-weighted mean of the facet
+    normals of its fan (the facets around the vertex reached without crossing a feature edge),
+    and which unique edges are feature edges (_edges' order)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    normal, angles = facet_normals(vertices, triangles)
+    directed, unique, inverse, counts = _edges(triangles)
+    T = len(triangles)
+    owner = np.full((len(unique), 2), -1)  # the (up to) two triangle-edges of each unique edge
+    order = np.argsort(inverse.ravel(), kind="stable")
+    start = np.searchsorted(inverse.ravel()[order], np.arange(len(unique)))
+    owner[:, 0] = order[start]
+    two = counts == 2
+    owner[two, 1] = order[start[two] + 1]
+    ta, tb = owner[two, 0] // 3, owner[two, 1] // 3
+    feature = np.zeros(len(unique), dtype=bool)
+    feature[two] = np.einsum("ij,ij->i", normal[ta], normal[tb]) < np.cos(np.radians(feature_angle))
+    feature[~two] = False
+    smooth = np.flatnonzero(two & ~feature)
+    # corners joined across smooth edges: corner index 3 t + k of the edge's two vertices in each triangle
+    rows, cols = [], []
+    for end in range(2):
+        v = unique[smooth, end]
+        a, b = owner[smooth, 0] // 3, owner[smooth, 1] // 3
+        rows.append(3 * a + np.argmax(triangles[a] == v[:, None], axis=1))
+        cols.append(3 * b + np.argmax(triangles[b] == v[:, None], axis=1))
+    rows, cols = np.concatenate(rows), np.concatenate(cols)
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(3 * T, 3 * T))
+    # corners at one vertex with the same fan: components of this graph
+    _, label = connected_components(graph, directed=False)
+    x = vertices[triangles]
+    weighted = np.zeros((T, 3, 3))
+    for k in range(3):  # Max's weights: the facet normal times sin(angle) / (|a| |b|), a, b the corner's edges
+        a = x[:, (k + 1) % 3] - x[:, k]
+        b = x[:, (k + 2) % 3] - x[:, k]
+        weighted[:, k] = np.cross(a, b) / (np.einsum("ij,ij->i", a, a) * np.einsum("ij,ij->i", b, b))[:, None]
+    weighted = weighted.reshape(-1, 3)
+    sums = np.zeros((label.max() + 1, 3))
+    np.add.at(sums, label, weighted)
+    sums /= np.linalg.norm(sums, axis=1)[:, None]
+    # a fan with exactly one plane in it (facets with the same normal, to 1e-12, whose angles at the
+    # vertex add up to PLANE_ANGLE or more: a vertex on a tangent seam between a plane and a
+    # fillet, not two facets of a cylinder's strip): the plane's normal
+    facet = np.repeat(normal, 3, axis=0)
+    groups, first, inverse = np.unique(np.c_[label, np.round(facet, 12)], axis=0, return_index=True,
+                                       return_inverse=True)
+    spread = np.zeros(len(groups))
+    np.add.at(spread, inverse.ravel(), angles.ravel())
+    wide = spread >= np.radians(PLANE_ANGLE)
+    planes = groups[wide, 0].astype(np.int64)
+    fans, how_many = np.unique(planes, return_counts=True)
+    single = fans[how_many == 1]
+    if single.size:
+        at = first[wide][np.isin(planes, single)]
+        sums[label[at]] = facet[at]
+    return sums[label].reshape(T, 3, 3), feature
+
+
+def nagata_coefficient(d, na, nb):
+    """Nagata's curvature coefficient c (points, 3) of edges d = x_b - x_a with unit normals na,
+    nb at their ends (module docstring): 0 where the normals are parallel or opposite."""
+    g = np.einsum("ij,ij->i", na, nb)
+    det = 1.0 - g * g
+    ok = det > PARALLEL
+    det = np.where(ok, det, 1.0)
+    da, db = np.einsum("ij,ij->i", na, d), np.einsum("ij,ij->i", nb, d)
+    alpha = (da + g * db) / det
+    beta = -(db + g * da) / det
+    return np.where(ok[:, None], alpha[:, None] * na + beta[:, None] * nb, 0.0)
+
+
+def crease_coefficient(d, ta, tb):
+    """The coefficient c of a crease's edge d = x_b - x_a whose tangent directions at its ends
+    are ta, tb (unit, along d): c = ((d . tb) tb - (d . ta) ta) / 2."""
+    return 0.5 * (np.einsum("ij,ij->i", d, tb)[:, None] * tb - np.einsum("ij,ij->i", d, ta)[:, None] * ta)
+
+
+def nagata_patches(vertices, triangles, feature_angle: float = FEATURE_ANGLE):
+    """The Nagata patches' coefficients (T, 6, 3) of a triangle mesh (module docstring): a_0 ..
+    a_5 of X(u, v) = a_0 + a_1 u + a_2 v + a_3 u^2 + a_4 v^2 + a_5 u v."""
+    vertices = np.asarray(vertices, dtype=float)
+    triangles = np.asarray(triangles, dtype=np.int64)
+    normals, feature = corner_normals(vertices, triangles, feature_angle)
+    directed, unique, inverse, counts = _edges(triangles)
+    T = len(triangles)
+    # each unique edge from its first triangle-edge (and its second, for a crease)
+    first = np.zeros(len(unique), dtype=np.int64)
+    second = np.full(len(unique), -1, dtype=np.int64)
+    order = np.argsort(inverse.ravel(), kind="stable")
+    start = np.searchsorted(inverse.ravel()[order], np.arange(len(unique)))
+    first[:] = order[start]
+    two = counts == 2
+    second[two] = order[start[two] + 1]
+    local = np.array([[0, 1], [1, 2], [0, 2]])
+
+    def corner_normal(triangle_edge, vertex):
+        t, k = triangle_edge // 3, triangle_edge % 3
+        corners = local[k]
+        at = np.where(triangles[t, corners[:, 0]] == vertex, corners[:, 0], corners[:, 1])
+        return normals[t, at]
+
+    a, b = unique[:, 0], unique[:, 1]
+    d = vertices[b] - vertices[a]
+    na, nb = corner_normal(first, a), corner_normal(first, b)
+    c = nagata_coefficient(d, na, nb)
+    crease = np.flatnonzero(feature)
+    if crease.size:
+        tangents = []
+        for v, n1 in ((a[crease], na[crease]), (b[crease], nb[crease])):
+            n2 = corner_normal(second[crease], v)
+            t = np.cross(n1, n2)
+            size = np.linalg.norm(t, axis=1)
+            along = d[crease] / np.linalg.norm(d[crease], axis=1)[:, None]
+            t = np.where(size[:, None] > 1e-6, t / np.maximum(size, 1e-300)[:, None], along)
+            t *= np.where(np.einsum("ij,ij->i", t, d[crease]) < 0, -1.0, 1.0)[:, None]
+            tangents.append(t)
+        c[crease] = crease_coefficient(d[crease], *tangents)
+    # only c's part along the edge's mean normal, made orthogonal to d, is kept
+    mean = na + nb
+    if crease.size:
+        mean[crease] = np.cross(d[crease], np.cross(na[crease] + nb[crease], d[crease]))
+    m = mean - (np.einsum("ij,ij->i", mean, d) / np.einsum("ij,ij->i", d, d))[:, None] * d
+    size = np.linalg.norm(m, axis=1)
+    m = np.where(size[:, None] > 1e-12, m / np.maximum(size, 1e-300)[:, None], 0.0)
+    c = np.einsum("ij,ij->i", c, m)[:, None] * m
+    c01, c12, c02 = c[inverse[:, 0]], c[inverse[:, 1]], c[inverse[:, 2]]
+    x = vertices[triangles]
+    return np.stack([x[:, 0], x[:, 1] - x[:, 0] - c01, x[:, 2] - x[:, 0] - c02, c01, c02, c01 + c02 - c12], axis=1) \
+        .reshape(T, 6, 3)
+
+
+# -- the patches' geometry -------------------------------------------------------------------
+def _evaluate(A, u, v):
+    """X, X_u, X_v of patches A (m, 6, 3) at (u, v)."""
+    u, v = u[:, None], v[:, None]
+    X = A[:, 0] + A[:, 1] * u + A[:, 2] * v + A[:, 3] * u * u + A[:, 4] * v * v + A[:, 5] * u * v
+    Xu = A[:, 1] + 2.0 * A[:, 3] * u + A[:, 5] * v
+    Xv = A[:, 2] + 2.0 * A[:, 4] * v + A[:, 5] * u
+    return X, Xu, Xv
+
+
+def _flat_closest(y, p0, p1, p2):
+    """The closest points' barycentric (u, v) on flat triangles p0 p1 p2 (m, 3) and the
+    distances to them."""
+    e1, e2 = p1 - p0, p2 - p0
+    w = y - p0
+    g11, g12, g22 = (np.einsum("ij,ij->i", a, b) for a, b in ((e1, e1), (e1, e2), (e2, e2)))
+    r1, r2 = np.einsum("ij,ij->i", w, e1), np.einsum("ij,ij->i", w, e2)
+    det = g11 * g22 - g12 * g12
+    u = (g22 * r1 - g12 * r2) / det
+    v = (g11 * r2 - g12 * r1) / det
+    inside = (u >= 0) & (v >= 0) & (u + v <= 1)
+    best_u, best_v = np.where(inside, u, 0.0), np.where(inside, v, 0.0)
+    dist = np.where(inside, np.linalg.norm(w - u[:, None] * e1 - v[:, None] * e2, axis=1), np.inf)
+    for (q0, q1, du, dv, u0, v0) in ((p0, p1, 1.0, 0.0, 0.0, 0.0), (p1, p2, -1.0, 1.0, 1.0, 0.0),
+                                     (p0, p2, 0.0, 1.0, 0.0, 0.0)):
+        s = q1 - q0
+        t = np.clip(np.einsum("ij,ij->i", y - q0, s) / np.einsum("ij,ij->i", s, s), 0.0, 1.0)
+        dd = np.linalg.norm(y - q0 - t[:, None] * s, axis=1)
+        better = ~inside & (dd < dist)
+        dist = np.where(better, dd, dist)
+        best_u = np.where(better, u0 + du * t, best_u)
+        best_v = np.where(better, v0 + dv * t, best_v)
+    return best_u, best_v, dist
+
+
+class MeshTool:
+    """A rigid tool: quadratic triangular patches (T, 6, 3), X(u, v) = a_0 + a_1 u + a_2 v + a_3 u^2
+    + a_4 v^2 + a_5 u v on u, v >= 0, u + v <= 1 (nagata_patches of a mesh; flat facets have
+    a_3 = a_4 = a_5 = 0), placed by `translation` (mm), their normals X_u x X_v pointing to the
+    sheet (`normals` "outward") or away from it ("inward": turned). Build it from a file with
+    from_file, from a mesh with from_triangles."""
+
+    def __init__(self, patches, translation=(0.0, 0.0, 0.0), normals: str = "outward"):
+        if normals not in NORMALS:
+            raise ValueError(f"normals must be one of {NORMALS}, got {normals!r}")
+        from scipy.spatial import cKDTree
+
+        A = np.asarray(patches, dtype=float).reshape(-1, 6, 3)
+        if len(A) == 0:
+            raise ValueError("the tool has no patches")
+        self.patches, self.sign = A, 1.0 if normals == "outward" else -1.0
+        self.translation = np.asarray(translation, dtype=float).reshape(3)
+        self.corners = np.stack([A[:, 0], A[:, 0] + A[:, 1] + A[:, 3], A[:, 0] + A[:, 2] + A[:, 4]], axis=1)
+        c01, c02 = A[:, 3], A[:, 4]
+        c12 = c01 + c02 - A[:, 5]
+        sizes = np.stack([np.linalg.norm(c, axis=1) for c in (c01, c12, c02)], axis=1)
+        self.bulge = np.minimum(sizes.max(axis=1) / 3.0, sizes.sum(axis=1) / 4.0) * (1 + 1e-9)
+        lo, hi = self.corners.reshape(-1, 3).min(axis=0), self.corners.reshape(-1, 3).max(axis=0)
+        self.size = float(np.linalg.norm(hi - lo))
+        # samples on each flat triangle: a barycentric grid of m intervals, m = longest edge / spacing
+        edges = np.linalg.norm(self.corners[:, [1, 2, 0]] - self.corners, axis=2)
+        spacing = float(np.median(edges))
+        m = np.maximum(1, np.ceil(edges.max(axis=1) / spacing)).astype(int)
+        points, owner, reach = [], [], np.zeros(len(A))
+        for k in np.unique(m):
+            tri = np.flatnonzero(m == k)
+            i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+            keep = i + j <= k
+            u, v = i[keep] / k, j[keep] / k
+            P = self.corners[tri]
+            pts = P[:, None, 0] * (1 - u - v)[None, :, None] + P[:, None, 1] * u[None, :, None] \
+                + P[:, None, 2] * v[None, :, None]
+            points.append(pts.reshape(-1, 3))
+            owner.append(np.repeat(tri, len(u)))
+            reach[tri] = edges[tri].max(axis=1) / k  # every flat point lies within this of a sample
+        self._samples = cKDTree(np.vstack(points))
+        self._sample_owner = np.concatenate(owner)
+        self._reach = float((reach + self.bulge).max()) * (1 + 1e-9) + 1e-12 * self.size
+        self._last = None  # the last call's points (tool frame) and their answers
+        self.counts = {"repeated": 0, "searched": 0}
+
+    def flat_top_boundary(self) -> list[np.ndarray]:
+        """The boundary loops, in the model's frame ((m, 3) points at the mesh's vertices), of the
+        highest flat facets whose (turned) normal is +z: a die's flat top, on which the holder
+        pinches the flange (the edges that one of those facets alone uses, chained into loops)."""
+        c = self.corners
+        n = self.sign * np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        up = n[:, 2] > 1.0 - 1e-9
+        if not up.any():
+            raise ValueError("the mesh has no flat facet whose normal is +z (a die's flat top)")
+        height = c[up][:, :, 2].max()
+        top = np.flatnonzero(up & (np.abs(c[:, :, 2] - height).max(axis=1) <= 1e-9 * self.size))
+        grid = 1e-9 * self.size  # vertices that coincide within it are one
+
+        def key(p, q):
+            return tuple(sorted((tuple(np.round(p / grid)), tuple(np.round(q / grid)))))
+
+        count = {}
+        for t in top:
+            for a, b in ((0, 1), (1, 2), (2, 0)):
+                count.setdefault(key(c[t, a], c[t, b]), [0, c[t, a], c[t, b]])[0] += 1
+        pieces = [np.array([p, q]) for k, p, q in count.values() if k == 1]
+        return closed_loops(pieces, 1e-6 * self.size)
+
+    @classmethod
+    def from_triangles(cls, vertices, triangles, translation=(0.0, 0.0, 0.0), normals: str = "outward") -> "MeshTool":
+        """The Nagata patches of a triangle mesh (vertices (V, 3), triangles (T, 3))."""
+        return cls(nagata_patches(vertices, triangles), translation, normals)
+
+    @classmethod
+    def from_file(cls, path, translation=(0.0, 0.0, 0.0), normals: str = "outward",
+                  field: str = "tools.file") -> "MeshTool":
+        """The tool of an STL or ASCII gmsh .msh file (a bad file: InputError naming `field`)."""
+        vertices, triangles = read_surface_mesh(path, field)
+        return cls.from_triangles(vertices, triangles, translation, normals)
+
+    # -- evaluation --------------------------------------------------------------------------
+    def gap(self, x, offset=0.0, dz: float = 0.0):
+        """Signed distance minus offset (> 0 clear) and unit normal from the tool towards x."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        _, d, n, _ = self._answers(x, dz)
+        return d - np.broadcast_to(np.asarray(offset, dtype=float), d.shape), n + 0.0
+
+    def shape(self, x, offset=0.0, dz: float = 0.0):
+        """H = dn/dx (n, 3, 3) (module docstring)."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        return self._answers(x, dz)[3] + 0.0
+
+    def closest(self, x, dz: float = 0.0):
+        """For points x (n, 3): the closest surface points (placed), the signed distances and
+        the normals."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        c, d, n, _ = self._answers(x, dz)
+        return c + self.translation + np.array([0.0, 0.0, dz]), d.copy(), n.copy()
+
+    def _answers(self, x, dz):
+        """Closest points c (tool frame), signed distances, normals and H; points given again
+        (the same point in the tool's frame as in the last call) take their last answers."""
+        y = x - self.translation - np.array([0.0, 0.0, dz])
+        npts = len(y)
+        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
+        todo = np.ones(npts, dtype=bool)
+        last = self._last
+        if last is not None and npts:
+            delta, ref = last[0].query(y)
+            same = np.flatnonzero(delta == 0.0)
+            r = ref[same]
+            c[same], d[same], n[same], H[same] = last[1][r], last[2][r], last[3][r], last[4][r]
+            todo[same] = False
+            self.counts["repeated"] += same.size
+            if same.size == npts:
+                return c, d, n, H
+        rest = np.flatnonzero(todo)
+        self.counts["searched"] += rest.size
+        if rest.size:
+            c[rest], d[rest], n[rest], H[rest] = self._search(y[rest])
+        if npts:
+            from scipy.spatial import cKDTree
+
+            self._last = (cKDTree(y), c, d, n, H)
+        return c, d, n, H
+
+    def _search(self, y):
+        """Closest points, signed distances, normals and H of points y (tool frame)."""
+        npts = len(y)
+        # a first upper bound of each point's distance: the triangles of its nearest samples
+        k = min(NEAREST_SAMPLES, self._samples.n)
+        _, near = self._samples.query(y, k=k)
+        near = self._sample_owner[np.asarray(near).reshape(npts, k)]
+        P = self.corners[near.ravel()]
+        _, _, flat = _flat_closest(np.repeat(y, k, axis=0), P[:, 0], P[:, 1], P[:, 2])
+        upper = (flat + self.bulge[near.ravel()]).reshape(npts, k).min(axis=1)
+        # candidates: every triangle with a sample within upper + reach, and lower bound <= upper
+        lists = self._samples.query_ball_point(y, upper + self._reach)
+        lengths = np.fromiter((len(s) for s in lists), dtype=np.int64, count=npts)
+        samples = np.fromiter((i for s in lists for i in s), dtype=np.int64, count=int(lengths.sum()))
+        pair = np.unique(np.repeat(np.arange(npts), lengths) * len(self.patches) + self._sample_owner[samples])
+        p, t = pair // len(self.patches), pair % len(self.patches)
+        P = self.corners[t]
+        u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
+        keep = flat - self.bulge[t] <= upper[p] * (1 + 1e-12) + 1e-12 * self.size
+        p, t, u, v = p[keep], t[keep], u[keep], v[keep]
+        # Newton on each candidate patch; the edges where its minimiser leaves the triangle
+        u, v, inside = self._project(y[p], t, u, v)
+        X, _, _ = _evaluate(self.patches[t], u, v)
+        dist = np.where(inside, np.linalg.norm(y[p] - X, axis=1), np.inf)
+        kind = np.full(len(p), -1)  # -1 inside; 0, 1, 2 the edge
+        out = np.flatnonzero(~inside)
+        if out.size:
+            for e in range(3):
+                ue, ve = self._project_edge(y[p[out]], t[out], e)
+                Xe, _, _ = _evaluate(self.patches[t[out]], ue, ve)
+                de = np.linalg.norm(y[p[out]] - Xe, axis=1)
+                better = de < dist[out]
+                rows = out[better]
+                dist[rows], u[rows], v[rows], kind[rows] = de[better], ue[better], ve[better], e
+        order = np.lexsort((dist, p))
+        firsts = order[np.r_[True, p[order][1:] != p[order][:-1]]]
+        best = np.empty(npts, dtype=np.int64)
+        best[p[firsts]] = firsts
+        return self._signed(y, t[best], u[best], v[best], kind[best])
+
+    def _project(self, y, t, u, v):
+        """Newton on patches t from (u, v): the minimisers of |X - y|^2 and whether each lies
+        inside its triangle (converged there)."""
+        A = self.patches[t]
+        S = np.stack([2.0 * A[:, 3], 2.0 * A[:, 4], A[:, 5]], axis=1)
+        u, v = u.copy(), v.copy()
+        active = np.ones(len(t), dtype=bool)
+        converged = np.zeros(len(t), dtype=bool)
+        tol = 1e-13
+        for _ in range(NEWTON_ITERATIONS):
+            i = np.flatnonzero(active)
+            if i.size == 0:
+                break
+            X, Xu, Xv = _evaluate(A[i], u[i], v[i])
+            r = X - y[i]
+            g = np.stack([np.einsum("ij,ij->i", Xu, r), np.einsum("ij,ij->i", Xv, r)], axis=1)
+            guu, guv, gvv = (np.einsum("ij,ij->i", a, b) for a, b in ((Xu, Xu), (Xu, Xv), (Xv, Xv)))
+            huu = guu + np.einsum("ij,ij->i", r, S[i, 0])
+            hvv = gvv + np.einsum("ij,ij->i", r, S[i, 1])
+            huv = guv + np.einsum("ij,ij->i", r, S[i, 2])
+            det = huu * hvv - huv * huv
+            indefinite = (det <= 1e-12 * (guu * gvv)) | (huu <= 0)
+            huu, hvv = np.where(indefinite, guu, huu), np.where(indefinite, gvv, hvv)
+            huv = np.where(indefinite, guv, huv)
+            det = huu * hvv - huv * huv
+            du = -(hvv * g[:, 0] - huv * g[:, 1]) / det
+            dv = -(huu * g[:, 1] - huv * g[:, 0]) / det
+            u[i] += du
+            v[i] += dv
+            small = np.abs(du) + np.abs(dv) < tol
+            far = (u[i] < -1.0) | (v[i] < -1.0) | (u[i] + v[i] > 2.0)  # left it: its edges decide
+            converged[i[small]] = True
+            active[i[small | far]] = False
+        eps = 1e-10
+        inside = converged & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
+        return np.where(inside, np.clip(u, 0, 1), u), np.where(inside, np.clip(v, 0, 1), v), inside
+
+    def _project_edge(self, y, t, e):
+        """The nearest points on edge e (0: u-axis, 1: u + v = 1, 2: v-axis) of patches t: their
+        (u, v), by Newton in the edge's parameter, clamped to [0, 1]."""
+        A = self.patches[t]
+        (u0, v0), (du, dv) = ((0.0, 0.0), (1.0, 0.0)) if e == 0 else (((1.0, 0.0), (-1.0, 1.0)) if e == 1 else
+                                                                      ((0.0, 0.0), (0.0, 1.0)))
+        P = self.corners[t]
+        a, b = P[:, {0: 0, 1: 1, 2: 0}[e]], P[:, {0: 1, 1: 2, 2: 2}[e]]
+        s = np.clip(np.einsum("ij,ij->i", y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
+        second = 2.0 * A[:, 3] * du * du + 2.0 * A[:, 4] * dv * dv + 2.0 * A[:, 5] * du * dv  # x''
+        for _ in range(NEWTON_ITERATIONS):
+            X, Xu, Xv = _evaluate(A, u0 + du * s, v0 + dv * s)
+            r = X - y
+            first = Xu * du + Xv * dv
+            g = np.einsum("ij,ij->i", first, r)
+            h = np.einsum("ij,ij->i", first, first) + np.einsum("ij,ij->i", second, r)
+            h = np.where(h > 0, h, np.einsum("ij,ij->i", first, first))
+            new = np.clip(s - g / h, 0.0, 1.0)
+            done = np.abs(new - s).max() < 1e-13
+            s = new
+            if done:
+                break
+        return u0 + du * s, v0 + dv * s
+
+    def _signed(self, y, t, u, v, kind):
+        """Closest points, signed distances, normals and H at the closest points (u, v) of
+        patches t: inside (kind -1) the patch's; on an edge (kind 0, 1, 2) the curve's."""
+        A = self.patches[t]
+        X, Xu, Xv = _evaluate(A, u, v)
+        S = np.stack([2.0 * A[:, 3], 2.0 * A[:, 4], A[:, 5]], axis=1)
+        nc = np.cross(Xu, Xv)
+        nc = self.sign * nc / np.maximum(np.linalg.norm(nc, axis=1), 1e-300)[:, None]
+        r = y - X
+        dist = np.linalg.norm(r, axis=1)
+        d, n, H = np.einsum("ij,ij->i", r, nc), nc.copy(), np.zeros((len(y), 3, 3))
+        inside = kind < 0
+        if inside.any():
+            H[inside] = distance_hessian(np.stack([Xu, Xv], axis=1)[inside], S[inside], n[inside], d[inside])
+        edge = np.flatnonzero(~inside)
+        if edge.size:
+            s = np.where(d[edge] < 0.0, -1.0, 1.0)
+            far = dist[edge] > 1e-12 * self.size
+            d[edge] = s * dist[edge]
+            n[edge] = np.where(far[:, None], s[:, None] * r[edge] / np.where(far, dist[edge], 1.0)[:, None], nc[edge])
+            direction = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])[kind[edge]]
+            first = Xu[edge] * direction[:, :1] + Xv[edge] * direction[:, 1:]
+            second = np.einsum("pk,pki->pi", np.stack([direction[:, 0] ** 2, direction[:, 1] ** 2,
+                                                       2 * direction[:, 0] * direction[:, 1]], axis=1), S[edge])
+            position = np.where(kind[edge] == 1, v[edge], np.where(kind[edge] == 0, u[edge], v[edge]))
+            vertex = (position <= 0.0) | (position >= 1.0)
+            stiff = np.einsum("ij,ij->i", first, first) - np.einsum("ij,ij->i", r[edge], second)
+            stiff = np.maximum(stiff, 1e-12 * np.einsum("ij,ij->i", first, first))
+            m = n[edge]
+            P = np.eye(3) - m[:, :, None] * m[:, None, :]
+            along = first[:, :, None] * first[:, None, :] / stiff[:, None, None]
+            P = P - np.where(vertex[:, None, None], 0.0, along)
+            dd = np.where(far, d[edge], np.inf)
+            H[edge] = P / dd[:, None, None]
+        return X, d, n, H
