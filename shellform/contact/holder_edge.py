@@ -110,10 +110,15 @@ class OutlineEdge:
         return np.where(right >= 0.0, dist, -dist)
 
     def offset(self, x, y):
+        """Where the opening is re-entrant, the edge bends round a tip of the die's top (kappa <
+        0) and the offset lines on the holder's side shorten, to nothing at the tip's radius:
+        there j is taken at half the radius at most (j <= 2), so that a band wider than the
+        tip's radius (a mesh coarser than it) does not gather the edge load of the whole tip on
+        the nodes beyond its centre."""
         q, k, t, dist = self._nearest(x, y)
         s = self._signed(q, k, t, dist)
         kappa = (1 - t) * self.curvature[k] + t * self.curvature[(k + 1) % len(self.points)]
-        return s, 1.0 / np.maximum(1.0 + kappa * s, 1e-3)
+        return s, 1.0 / np.maximum(1.0 + kappa * s, 0.5)
 
     def length(self) -> float:
         return float(self.lengths.sum())
