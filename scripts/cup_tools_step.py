@@ -59,8 +59,9 @@ def die(gmsh, half_width, corner_radius, profile_radius, z_top=0.0, outer=100.0,
     occ.synchronize()
 
 
-def write_step(build, path, *args):
-    """build(gmsh, *args) in a fresh gmsh model, written to path (STEP)."""
+def write_step(build, path, *args, prepare=None):
+    """build(gmsh, *args) in a fresh gmsh model, written to path (STEP; or what path's suffix
+    says, after prepare(gmsh): a surface mesh's, for example)."""
     import gmsh
 
     owner = not gmsh.isInitialized()
@@ -71,6 +72,8 @@ def write_step(build, path, *args):
     gmsh.model.add(f"write_{Path(path).stem}")
     try:
         build(gmsh, *args)
+        if prepare is not None:
+            prepare(gmsh)
         gmsh.write(str(path))
     finally:
         gmsh.model.remove()

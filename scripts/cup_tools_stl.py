@@ -16,35 +16,21 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cup_tools_step import die, punch  # noqa: E402
+from cup_tools_step import die, punch, write_step  # noqa: E402
 
 
 def write_stl(build, path, per_turn, largest, *args):
     """build(gmsh, *args) in a fresh gmsh model, its surface meshed (per_turn triangles along a
     full turn of a curved face, at most `largest` mm), written to path as binary STL."""
-    import gmsh
 
-    owner = not gmsh.isInitialized()
-    if owner:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-    gmsh.option.setNumber("General.Terminal", 0)
-    previous = gmsh.model.getCurrent()
-    gmsh.model.add(f"write_{Path(path).stem}")
-    try:
-        build(gmsh, *args)
+    def mesh(gmsh):
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", per_turn)
         gmsh.option.setNumber("Mesh.MeshSizeMax", largest)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
         gmsh.model.mesh.generate(2)
         gmsh.option.setNumber("Mesh.Binary", 1)
-        gmsh.write(str(path))
-    finally:
-        gmsh.model.remove()
-        if owner:
-            gmsh.finalize()
-        elif previous:
-            gmsh.model.setCurrent(previous)
 
+    write_step(build, path, *args, prepare=mesh)
 
 if __name__ == "__main__":
     from shellform import scene
