@@ -78,6 +78,7 @@ from pathlib import Path
 import numpy as np
 
 from shellform.contact.cad_files import probe
+from shellform.contact.faces import Cylinders, Planes, Revolutions
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
@@ -167,7 +168,7 @@ class SurfaceTool:
                                    for e in self.edges}
             self._setup(gmsh)
             self._last = None  # the last call's points and their closest points (_Projections)
-            self.counts = {"repeated": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
+            self.counts = {"repeated": 0, "exact": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
             self._index = {de: k for k, de in enumerate(self._ents)}
             self._is_face = np.array([d == 2 for d, _ in self._ents])
             self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
@@ -220,8 +221,11 @@ class SurfaceTool:
             raise InputError(field, f"{path}: {exc}") from None
 
     def _setup(self, gmsh):
-        """Bounding boxes, parametric bounds, whether each face fills its parametric bounds, and
-        the sampled points of the upper bounds."""
+        """Bounding boxes, parametric bounds, whether each face fills its parametric bounds, the
+        sampled points of the upper bounds, and the faces evaluated in numpy (faces.py): the
+        planes, cylinders and surfaces of revolution of a circle that fill their parameter
+        rectangle (their nearest points in closed form), and the trimmed planes (their foot
+        points, checked against the trim)."""
         m = gmsh.model
         self._ents = [(2, f) for f in self.faces] + [(1, e) for e in self.edges]
         self._box = np.array([m.getBoundingBox(d, t) for d, t in self._ents]).reshape(-1, 2, 3)
@@ -229,7 +233,8 @@ class SurfaceTool:
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
         self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
-        self._rectangles, self._cylinders = [], []
+        self._kinds = [Planes(self.size), Cylinders(self.size), Revolutions(self.size)]  # filling their rectangle
+        self._trimmed_planes = Planes(self.size)
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
@@ -251,10 +256,7 @@ class SurfaceTool:
                 J = np.asarray(m.getDerivative(2, t, uv.ravel())).reshape(-1, 2, 3)
                 normal = np.asarray(m.getNormal(t, uv.ravel())).reshape(-1, 3)
                 self._orient[t] = 1.0 if np.einsum("pi,pi->", np.cross(J[:, 0], J[:, 1]), normal) >= 0 else -1.0
-                if (d, t) in self._flat and self._filled[t]:
-                    self._rectangle(k, xyz, uv, J, b0, b1)
-                elif m.getType(d, t) == "Cylinder" and self._filled[t]:
-                    self._cylinder(m, k, t, xyz, uv, b0, b1)
+                self._fit(m, k, t, b0, b1, uv, xyz, J)
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
@@ -265,61 +267,49 @@ class SurfaceTool:
 
         self._tree = cKDTree(np.vstack(points))
         self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
+        self._exact_faces = np.zeros(len(self._ents), dtype=bool)  # evaluated in numpy
+        covered = np.zeros(len(self._ents), dtype=bool)  # an exact face's, or an edge of a filled one
+        for kind in self._kinds + [self._trimmed_planes]:
+            self._exact_faces[kind.index] = True
+        for kind in self._kinds:
+            covered[kind.index] = True
+        covered |= self._exact_faces
+        for k, (d, t) in enumerate(self._ents):
+            if d == 1:
+                covered[k] = any(covered[self._ents.index((2, f))] and self._filled[f] for f in self._face_adjacent[t])
+        self._rest = np.flatnonzero(~covered)  # the entities the exact faces do not answer for
+        self._kind_of, self._position = np.zeros(len(self._ents), dtype=np.int64), np.zeros(len(self._ents), dtype=int)
+        for kind in self._kinds + [self._trimmed_planes]:
+            self._kind_of[kind.index], self._position[kind.index] = id(kind), np.arange(len(kind))
 
-    def _rectangle(self, k, xyz, uv, J, b0, b1):
-        """Face k, a plane that fills its parameter rectangle, kept as a rectangle where its
-        parametrisation is X = O + u E_u + v E_v with E_u, E_v orthonormal (OCC's planes; checked at
-        its samples xyz, uv): its nearest point to y is X at the clamped (E . (y - O))."""
-        E = J[0]
-        if np.abs(E @ E.T - np.eye(2)).max() > 1e-12 or np.abs(J - E).max() > 1e-12:
-            return
-        O = xyz[0] - uv[0] @ E
-        if np.abs(O + uv @ E - xyz).max() > 1e-9 * self.size:
-            return
-        self._rectangles.append((k, O, E, b0, b1))
+    def _fit(self, m, k, f, b0, b1, uv, xyz, J):
+        """Face k (tag f) evaluated in numpy where gmsh names it a plane, a cylinder or a surface
+        of revolution (a torus, a sphere) and the kind's parametrisation fitted from it is gmsh's
+        at its samples uv (faces.py)."""
+        kind = m.getType(2, f)
+        S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+        filled = self._filled[f]
+        if kind == "Plane":
+            (self._kinds[0] if filled else self._trimmed_planes).add(
+                k, b0 if filled else np.full(2, -np.inf), b1 if filled else np.full(2, np.inf), xyz, J, S, uv)
+        elif kind == "Cylinder" and filled:
+            origin = [np.asarray(g(2, f, [0.0, 0.0])).reshape(shape) for g, shape in
+                      ((m.getValue, 3), (m.getDerivative, (2, 3)), (m.getSecondDerivative, (3, 3)))]
+            self._kinds[1].add(k, b0, b1, xyz, J, S, uv, origin)
+        elif kind in ("Torus", "Sphere", "Surface of Revolution") and filled:
+            mid = 0.5 * (b0 + b1)
+            middle = [mid] + [np.asarray(g(2, f, mid)).reshape(shape) for g, shape in
+                              ((m.getValue, 3), (m.getDerivative, (2, 3)), (m.getSecondDerivative, (3, 3)))]
+            self._kinds[2].add(k, b0, b1, xyz, J, S, uv, middle)
 
-    def _cylinder(self, m, k, f, xyz, uv, b0, b1):
-        """Face k (tag f), a cylinder that fills its parameter rectangle, kept where its
-        parametrisation is X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's
-        cylinders; E and R from the derivatives at (0, 0), checked at its samples xyz, uv): the
-        patch is an arc times a segment, its nearest point to y the arc's nearest to y's
-        projection onto the axis' plane and the segment's nearest to y's height."""
-        J = np.asarray(m.getDerivative(2, f, [0.0, 0.0])).reshape(2, 3)
-        S = np.asarray(m.getSecondDerivative(2, f, [0.0, 0.0])).reshape(3, 3)
-        R = float(np.linalg.norm(S[0]))
-        if not R > 1e-9 * self.size or b1[0] - b0[0] > 2 * np.pi + 1e-12:
-            return
-        E = np.array([-S[0] / R, J[0] / R, J[1]])
-        if np.abs(E @ E.T - np.eye(3)).max() > 1e-12:
-            return
-        O = np.asarray(m.getValue(2, f, [0.0, 0.0])) - R * E[0]
-        X = O + R * (np.cos(uv[:, :1]) * E[0] + np.sin(uv[:, :1]) * E[1]) + uv[:, 1:] * E[2]
-        if np.abs(X - xyz).max() > 1e-9 * self.size:
-            return
-        self._cylinders.append((k, O, E, R, b0, b1))
-
-    def _rectangle_distances(self, y):
-        """The faces kept as rectangles or cylinders (their indices) and the points' distances
-        to them."""
+    def _exact_distances(self, y):
+        """The faces evaluated in numpy that fill their parameter rectangle (their indices) and
+        the points' distances to them (faces.py: in closed form)."""
         ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
-        if self._rectangles:
-            k, O, E, b0, b1 = (np.array(v) for v in zip(*self._rectangles))
-            uv = np.clip(np.einsum("pfi,fai->pfa", y[:, None] - O[None], E), b0[None], b1[None])
-            ks.append(k)
-            ds.append(np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2))
-        if self._cylinders:
-            k, O, E, R, b0, b1 = (np.array(v) for v in zip(*self._cylinders))
-            q = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)  # (x, y, z) in each cylinder's frame
-            phi = np.arctan2(q[..., 1], q[..., 0])
-            span = b1[None, :, 0] - b0[None, :, 0]
-            after = np.mod(phi - b0[None, :, 0], 2 * np.pi)  # the angle past the arc's start
-            u = np.where(after <= span, b0[None, :, 0] + after,  # on the arc, else its nearer end
-                         np.where(after - span < 2 * np.pi - after, b1[None, :, 0], b0[None, :, 0]))
-            rho = np.hypot(q[..., 0], q[..., 1])
-            plane = np.hypot(rho * np.cos(phi) - R * np.cos(u), rho * np.sin(phi) - R * np.sin(u))
-            height = q[..., 2] - np.clip(q[..., 2], b0[None, :, 1], b1[None, :, 1])
-            ks.append(k)
-            ds.append(np.hypot(plane, height))
+        for kind in self._kinds:
+            if len(kind):
+                ks.append(np.asarray(kind.index))
+                ds.append(kind.nearest(y)[1])
         return np.concatenate(ks), np.hstack(ds)
 
     # -- evaluation --------------------------------------------------------------------------
@@ -359,6 +349,15 @@ class SurfaceTool:
         with _Current(self.model) as gmsh:
             m = gmsh.model
             new = np.flatnonzero(todo)
+            if new.size and self._exact_faces.any():
+                out = self._exact(m, y[new])
+                bound[new] = out[-1]
+                found = out[-2]
+                rows = new[found]
+                c[rows], dist[rows], ent[rows], par[rows], J[rows], S[rows] = (v[found] for v in out[:6])
+                has[rows] = True
+                todo[rows] = False
+                self.counts["exact"] += rows.size
             if last is not None:
                 warm = np.flatnonzero(todo & self._is_face[np.maximum(last.ent[ref], 0)] & (last.ent[ref] >= 0))
                 if warm.size:
@@ -373,6 +372,61 @@ class SurfaceTool:
         if npts:
             self._last = _Projections(y, c, dist, d, n, ent, par, bound, J, S, has)
         return c + shift, d.copy(), n.copy(), ent.copy(), par.copy(), J, S, has
+
+    def _exact(self, m, y):
+        """Closest points on the faces evaluated in numpy (faces.py), for all of them at once: each
+        filled face's nearest point in closed form, each trimmed plane's foot point where it lies
+        inside the trim (its sampled boundary, isInside within the sampling's margin; checked
+        only where it may be the nearest). The nearest of these is the closest point (found)
+        where it lies inside its face's parameter rectangle (not on its boundary: an edge's
+        point, answered by the search as before), the face's parametrisation is regular there,
+        and every entity no exact face answers for (a face of another kind, an edge that bounds
+        no filled exact face) lies farther by its bounding box (less 1e-9 of the tool's size: a
+        tie goes to the search). Ties between faces go to the lower face tag. Returns c, dist,
+        ent, par, J, S, found and lower bounds of every point's distance to every entity (the
+        bounding boxes', the exact faces' distances, the trimmed planes' to their planes)."""
+        npts, nent = len(y), len(self._ents)
+        bound = self._lower(y)
+        D, U = np.full((npts, nent), np.inf), np.zeros((npts, nent, 2))
+        inside = np.zeros((npts, nent), dtype=bool)
+        for kind in self._kinds:
+            if len(kind):
+                U[:, kind.index], D[:, kind.index], inside[:, kind.index] = kind.nearest(y)
+        bound = np.maximum(bound, np.where(np.isfinite(D), D, 0.0))
+        planes = self._trimmed_planes
+        if len(planes):
+            reach = D.min(axis=1) * (1 + 1e-9) + 1e-9 * self.size
+            uv, d, _ = planes.nearest(y)
+            bound[:, planes.index] = np.maximum(bound[:, planes.index], d)
+            for j, k in enumerate(planes.index):
+                rows = np.flatnonzero(d[:, j] <= reach)
+                if rows.size == 0:
+                    continue
+                f = self._ents[k][1]
+                ins, sure = self._in_trim(f, uv[rows, j])
+                for i in np.flatnonzero(~sure):
+                    ins[i] = m.isInside(2, f, uv[rows[i], j], True) > 0
+                rows = rows[ins]
+                U[rows, k], D[rows, k], inside[rows, k] = uv[rows, j], d[rows, j], True
+        best = np.argmin(D, axis=1)
+        r = np.arange(npts)
+        dist, par = D[r, best], U[r, best]
+        found = np.isfinite(dist) & inside[r, best]
+        if self._rest.size:
+            found &= bound[:, self._rest].min(axis=1) > dist * (1 + 1e-9) + 1e-9 * self.size
+        c, J, S = np.zeros((npts, 3)), np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3))
+        for kind in self._kinds + [planes]:
+            if len(kind):
+                at = self._kind_of[best] == id(kind)
+                rows = np.flatnonzero(at & found)
+                if rows.size:
+                    c[rows], J[rows], S[rows] = kind.derivatives(self._position[best[rows]], par[rows])
+        cross = np.linalg.norm(np.cross(J[:, 0], J[:, 1]), axis=1)
+        found &= cross > 1e-12 * np.einsum("pai,pai->p", J, J)  # not a pole
+        dist = np.where(found, np.linalg.norm(y - c, axis=1), dist)
+        rows = np.flatnonzero(found)
+        bound[rows, best[rows]] = dist[rows]
+        return c, dist, best, par, J, S, found, bound
 
     def _lower(self, y):
         """The distance of points y to every entity's bounding box (points, entities): a lower
@@ -524,7 +578,7 @@ class SurfaceTool:
         sure = ok & (d <= others)
         i = np.flatnonzero(ok & ~sure)
         if i.size:  # the rectangles' and cylinders' distances
-            k, exact = self._rectangle_distances(y[warm[i]])
+            k, exact = self._exact_distances(y[warm[i]])
             lower[np.ix_(i, k)] = np.maximum(lower[np.ix_(i, k)], exact)
             others = np.where(known[i], np.inf, lower[i] - 1e-9 * self.size).min(axis=1)
             sure[i] = d[i] <= others

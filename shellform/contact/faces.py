@@ -1,0 +1,231 @@
+"""Elementary faces of a CAD tool evaluated in numpy from their parameters (docs/tools.md, "How a
+surface is evaluated").
+
+A CAD tool's faces are mostly OpenCASCADE's elementary surfaces: planes, cylinders, tori,
+spheres and surfaces of revolution of a circle arc (a fillet's corner). Each kind's class holds
+the faces of that kind of one tool, their geometric parameters fitted once from gmsh's
+evaluations of the face (gmsh names the surface's kind, not its parameters) and verified
+against gmsh's point, first and second derivatives at the face's samples: a face whose
+parametrisation is not the one fitted is refused (`add` returns False) and left to gmsh.
+
+For points y and every face of the kind at once (arrays (points, faces)):
+
+    nearest(y)            the nearest point of each face's parameter rectangle to y in closed form:
+                          its parameters, its distance, and whether it lies inside the
+                          rectangle (within `tol` of each bound: the parameters are then the
+                          untrimmed surface's foot point, which may lie up to `tol` outside),
+                          not clamped onto its boundary;
+    derivatives(j, uv)    the point X and its derivatives J = (X_u, X_v), S = (X_uu, X_vv, X_uv)
+                          of face j (an index per point) at parameters uv, as gmsh orders them.
+
+The nearest point is exact where the face fills its parameter rectangle (a trimmed face's
+projection must be checked against its trim by the tool).
+"""
+
+import numpy as np
+
+TWO_PI = 2.0 * np.pi
+
+
+def _interval(p, lo, hi, tol):
+    """The parameter nearest to p in [lo, hi]: p itself where it lies within tol of the
+    interval (inside True), else the nearer bound."""
+    inside = (p >= lo - tol) & (p <= hi + tol)
+    return np.where(inside, p, np.clip(p, lo, hi)), inside
+
+
+def _arc(phi, lo, hi, tol):
+    """The angle nearest to the angle phi in the arc [lo, hi] (angles modulo 2 pi, hi - lo <=
+    2 pi): phi's representative where it lies within tol of the arc (inside True), else the
+    arc's nearer end by angle (on a circle the distance grows with the angle between)."""
+    span = hi - lo
+    after = np.mod(phi - lo, TWO_PI)  # the angle past the arc's start, in [0, 2 pi)
+    before = TWO_PI - after  # the angle before its start
+    on = after <= span + tol
+    early = ~on & (before <= tol)
+    u = np.where(on, lo + after, np.where(early, lo - before, np.where(after - span < before, hi, lo)))
+    return u, on | early
+
+
+def _close(a, b, tol) -> bool:
+    return bool(np.abs(np.asarray(a) - np.asarray(b)).max(initial=0.0) <= tol)
+
+
+class _Kind:
+    """The faces of one kind: their indices in the tool (`index`), parameter bounds and
+    tolerances, and each kind's parameters (arrays with the face first)."""
+
+    def __init__(self, size: float):
+        self.size = size
+        self.index, self.b0, self.b1, self.tol, self._params = [], [], [], [], []
+
+    def __len__(self):
+        return len(self.index)
+
+    def _keep(self, index, b0, b1, params, X, J, S, uv) -> bool:
+        """Keeps the face where the fitted parametrisation gives gmsh's X, J and S at its samples
+        uv to round-off (1e-12 of the tool's size, the derivatives of their own size)."""
+        self._params.append(params)
+        self.index.append(index)
+        self.b0.append(np.asarray(b0, dtype=float))
+        self.b1.append(np.asarray(b1, dtype=float))
+        self.tol.append(1e-9 * (np.asarray(b1, dtype=float) - b0 + 1.0))
+        self._stack()
+        j = np.full(len(uv), len(self) - 1)
+        Xf, Jf, Sf = self.derivatives(j, uv)
+        scale = max(np.abs(J).max(initial=0.0), np.abs(S).max(initial=0.0), 1.0)
+        if _close(Xf, X, 1e-12 * self.size) and _close(Jf, J, 1e-12 * scale) and _close(Sf, S, 1e-12 * scale):
+            return True
+        for rows in (self._params, self.index, self.b0, self.b1, self.tol):
+            rows.pop()
+        self._stack()
+        return False
+
+    def _stack(self):
+        self.lo, self.hi, self.eps = (np.array(v).reshape(-1, 2) for v in (self.b0, self.b1, self.tol))
+        self.p = {k: np.array([q[k] for q in self._params]) for k in (self._params[0] if self._params else ())}
+
+
+class Planes(_Kind):
+    """Planes X = O + u E_u + v E_v, E_u and E_v orthonormal (OCC's planes). The nearest point
+    of the rectangle [u0, u1] x [v0, v1] is X at the clamped (E . (y - O)): the rectangle's
+    sides are orthogonal. A trimmed plane is given infinite bounds: the foot point of the
+    plane."""
+
+    def add(self, index, b0, b1, X, J, S, uv) -> bool:
+        E = J[0]
+        if not _close(E @ E.T, np.eye(2), 1e-12) or not _close(J, E, 1e-12 * np.abs(E).max()):
+            return False
+        O = X[0] - uv[0] @ E
+        return self._keep(index, b0, b1, {"O": O, "E": E}, X, J, S, uv)
+
+    def nearest(self, y):
+        O, E = self.p["O"], self.p["E"]
+        foot = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)
+        uv, inside = _interval(foot, self.lo[None], self.hi[None], self.eps[None])
+        d = np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2)
+        return uv, d, inside.all(axis=2)
+
+    def derivatives(self, j, uv):
+        O, E = self.p["O"][j], self.p["E"][j]
+        return O + np.einsum("pa,pai->pi", uv, E), E.copy(), np.zeros((len(j), 3, 3))
+
+
+class Cylinders(_Kind):
+    """Cylinders X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's cylinders), an
+    arc u in [u0, u1] times a segment v in [v0, v1]: the nearest point's u is the arc's nearest
+    angle to y's angle about the axis, its v y's height clamped."""
+
+    def add(self, index, b0, b1, X, J, S, uv, origin) -> bool:
+        """origin: gmsh's X, J, S at (u, v) = (0, 0), from which E and R are read."""
+        X0, J0, S0 = origin
+        R = float(np.linalg.norm(S0[0]))
+        if not R > 1e-9 * self.size or b1[0] - b0[0] > TWO_PI + 1e-12:
+            return False
+        E = np.array([-S0[0] / R, J0[0] / R, J0[1]])
+        if not _close(E @ E.T, np.eye(3), 1e-12):
+            return False
+        return self._keep(index, b0, b1, {"O": X0 - R * E[0], "E": E, "R": R}, X, J, S, uv)
+
+    def nearest(self, y):
+        O, E, R = self.p["O"], self.p["E"], self.p["R"]
+        q = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)  # y in each cylinder's frame
+        phi = np.arctan2(q[..., 1], q[..., 0])
+        u, on_arc = _arc(phi, self.lo[None, :, 0], self.hi[None, :, 0], self.eps[None, :, 0])
+        v, on_line = _interval(q[..., 2], self.lo[None, :, 1], self.hi[None, :, 1], self.eps[None, :, 1])
+        rho = np.hypot(q[..., 0], q[..., 1])
+        turn = u - phi
+        d = np.sqrt((rho * np.cos(turn) - R) ** 2 + (rho * np.sin(turn)) ** 2 + (q[..., 2] - v) ** 2)
+        return np.stack([u, v], axis=2), d, on_arc & on_line
+
+    def derivatives(self, j, uv):
+        O, E, R = self.p["O"][j], self.p["E"][j], self.p["R"][j][:, None]
+        c, s = np.cos(uv[:, :1]), np.sin(uv[:, :1])
+        radial = c * E[:, 0] + s * E[:, 1]
+        X = O + R * radial + uv[:, 1:] * E[:, 2]
+        J = np.stack([R * (-s * E[:, 0] + c * E[:, 1]), E[:, 2]], axis=1)
+        S = np.zeros((len(j), 3, 3))
+        S[:, 0] = -R * radial
+        return X, J, S
+
+
+class Revolutions(_Kind):
+    """Surfaces swept by a circle arc turning about an axis in the arc's plane: tori, spheres and
+    OCC's surfaces of revolution of a circle (a fillet's corner). With A a point of the axis,
+    a its direction, w(u) = cos u w_0 + sin u b_0 (b_0 = a x w_0) the radial direction at the
+    turn u, and the meridian arc (rho(v), h(v)) = c + r (cos v f_1 + sin v f_2) in the
+    half-plane (w, a),
+
+        X(u, v) = A + rho(v) w(u) + h(v) a.
+
+    Where rho >= 0 on the arc (it does not cross the axis), |X - y|^2 = rho_y^2 + rho^2 -
+    2 rho_y rho cos(u - phi_y) + (h_y - h)^2 (y at radius rho_y, angle phi_y and height h_y):
+    for every v the nearest u is the arc's nearest angle to phi_y, whatever v. In the half-plane
+    of that u, y lies at (rho_y cos(u - phi_y), h_y) and rho_y sin(u - phi_y) out of it, and the
+    nearest v is the meridian arc's nearest angle to y's angle about the circle's centre c."""
+
+    def add(self, index, b0, b1, X, J, S, uv, middle) -> bool:
+        """middle: gmsh's (u, v), X, J, S at a point where the face is not on the axis (rho >
+        0), from which the axis, the radial frame and the meridian circle are read: X_uu = -rho
+        w, X_u = rho b, and the meridian's (rho, h)'' = -((rho, h) - c)."""
+        (um, vm), Xm, Jm, Sm = middle
+        rho = float(np.linalg.norm(Sm[0]))
+        if not rho > 1e-9 * self.size:
+            return False
+        w, b = -Sm[0] / rho, Jm[0] / rho
+        a = np.cross(w, b)
+        A = Xm + Sm[0]  # the centre of the parallel through Xm, on the axis
+        w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
+        if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
+            return False
+        p, dp, ddp = np.array([rho, 0.0]), Jm[1] @ np.array([w, a]).T, Sm[1] @ np.array([w, a]).T
+        r = float(np.linalg.norm(ddp))
+        if not r > 1e-9 * self.size:
+            return False
+        c = p + ddp
+        f1 = (np.cos(vm) * (p - c) - np.sin(vm) * dp) / r
+        f2 = (np.sin(vm) * (p - c) + np.cos(vm) * dp) / r
+        if not _close(np.array([f1, f2]) @ np.array([f1, f2]).T, np.eye(2), 1e-12):
+            return False
+        # the meridian arc stays on one side of the axis: rho(v) >= 0 at its ends and extremes
+        psi = np.arctan2(f2[0], f1[0])  # rho(v) = c_0 + m cos(v - psi)
+        m = np.hypot(f1[0], f2[0]) * r
+        v = np.array([b0[1], b1[1]])
+        v = np.concatenate([v, psi + np.pi + TWO_PI * np.arange(np.ceil((b0[1] - psi - np.pi) / TWO_PI),
+                                                                np.floor((b1[1] - psi - np.pi) / TWO_PI) + 1)])
+        if np.min(c[0] + m * np.cos(v - psi)) < -1e-12 * self.size or b1[0] - b0[0] > TWO_PI + 1e-12 \
+                or b1[1] - b0[1] > TWO_PI + 1e-12:
+            return False
+        params = {"A": A, "a": a, "w0": w0, "b0": b0_, "c": c, "r": r, "f1": f1, "f2": f2}
+        return self._keep(index, b0, b1, params, X, J, S, uv)
+
+    def nearest(self, y):
+        P = self.p
+        q = y[:, None] - P["A"][None]
+        h = np.einsum("pfi,fi->pf", q, P["a"])
+        qw, qb = np.einsum("pfi,fi->pf", q, P["w0"]), np.einsum("pfi,fi->pf", q, P["b0"])
+        rho, phi = np.hypot(qw, qb), np.arctan2(qb, qw)
+        u, on_turn = _arc(phi, self.lo[None, :, 0], self.hi[None, :, 0], self.eps[None, :, 0])
+        turn = u - phi
+        s = np.stack([rho * np.cos(turn), h], axis=2) - P["c"][None]  # y in the meridian's plane, from c
+        angle = np.arctan2(np.einsum("pfk,fk->pf", s, P["f2"]), np.einsum("pfk,fk->pf", s, P["f1"]))
+        v, on_arc = _arc(angle, self.lo[None, :, 1], self.hi[None, :, 1], self.eps[None, :, 1])
+        meridian = P["c"][None] + P["r"][None, :, None] * (np.cos(v)[..., None] * P["f1"][None]
+                                                           + np.sin(v)[..., None] * P["f2"][None])
+        d = np.sqrt((rho * np.cos(turn) - meridian[..., 0]) ** 2 + (h - meridian[..., 1]) ** 2
+                    + (rho * np.sin(turn)) ** 2)
+        return np.stack([u, v], axis=2), d, on_turn & on_arc
+
+    def derivatives(self, j, uv):
+        P = {k: v[j] for k, v in self.p.items()}
+        cu, su, cv, sv = np.cos(uv[:, :1]), np.sin(uv[:, :1]), np.cos(uv[:, 1:]), np.sin(uv[:, 1:])
+        w = cu * P["w0"] + su * P["b0"]
+        b = -su * P["w0"] + cu * P["b0"]
+        r = P["r"][:, None]
+        m = P["c"] + r * (cv * P["f1"] + sv * P["f2"])  # (rho, h)
+        dm = r * (-sv * P["f1"] + cv * P["f2"])
+        ddm = -r * (cv * P["f1"] + sv * P["f2"])
+        X = P["A"] + m[:, :1] * w + m[:, 1:] * P["a"]
+        J = np.stack([m[:, :1] * b, dm[:, :1] * w + dm[:, 1:] * P["a"]], axis=1)
+        S = np.stack([-m[:, :1] * w, ddm[:, :1] * w + ddm[:, 1:] * P["a"], dm[:, :1] * b], axis=1)
+        return X, J, S
