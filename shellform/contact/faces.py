@@ -8,9 +8,9 @@ evaluations of the face (gmsh names the surface's kind, not its parameters) and 
 against gmsh's point, first and second derivatives at the face's samples: a face whose
 parametrisation is not the one fitted is refused (`add` returns False) and left to gmsh.
 
-For points y and every face of the kind at once (arrays (points, faces)):
+For points y and faces j of the kind (pairs: an index of a face of the kind per point):
 
-    nearest(y)            the nearest point of each face's parameter rectangle to y in closed form:
+    nearest(y, j)         the nearest point of face j's parameter rectangle to y in closed form:
                           its parameters, its distance, and whether it lies inside the
                           rectangle (within `tol` of each bound: the parameters are then the
                           untrimmed surface's foot point, which may lie up to `tol` outside),
@@ -99,12 +99,12 @@ class Planes(_Kind):
         O = X[0] - uv[0] @ E
         return self._keep(index, b0, b1, {"O": O, "E": E}, X, J, S, uv)
 
-    def nearest(self, y):
-        O, E = self.p["O"], self.p["E"]
-        foot = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)
-        uv, inside = _interval(foot, self.lo[None], self.hi[None], self.eps[None])
-        d = np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2)
-        return uv, d, inside.all(axis=2)
+    def nearest(self, y, j):
+        O, E = self.p["O"][j], self.p["E"][j]
+        foot = np.einsum("pi,pai->pa", y - O, E)
+        uv, inside = _interval(foot, self.lo[j], self.hi[j], self.eps[j])
+        r = y - O - np.einsum("pa,pai->pi", uv, E)
+        return uv, np.sqrt(np.einsum("pi,pi->p", r, r)), inside.all(axis=1)
 
     def derivatives(self, j, uv):
         O, E = self.p["O"][j], self.p["E"][j]
@@ -127,16 +127,16 @@ class Cylinders(_Kind):
             return False
         return self._keep(index, b0, b1, {"O": X0 - R * E[0], "E": E, "R": R}, X, J, S, uv)
 
-    def nearest(self, y):
-        O, E, R = self.p["O"], self.p["E"], self.p["R"]
-        q = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)  # y in each cylinder's frame
-        phi = np.arctan2(q[..., 1], q[..., 0])
-        u, on_arc = _arc(phi, self.lo[None, :, 0], self.hi[None, :, 0], self.eps[None, :, 0])
-        v, on_line = _interval(q[..., 2], self.lo[None, :, 1], self.hi[None, :, 1], self.eps[None, :, 1])
-        rho = np.hypot(q[..., 0], q[..., 1])
+    def nearest(self, y, j):
+        O, E, R, lo, hi, eps = self.p["O"][j], self.p["E"][j], self.p["R"][j], self.lo[j], self.hi[j], self.eps[j]
+        q = np.einsum("pi,pai->pa", y - O, E)  # y in the cylinder's frame
+        phi = np.arctan2(q[:, 1], q[:, 0])
+        u, on_arc = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
+        v, on_line = _interval(q[:, 2], lo[:, 1], hi[:, 1], eps[:, 1])
+        rho = np.hypot(q[:, 0], q[:, 1])
         turn = u - phi
-        d = np.sqrt((rho * np.cos(turn) - R) ** 2 + (rho * np.sin(turn)) ** 2 + (q[..., 2] - v) ** 2)
-        return np.stack([u, v], axis=2), d, on_arc & on_line
+        d = np.sqrt((rho * np.cos(turn) - R) ** 2 + (rho * np.sin(turn)) ** 2 + (q[:, 2] - v) ** 2)
+        return np.stack([u, v], axis=1), d, on_arc & on_line
 
     def derivatives(self, j, uv):
         O, E, R = self.p["O"][j], self.p["E"][j], self.p["R"][j][:, None]
@@ -196,25 +196,24 @@ class Revolutions(_Kind):
         if np.min(c[0] + m * np.cos(v - psi)) < -1e-12 * self.size or b1[0] - b0[0] > TWO_PI + 1e-12 \
                 or b1[1] - b0[1] > TWO_PI + 1e-12:
             return False
-        params = {"A": A, "a": a, "w0": w0, "b0": b0_, "c": c, "r": r, "f1": f1, "f2": f2}
+        params = {"A": A, "a": a, "w0": w0, "b0": b0_, "frame": np.array([w0, b0_, a]), "c": c, "r": r, "f1": f1,
+                  "f2": f2}
         return self._keep(index, b0, b1, params, X, J, S, uv)
 
-    def nearest(self, y):
-        P = self.p
-        q = y[:, None] - P["A"][None]
-        h = np.einsum("pfi,fi->pf", q, P["a"])
-        qw, qb = np.einsum("pfi,fi->pf", q, P["w0"]), np.einsum("pfi,fi->pf", q, P["b0"])
-        rho, phi = np.hypot(qw, qb), np.arctan2(qb, qw)
-        u, on_turn = _arc(phi, self.lo[None, :, 0], self.hi[None, :, 0], self.eps[None, :, 0])
+    def nearest(self, y, j):
+        P = {k: v[j] for k, v in self.p.items()}
+        lo, hi, eps = self.lo[j], self.hi[j], self.eps[j]
+        q = np.einsum("pi,pki->pk", y - P["A"], P["frame"])  # y along w_0, b_0 and a
+        rho, phi = np.hypot(q[:, 0], q[:, 1]), np.arctan2(q[:, 1], q[:, 0])
+        u, on_turn = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
         turn = u - phi
-        s = np.stack([rho * np.cos(turn), h], axis=2) - P["c"][None]  # y in the meridian's plane, from c
-        angle = np.arctan2(np.einsum("pfk,fk->pf", s, P["f2"]), np.einsum("pfk,fk->pf", s, P["f1"]))
-        v, on_arc = _arc(angle, self.lo[None, :, 1], self.hi[None, :, 1], self.eps[None, :, 1])
-        meridian = P["c"][None] + P["r"][None, :, None] * (np.cos(v)[..., None] * P["f1"][None]
-                                                           + np.sin(v)[..., None] * P["f2"][None])
-        d = np.sqrt((rho * np.cos(turn) - meridian[..., 0]) ** 2 + (h - meridian[..., 1]) ** 2
+        s = np.stack([rho * np.cos(turn), q[:, 2]], axis=1) - P["c"]  # y in the meridian's plane, from c
+        angle = np.arctan2(np.einsum("pk,pk->p", s, P["f2"]), np.einsum("pk,pk->p", s, P["f1"]))
+        v, on_arc = _arc(angle, lo[:, 1], hi[:, 1], eps[:, 1])
+        meridian = P["c"] + P["r"][:, None] * (np.cos(v)[:, None] * P["f1"] + np.sin(v)[:, None] * P["f2"])
+        d = np.sqrt((rho * np.cos(turn) - meridian[:, 0]) ** 2 + (q[:, 2] - meridian[:, 1]) ** 2
                     + (rho * np.sin(turn)) ** 2)
-        return np.stack([u, v], axis=2), d, on_turn & on_arc
+        return np.stack([u, v], axis=1), d, on_turn & on_arc
 
     def derivatives(self, j, uv):
         P = {k: v[j] for k, v in self.p.items()}

@@ -278,9 +278,11 @@ class SurfaceTool:
             if d == 1:
                 covered[k] = any(covered[self._ents.index((2, f))] and self._filled[f] for f in self._face_adjacent[t])
         self._rest = np.flatnonzero(~covered)  # the entities the exact faces do not answer for
-        self._kind_of, self._position = np.zeros(len(self._ents), dtype=np.int64), np.zeros(len(self._ents), dtype=int)
-        for kind in self._kinds + [self._trimmed_planes]:
-            self._kind_of[kind.index], self._position[kind.index] = id(kind), np.arange(len(kind))
+        self._kind_of, self._position = np.full(len(self._ents), -1), np.zeros(len(self._ents), dtype=int)
+        for i, kind in enumerate(self._kinds + [self._trimmed_planes]):  # kind i's face, at its position
+            self._kind_of[kind.index], self._position[kind.index] = i, np.arange(len(kind))
+        self._exact_index = np.flatnonzero(self._exact_faces)
+        self._orientation = np.array([self._orient.get(t, 1.0) if d == 2 else 0.0 for d, t in self._ents])
 
     def _fit(self, m, k, f, b0, b1, uv, xyz, J):
         """Face k (tag f) evaluated in numpy where gmsh names it a plane, a cylinder or a surface
@@ -301,16 +303,6 @@ class SurfaceTool:
             middle = [mid] + [np.asarray(g(2, f, mid)).reshape(shape) for g, shape in
                               ((m.getValue, 3), (m.getDerivative, (2, 3)), (m.getSecondDerivative, (3, 3)))]
             self._kinds[2].add(k, b0, b1, xyz, J, S, uv, middle)
-
-    def _exact_distances(self, y):
-        """The faces evaluated in numpy that fill their parameter rectangle (their indices) and
-        the points' distances to them (faces.py: in closed form)."""
-        ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
-        for kind in self._kinds:
-            if len(kind):
-                ks.append(np.asarray(kind.index))
-                ds.append(kind.nearest(y)[1])
-        return np.concatenate(ks), np.hstack(ds)
 
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
@@ -350,12 +342,12 @@ class SurfaceTool:
             m = gmsh.model
             new = np.flatnonzero(todo)
             if new.size and self._exact_faces.any():
-                out = self._exact(m, y[new])
-                bound[new] = out[-1]
-                found = out[-2]
+                upper = last.dist[ref[new]] + delta[new] if last is not None else self._tree.query(y[new])[0]
+                out = self._exact(m, y[new], upper)
+                found = out[-1]
                 rows = new[found]
                 c[rows], dist[rows], ent[rows], par[rows], J[rows], S[rows] = (v[found] for v in out[:6])
-                has[rows] = True
+                has[rows], bound[rows] = True, np.nan  # their bounds computed where asked (_remembered_bounds)
                 todo[rows] = False
                 self.counts["exact"] += rows.size
             if last is not None:
@@ -373,66 +365,98 @@ class SurfaceTool:
             self._last = _Projections(y, c, dist, d, n, ent, par, bound, J, S, has)
         return c + shift, d.copy(), n.copy(), ent.copy(), par.copy(), J, S, has
 
-    def _exact(self, m, y):
-        """Closest points on the faces evaluated in numpy (faces.py), for all of them at once: each
-        filled face's nearest point in closed form, each trimmed plane's foot point where it lies
-        inside the trim (its sampled boundary, isInside within the sampling's margin; checked
-        only where it may be the nearest). The nearest of these is the closest point (found)
-        where it lies inside its face's parameter rectangle (not on its boundary: an edge's
-        point, answered by the search as before), the face's parametrisation is regular there,
-        and every entity no exact face answers for (a face of another kind, an edge that bounds
-        no filled exact face) lies farther by its bounding box (less 1e-9 of the tool's size: a
-        tie goes to the search). Ties between faces go to the lower face tag. Returns c, dist,
-        ent, par, J, S, found and lower bounds of every point's distance to every entity (the
-        bounding boxes', the exact faces' distances, the trimmed planes' to their planes)."""
+    def _exact(self, m, y, upper):
+        """Closest points on the faces evaluated in numpy (faces.py) of points y whose distance
+        is at most `upper`: the nearest point in closed form of each filled face whose bounding
+        box lies within upper, each trimmed plane's foot point where it lies inside the trim
+        (its sampled boundary, isInside within the sampling's margin; checked only where it may
+        be the nearest). The nearest of these is the closest point (found) where it lies inside
+        its face's parameter rectangle (not on its boundary: an edge's point, answered by the
+        search as before), the face's parametrisation is regular there, and every entity no
+        exact face answers for (a face of another kind, an edge that bounds no filled exact
+        face) lies farther by its bounding box (less 1e-9 of the tool's size: a tie goes to
+        the search). Ties between faces go to the lower face tag. Returns c, dist, ent, par,
+        J, S and found."""
         npts, nent = len(y), len(self._ents)
-        bound = self._lower(y)
+        faces = self._exact_index
+        near = self._lower(y, faces) <= (upper * (1 + 1e-9) + 1e-9 * self.size)[:, None]
+        pi, k = np.nonzero(near)
+        k = faces[k]
+        kind_of = self._kind_of[k]
         D, U = np.full((npts, nent), np.inf), np.zeros((npts, nent, 2))
         inside = np.zeros((npts, nent), dtype=bool)
-        for kind in self._kinds:
-            if len(kind):
-                U[:, kind.index], D[:, kind.index], inside[:, kind.index] = kind.nearest(y)
-        bound = np.maximum(bound, np.where(np.isfinite(D), D, 0.0))
-        planes = self._trimmed_planes
-        if len(planes):
-            reach = D.min(axis=1) * (1 + 1e-9) + 1e-9 * self.size
-            uv, d, _ = planes.nearest(y)
-            bound[:, planes.index] = np.maximum(bound[:, planes.index], d)
-            for j, k in enumerate(planes.index):
-                rows = np.flatnonzero(d[:, j] <= reach)
-                if rows.size == 0:
-                    continue
-                f = self._ents[k][1]
-                ins, sure = self._in_trim(f, uv[rows, j])
+        for i, kind in enumerate(self._kinds):
+            sel = np.flatnonzero(kind_of == i)
+            if sel.size:
+                p, e = pi[sel], k[sel]
+                U[p, e], D[p, e], inside[p, e] = kind.nearest(y[p], self._position[e])
+        sel = np.flatnonzero(kind_of == len(self._kinds))  # the trimmed planes
+        if sel.size:
+            p, e = pi[sel], k[sel]
+            uv, d, _ = self._trimmed_planes.nearest(y[p], self._position[e])
+            check = np.flatnonzero(d <= D.min(axis=1)[p] * (1 + 1e-9) + 1e-9 * self.size)
+            for e0 in np.unique(e[check]):
+                rows = check[e[check] == e0]
+                f = self._ents[e0][1]
+                ins, sure = self._in_trim(f, uv[rows])
                 for i in np.flatnonzero(~sure):
-                    ins[i] = m.isInside(2, f, uv[rows[i], j], True) > 0
+                    ins[i] = m.isInside(2, f, uv[rows[i]], True) > 0
                 rows = rows[ins]
-                U[rows, k], D[rows, k], inside[rows, k] = uv[rows, j], d[rows, j], True
+                U[p[rows], e0], D[p[rows], e0], inside[p[rows], e0] = uv[rows], d[rows], True
         best = np.argmin(D, axis=1)
         r = np.arange(npts)
         dist, par = D[r, best], U[r, best]
         found = np.isfinite(dist) & inside[r, best]
         if self._rest.size:
-            found &= bound[:, self._rest].min(axis=1) > dist * (1 + 1e-9) + 1e-9 * self.size
+            found &= self._lower(y, self._rest).min(axis=1) > dist * (1 + 1e-9) + 1e-9 * self.size
         c, J, S = np.zeros((npts, 3)), np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3))
-        for kind in self._kinds + [planes]:
-            if len(kind):
-                at = self._kind_of[best] == id(kind)
-                rows = np.flatnonzero(at & found)
-                if rows.size:
-                    c[rows], J[rows], S[rows] = kind.derivatives(self._position[best[rows]], par[rows])
-        cross = np.linalg.norm(np.cross(J[:, 0], J[:, 1]), axis=1)
-        found &= cross > 1e-12 * np.einsum("pai,pai->p", J, J)  # not a pole
-        dist = np.where(found, np.linalg.norm(y - c, axis=1), dist)
-        rows = np.flatnonzero(found)
-        bound[rows, best[rows]] = dist[rows]
-        return c, dist, best, par, J, S, found, bound
+        for i, kind in enumerate(self._kinds + [self._trimmed_planes]):
+            rows = np.flatnonzero(found & (self._kind_of[best] == i))
+            if rows.size:
+                c[rows], J[rows], S[rows] = kind.derivatives(self._position[best[rows]], par[rows])
+        cross = np.cross(J[:, 0], J[:, 1])
+        found &= np.einsum("pi,pi->p", cross, cross) > 1e-24 * np.einsum("pai,pai->p", J, J) ** 2  # not a pole
+        r = y - c
+        dist = np.where(found, np.sqrt(np.einsum("pi,pi->p", r, r)), dist)
+        return c, dist, best, par, J, S, found
 
-    def _lower(self, y):
-        """The distance of points y to every entity's bounding box (points, entities): a lower
-        bound of their distance to the entity."""
-        return np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
-                              + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)
+    def _face_distances(self, y, kinds):
+        """The faces of `kinds` (their indices) and the points' distances to them (points,
+        faces), in closed form (faces.py; a trimmed plane's: to its plane)."""
+        ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
+        for kind in kinds:
+            if len(kind):
+                j = np.tile(np.arange(len(kind)), len(y))
+                ks.append(np.asarray(kind.index))
+                ds.append(kind.nearest(np.repeat(y, len(kind), axis=0), j)[1].reshape(len(y), -1))
+        return np.concatenate(ks), np.hstack(ds)
+
+    def _exact_distances(self, y):
+        """The faces evaluated in numpy that fill their parameter rectangle (their indices) and
+        the points' distances to them (in closed form)."""
+        return self._face_distances(y, self._kinds)
+
+    def _remembered_bounds(self, last, ref):
+        """The lower bounds of the remembered points ref's distances to every entity (points,
+        entities); those of points the exact pass answered computed now: the bounding boxes',
+        raised to the exact faces' distances and the trimmed planes' distances to their
+        planes."""
+        bound = last.bound[ref]
+        miss = np.flatnonzero(np.isnan(bound[:, 0]))
+        if miss.size:
+            y = last.y[ref[miss]]
+            sub = self._lower(y)
+            k, d = self._face_distances(y, self._kinds + [self._trimmed_planes])
+            sub[:, k] = np.maximum(sub[:, k], d)
+            bound[miss] = sub
+        return bound
+
+    def _lower(self, y, entities=slice(None)):
+        """The distance of points y to the entities' bounding boxes (points, entities; every
+        entity unless given): a lower bound of their distance to the entity."""
+        box = self._box[entities]
+        out = np.maximum(np.maximum(box[None, :, 0] - y[:, None], y[:, None] - box[None, :, 1]), 0.0)
+        return np.sqrt(np.einsum("pei,pei->pe", out, out))
 
     def _search(self, m, y):
         """Closest points: first the local projection from the nearest sample (_local), where
@@ -569,7 +593,7 @@ class SurfaceTool:
             X[sel], ok[sel], J[sel], S[sel] = self._newton(m, self._ents[k][1], uv, y[warm[sel]])
             uvs[sel] = uv
             d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
-        lower = last.bound[ref] - delta[:, None]
+        lower = self._remembered_bounds(last, ref) - delta[:, None]
         known = np.zeros_like(lower, dtype=bool)
         for k in np.unique(ks):
             sel = np.flatnonzero((ks == k) & ok)
@@ -727,18 +751,16 @@ class SurfaceTool:
         m = gmsh.model
         n = np.zeros((len(y), 3))
         d = dist.copy()
-        for k in np.unique(ent):
+        rows = np.flatnonzero(has)
+        if rows.size:
+            cross = np.cross(J[rows, 0], J[rows, 1])
+            n[rows] = (self.sign * self._orientation[ent[rows]] / np.linalg.norm(cross, axis=1))[:, None] * cross
+            d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], n[rows])
+        for k in np.unique(ent[~has]):
             dim, t = self._ents[k]
-            rows = np.flatnonzero(ent == k)
+            rows = np.flatnonzero((ent == k) & ~has)
             if dim == 2:
-                nc = np.zeros((rows.size, 3))
-                at = has[rows]
-                if at.any():
-                    cross = np.cross(J[rows[at], 0], J[rows[at], 1])
-                    nc[at] = self._orient[t] * cross / np.linalg.norm(cross, axis=1)[:, None]
-                if not at.all():
-                    nc[~at] = np.asarray(m.getNormal(t, par[rows[~at]].ravel())).reshape(-1, 3)
-                nc *= self.sign
+                nc = self.sign * np.asarray(m.getNormal(t, par[rows].ravel())).reshape(-1, 3)
                 n[rows] = nc
                 d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], nc)
             else:
