@@ -62,17 +62,17 @@ class _Kind:
     def __len__(self):
         return len(self.index)
 
-    def _keep(self, index, b0, b1, params, X, J, S, uv) -> bool:
-        """Keeps the face where the fitted parametrisation gives gmsh's X, J and S at its samples
-        uv to round-off (1e-12 of the tool's size, the derivatives of their own size)."""
+    def _keep(self, index, b0, b1, params, X, J, S, uv, model=None) -> bool:
+        """Keeps the face where the fitted parametrisation (`model`: X, J, S at uv; this kind's
+        derivatives unless given) gives gmsh's X, J and S at its samples uv to round-off (1e-12
+        of the tool's size, the derivatives of their own size)."""
         self._params.append(params)
         self.index.append(index)
         self.b0.append(np.asarray(b0, dtype=float))
         self.b1.append(np.asarray(b1, dtype=float))
         self.tol.append(1e-9 * (np.asarray(b1, dtype=float) - b0 + 1.0))
         self._stack()
-        j = np.full(len(uv), len(self) - 1)
-        Xf, Jf, Sf = self.derivatives(j, uv)
+        Xf, Jf, Sf = model if model is not None else self.derivatives(np.full(len(uv), len(self) - 1), uv)
         scale = max(np.abs(J).max(initial=0.0), np.abs(S).max(initial=0.0), 1.0)
         if _close(Xf, X, 1e-12 * self.size) and _close(Jf, J, 1e-12 * scale) and _close(Sf, S, 1e-12 * scale):
             return True
@@ -83,7 +83,8 @@ class _Kind:
 
     def _stack(self):
         self.lo, self.hi, self.eps = (np.array(v).reshape(-1, 2) for v in (self.b0, self.b1, self.tol))
-        self.p = {k: np.array([q[k] for q in self._params]) for k in (self._params[0] if self._params else ())}
+        self.p = {k: np.array([q[k] for q in self._params]) for k in (self._params[0] if self._params else ())
+                  if k not in ("theta", "v")}
 
 
 class Planes(_Kind):
@@ -228,3 +229,118 @@ class Revolutions(_Kind):
         J = np.stack([m[:, :1] * b, dm[:, :1] * w + dm[:, 1:] * P["a"]], axis=1)
         S = np.stack([-m[:, :1] * w, ddm[:, :1] * w + ddm[:, 1:] * P["a"], dm[:, :1] * b], axis=1)
         return X, J, S
+
+
+class CurveRevolutions(_Kind):
+    """Surfaces of revolution whose meridian is not a circle (OCC's surfaces of revolution of a
+    B-spline: a fillet's corner written to STEP, whose meridian approximates a circle), X(u, v)
+    = A + rho(v) w(u) + h(v) a as for Revolutions, the meridian (rho, h)(v) evaluated by gmsh:
+    `evaluate(j, uv)` gives X, J, S of face j at parameters uv.
+
+    Where rho >= 0 the nearest u is the arc's nearest angle to y's, whatever v (Revolutions);
+    along that meridian Newton minimises |X(u, v) - y|^2 over v, from the v of the nearest point
+    of the circle fitted to the meridian's samples (v interpolated in the samples' angles about
+    its centre). It stops where the step's square, times ten times the meridian's curvature,
+    lies below 1e-13 of the tool's size (quadratic convergence): the point is then within
+    round-off of the step's end. A pair whose Newton does not converge inside the face is not
+    inside (its distance inf): the face's nearest point lies on its boundary."""
+
+    def __init__(self, size: float, evaluate):
+        super().__init__(size)
+        self.evaluate = evaluate
+
+    def add(self, index, b0, b1, X, J, S, uv, middle, meridian) -> bool:
+        """middle: gmsh's (u, v), X, J, S at the face's middle (the axis and the radial frame,
+        as for Revolutions); meridian: gmsh's X, J, S at (u_m, v) for the samples' v. Kept where
+        the surface is the meridian turned about the axis by u at the samples, to round-off."""
+        (um, vm), Xm, Jm, Sm = middle
+        rho = float(np.linalg.norm(Sm[0]))
+        if not rho > 1e-9 * self.size:
+            return False
+        w, b = -Sm[0] / rho, Jm[0] / rho
+        a = np.cross(w, b)
+        if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
+            return False
+        A = Xm + Sm[0]
+        w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
+        frame = np.array([w0, b0_, a])
+        Xr, Jr, Sr = meridian
+        wa = np.array([w, a])
+        P, dP, ddP = (np.einsum("pi,ki->pk", V, wa) for V in (Xr - A, Jr[:, 1], Sr[:, 1]))  # (rho, h) and its v-derivatives
+        if np.min(P[:, 0]) < 0.0 or b1[0] - b0[0] > TWO_PI + 1e-12:
+            return False
+        cu, su = np.cos(uv[:, :1]), np.sin(uv[:, :1])
+        wu, bu = cu * w0 + su * b0_, -su * w0 + cu * b0_
+        model = (A + P[:, :1] * wu + P[:, 1:] * a,
+                 np.stack([P[:, :1] * bu, dP[:, :1] * wu + dP[:, 1:] * a], axis=1),
+                 np.stack([-P[:, :1] * wu, ddP[:, :1] * wu + ddP[:, 1:] * a, dP[:, :1] * bu], axis=1))
+        # the circle nearest the meridian's samples (|P - c|^2 = r^2: linear in c and r^2 - |c|^2)
+        sol = np.linalg.lstsq(np.c_[2.0 * P, np.ones(len(P))], np.einsum("pk,pk->p", P, P), rcond=None)[0]
+        c = sol[:2]
+        r = float(np.sqrt(sol[2] + c @ c))
+        if not np.abs(np.linalg.norm(P - c, axis=1) - r).max() <= 1e-3 * r:
+            return False
+        v, first = np.unique(uv[:, 1], return_index=True)
+        theta = np.arctan2(P[first, 1] - c[1], P[first, 0] - c[0])
+        mid = theta[len(theta) // 2]
+        theta = np.mod(theta - mid + np.pi, TWO_PI) - np.pi  # about the middle sample's angle
+        order = np.argsort(theta)
+        if np.any(np.diff(v[order]) * np.sign(v[order][-1] - v[order][0]) <= 0):  # v monotone in the angle
+            return False
+        params = {"A": A, "frame": frame, "c": c, "mid": mid, "theta": theta[order], "v": v[order]}
+        return self._keep(index, b0, b1, params, X, J, S, uv, model)
+
+    def _stack(self):
+        super()._stack()
+        self.samples = [(q["theta"], q["v"]) for q in self._params]  # per face, of their own lengths
+
+    def derivatives(self, j, uv):
+        X, J, S = np.zeros((len(j), 3)), np.zeros((len(j), 2, 3)), np.zeros((len(j), 3, 3))
+        for f in np.unique(j):
+            rows = np.flatnonzero(j == f)
+            X[rows], J[rows], S[rows] = self.evaluate(self.index[f], uv[rows])
+        return X, J, S
+
+    def nearest(self, y, j):
+        P = {k: v[j] for k, v in self.p.items()}
+        lo, hi, eps = self.lo[j], self.hi[j], self.eps[j]
+        q = np.einsum("pi,pki->pk", y - P["A"], P["frame"])
+        rho, phi = np.hypot(q[:, 0], q[:, 1]), np.arctan2(q[:, 1], q[:, 0])
+        u, on_turn = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
+        s = np.stack([rho * np.cos(u - phi), q[:, 2]], axis=1) - P["c"]  # y in the meridian's plane
+        theta = np.mod(np.arctan2(s[:, 1], s[:, 0]) - P["mid"] + np.pi, TWO_PI) - np.pi
+        uv = np.stack([u, np.zeros(len(j))], axis=1)
+        d, inside = np.full(len(j), np.inf), np.zeros(len(j), dtype=bool)
+        for f in np.unique(j):
+            rows = np.flatnonzero(j == f)
+            start = np.c_[u[rows], np.interp(theta[rows], *self.samples[f])]
+            d[rows], inside[rows] = self._newton(f, start, y[rows])
+            uv[rows] = start
+        uv[:, 1] = np.where(inside, uv[:, 1], np.clip(uv[:, 1], lo[:, 1], hi[:, 1]))
+        return uv, np.where(inside, d, np.inf), inside & on_turn
+
+    def _newton(self, f, uv, y, iterations=8):
+        """Newton along v (u fixed) on face f from uv (modified in place) towards y: the
+        distances at the end, and where it converged within the face's v bounds."""
+        ok = np.zeros(len(y), dtype=bool)
+        todo = np.arange(len(y))
+        d = np.full(len(y), np.inf)
+        for _ in range(iterations):
+            X, J, S = self.evaluate(self.index[f], uv[todo])
+            r = X - y[todo]
+            Xv, Xvv = J[:, 1], S[:, 1]
+            g = np.einsum("pi,pi->p", Xv, r)
+            A = np.einsum("pi,pi->p", Xv, Xv) + np.einsum("pi,pi->p", Xvv, r)
+            good = A > 0
+            step = np.where(good, -g / np.where(good, A, 1.0), 0.0)
+            uv[todo, 1] += step
+            move = Xv * step[:, None]
+            d[todo] = np.linalg.norm(r + move, axis=1)
+            kappa = np.linalg.norm(Xvv, axis=1) / np.einsum("pi,pi->p", Xv, Xv)
+            done = good & (10.0 * kappa * np.einsum("pi,pi->p", move, move) <= 1e-13 * self.size)
+            ok[todo[done]] = True
+            todo = todo[~done]
+            if todo.size == 0:
+                break
+        lo, hi, eps = self.lo[f, 1], self.hi[f, 1], self.eps[f, 1]
+        return d, ok & (uv[:, 1] >= lo - eps) & (uv[:, 1] <= hi + eps)

@@ -78,7 +78,7 @@ from pathlib import Path
 import numpy as np
 
 from shellform.contact.cad_files import probe
-from shellform.contact.faces import Cylinders, Planes, Revolutions
+from shellform.contact.faces import CurveRevolutions, Cylinders, Planes, Revolutions
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
@@ -233,7 +233,11 @@ class SurfaceTool:
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
         self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
-        self._kinds = [Planes(self.size), Cylinders(self.size), Revolutions(self.size)]  # filling their rectangle
+        # the faces evaluated in numpy that fill their rectangle: the first three in closed form,
+        # also on their boundary; the surfaces of revolution of a curve only inside
+        self._kinds = [Planes(self.size), Cylinders(self.size), Revolutions(self.size),
+                       CurveRevolutions(self.size, self._evaluate)]
+        self._covering = self._kinds[:3]
         self._trimmed_planes = Planes(self.size)
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
@@ -267,16 +271,18 @@ class SurfaceTool:
 
         self._tree = cKDTree(np.vstack(points))
         self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
+        self._index_of = {de: k for k, de in enumerate(self._ents)}
         self._exact_faces = np.zeros(len(self._ents), dtype=bool)  # evaluated in numpy
         covered = np.zeros(len(self._ents), dtype=bool)  # an exact face's, or an edge of a filled one
         for kind in self._kinds + [self._trimmed_planes]:
             self._exact_faces[kind.index] = True
-        for kind in self._kinds:
+        for kind in self._covering:
             covered[kind.index] = True
+        filled = covered.copy()
         covered |= self._exact_faces
         for k, (d, t) in enumerate(self._ents):
             if d == 1:
-                covered[k] = any(covered[self._ents.index((2, f))] and self._filled[f] for f in self._face_adjacent[t])
+                covered[k] = any(filled[self._index_of[(2, f)]] for f in self._face_adjacent[t])
         self._rest = np.flatnonzero(~covered)  # the entities the exact faces do not answer for
         self._kind_of, self._position = np.full(len(self._ents), -1), np.zeros(len(self._ents), dtype=int)
         for i, kind in enumerate(self._kinds + [self._trimmed_planes]):  # kind i's face, at its position
@@ -302,7 +308,16 @@ class SurfaceTool:
             mid = 0.5 * (b0 + b1)
             middle = [mid] + [np.asarray(g(2, f, mid)).reshape(shape) for g, shape in
                               ((m.getValue, 3), (m.getDerivative, (2, 3)), (m.getSecondDerivative, (3, 3)))]
-            self._kinds[2].add(k, b0, b1, xyz, J, S, uv, middle)
+            if not self._kinds[2].add(k, b0, b1, xyz, J, S, uv, middle) and kind == "Surface of Revolution":
+                meridian = self._evaluate(k, np.c_[np.full(len(uv), mid[0]), uv[:, 1]])
+                self._kinds[3].add(k, b0, b1, xyz, J, S, uv, middle, meridian)
+
+    def _evaluate(self, k, uv):
+        """gmsh's X, J (X_u, X_v) and S (X_uu, X_vv, X_uv) of face k (an index) at parameters uv
+        (the tool's model current)."""
+        m, f, flat = _gmsh().model, self._ents[k][1], np.ravel(uv)
+        return (np.asarray(m.getValue(2, f, flat)).reshape(-1, 3), np.asarray(m.getDerivative(2, f, flat)).reshape(-1, 2, 3),
+                np.asarray(m.getSecondDerivative(2, f, flat)).reshape(-1, 3, 3))
 
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
@@ -434,7 +449,7 @@ class SurfaceTool:
     def _exact_distances(self, y):
         """The faces evaluated in numpy that fill their parameter rectangle (their indices) and
         the points' distances to them (in closed form)."""
-        return self._face_distances(y, self._kinds)
+        return self._face_distances(y, self._covering)
 
     def _remembered_bounds(self, last, ref):
         """The lower bounds of the remembered points ref's distances to every entity (points,
@@ -446,7 +461,7 @@ class SurfaceTool:
         if miss.size:
             y = last.y[ref[miss]]
             sub = self._lower(y)
-            k, d = self._face_distances(y, self._kinds + [self._trimmed_planes])
+            k, d = self._face_distances(y, self._covering + [self._trimmed_planes])
             sub[:, k] = np.maximum(sub[:, k], d)
             bound[miss] = sub
         return bound
