@@ -84,6 +84,7 @@ from shellform.errors import InputError
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
 SAMPLES = 24  # points per parametric direction sampled on a face (per edge: along it) for the upper bounds
 BOUNDARY_SAMPLES = 400  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
+RASTER = 512  # at most as many cells along each parameter of a trimmed face's raster of its sides
 NORMALS = ("outward", "inward")
 
 
@@ -124,15 +125,22 @@ class _Projections:
     X_vv, X_uv)."""
 
     def __init__(self, y, c, dist, d, n, ent, par, bound, J, S, has):
-        from scipy.spatial import cKDTree
-
         self.y, self.c, self.dist, self.d, self.n, self.ent, self.par, self.bound = y, c, dist, d, n, ent, par, bound
         self.J, self.S, self.has = J, S, has
-        self.tree = cKDTree(y)
+        self.tree = None
 
     def nearest(self, y):
-        """The nearest remembered point of each of y (its index) and the distance to it (0
-        exactly where the point is given again)."""
+        """A remembered point near each of y (its index) and the distance to it: as many points
+        as remembered are taken row by row (the contact set's nodes again, moved or not); other
+        calls the nearest remembered point's (a k-d tree). 0 exactly where the point is given
+        again (in its row)."""
+        if len(y) == len(self.y):
+            r = y - self.y
+            return np.arange(len(y)), np.sqrt(np.einsum("pi,pi->p", r, r))
+        if self.tree is None:
+            from scipy.spatial import cKDTree
+
+            self.tree = cKDTree(self.y)
         delta, ref = self.tree.query(y)
         return ref, delta
 
@@ -742,22 +750,46 @@ class SurfaceTool:
             normals.append(np.where(into[:, None], normal, -normal))
             sag = np.linalg.norm(mid - 0.5 * (ends[:-1] + ends[1:]), axis=1)
             margin = max(margin, 0.5 * float(length.max()) + 2.0 * float(sag.max()))
-        trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size)
+        trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size, None)
         self._trims[f] = trim
         ins, sure = self._in_trim(f, uv)
-        return trim if bool(np.all(ins[sure] == inside[sure])) else None
+        if not bool(np.all(ins[sure] == inside[sure])):
+            return None
+        b0, b1 = (np.asarray(b, dtype=float) for b in m.getParametrizationBounds(2, f))
+        cells = np.minimum(np.ceil((b1 - b0) / trim[2]), RASTER).astype(int) + 1
+        cell = np.maximum((b1 - b0) / np.maximum(cells - 1, 1), 1e-9 * self.size)  # cell k centred at b0 + k cell
+        centres = np.stack(np.meshgrid(*(b0[a] + cell[a] * np.arange(cells[a]) for a in range(2)), indexing="ij"),
+                           axis=-1).reshape(-1, 2)
+        dist, i = trim[0].query(centres)
+        ins = np.einsum("pi,pi->p", centres - trim[0].data[i], trim[1][i]) > 0
+        sure = dist > trim[2] + 0.5 * float(np.linalg.norm(cell))  # no boundary within the cell
+        raster = (b0, cell, ins.reshape(cells), sure.reshape(cells))
+        self._trims[f] = trim[:3] + (raster,)
+        return self._trims[f]
 
     def _in_trim(self, f, uv):
         """(inside, sure) for parameters uv of trimmed face f: inside where uv lies on the inner
         side of its nearest boundary segment, sure where it lies farther from the sampled
-        boundary than the margin (_trim); isInside decides the others."""
+        boundary than the margin (_trim); isInside decides the others. Looked up first in a
+        raster of the face's parameter rectangle (cells of about the margin's size), whose
+        cells no boundary crosses (their centres farther than the margin and half the cell's
+        diagonal from it) hold their side."""
         trim = self._trims.get(f)
         if trim is None:
             return np.zeros(len(uv), dtype=bool), np.zeros(len(uv), dtype=bool)
-        tree, normals, margin = trim
-        dist, i = tree.query(uv)
-        inside = np.einsum("pi,pi->p", uv - tree.data[i], normals[i]) > 0
-        return inside, dist > margin
+        tree, normals, margin, raster = trim
+        inside, sure = np.zeros(len(uv), dtype=bool), np.zeros(len(uv), dtype=bool)
+        if raster is not None:
+            origin, cell, ins, known = raster
+            k = np.floor((uv - origin) / cell + 0.5).astype(int)
+            on = np.all((k >= 0) & (k < np.array(ins.shape)), axis=1)
+            inside[on], sure[on] = ins[k[on, 0], k[on, 1]], known[k[on, 0], k[on, 1]]
+        rest = np.flatnonzero(~sure)
+        if rest.size:
+            dist, i = tree.query(uv[rest])
+            inside[rest] = np.einsum("pi,pi->p", uv[rest] - tree.data[i], normals[i]) > 0
+            sure[rest] = dist > margin
+        return inside, sure
 
     def _signed(self, gmsh, y, c, dist, ent, par, J, has):
         """Signed distances and normals (module docstring); on a face the normal X_u x X_v
@@ -847,17 +879,32 @@ class SurfaceTool:
 
     @staticmethod
     def _hessian(J, S, n, d):
-        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv)."""
-        B = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
-        B = np.stack([np.stack([B[:, 0], B[:, 2]], 1), np.stack([B[:, 2], B[:, 1]], 1)], 1)
-        G = np.einsum("pai,pbi->pab", J, J)
-        det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] * G[:, 1, 0]
-        regular = det > 1e-12 * (G[:, 0, 0] + G[:, 1, 1]) ** 2
-        Gi = np.stack([np.stack([G[:, 1, 1], -G[:, 0, 1]], 1), np.stack([-G[:, 1, 0], G[:, 0, 0]], 1)], 1) \
-            / np.where(regular, det, 1.0)[:, None, None]
+        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv). With A =
+        G^-1 J (the dual basis; A J^T = I) it is J^T W J, W = G^-1 B (G + d B)^-1 (2 x 2,
+        symmetric): H0 (I + d H0)^-1 = A^T B (I + d A A^T B)^-1 A and A A^T = G^-1. Where G is
+        singular (a pole) H0 from G's pseudo-inverse."""
+        b = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
+        g = np.stack([np.einsum("pi,pi->p", J[:, 0], J[:, 0]), np.einsum("pi,pi->p", J[:, 1], J[:, 1]),
+                      np.einsum("pi,pi->p", J[:, 0], J[:, 1])], axis=1)
+        det = g[:, 0] * g[:, 1] - g[:, 2] ** 2
+        regular = det > 1e-12 * (g[:, 0] + g[:, 1]) ** 2
+        k = g + d[:, None] * b  # G + d B
+        # B adj(K) / det(K), then adj(G) / det(G) times it
+        dk = k[:, 0] * k[:, 1] - k[:, 2] ** 2
+        m00, m01 = b[:, 0] * k[:, 1] - b[:, 2] * k[:, 2], b[:, 2] * k[:, 0] - b[:, 0] * k[:, 2]
+        m10, m11 = b[:, 2] * k[:, 1] - b[:, 1] * k[:, 2], b[:, 1] * k[:, 0] - b[:, 2] * k[:, 2]
+        scale = 1.0 / (np.where(regular, det, 1.0) * dk)
+        w00 = (g[:, 1] * m00 - g[:, 2] * m10) * scale
+        w11 = (g[:, 0] * m11 - g[:, 2] * m01) * scale
+        w01 = 0.5 * ((g[:, 1] * m01 - g[:, 2] * m11) + (g[:, 0] * m10 - g[:, 2] * m00)) * scale
+        W = np.stack([np.stack([w00, w01], 1), np.stack([w01, w11], 1)], 1)
+        H = np.matmul(J.transpose(0, 2, 1), np.matmul(W, J))
         if not regular.all():  # a singular parametrisation (a pole): the pseudo-inverse
-            Gi[~regular] = np.linalg.pinv(G[~regular])
-        A = np.einsum("pai,pab->pbi", J, Gi)  # G^-1 J^T as (p, 2, 3): rows the dual basis
-        H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
-        H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
-        return H0 @ np.linalg.inv(np.eye(3) + d[:, None, None] * H0)
+            i = ~regular
+            G = np.stack([np.stack([g[i, 0], g[i, 2]], 1), np.stack([g[i, 2], g[i, 1]], 1)], 1)
+            B = np.stack([np.stack([b[i, 0], b[i, 2]], 1), np.stack([b[i, 2], b[i, 1]], 1)], 1)
+            A = np.einsum("pai,pab->pbi", J[i], np.linalg.pinv(G))
+            H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
+            H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
+            H[i] = H0 @ np.linalg.inv(np.eye(3) + d[i, None, None] * H0)
+        return H
