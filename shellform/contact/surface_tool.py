@@ -83,8 +83,9 @@ from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
 SAMPLES = 24  # points per parametric direction sampled on a face (per edge: along it) for the upper bounds
-BOUNDARY_SAMPLES = 400  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
-RASTER = 512  # at most as many cells along each parameter of a trimmed face's raster of its sides
+BOUNDARY_SAMPLES = 4000  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
+SIDE_TESTS = 9  # segments of an edge of a trimmed face at which the face's side is asked
+RASTER = 256  # at most as many cells along each parameter of a trimmed face's raster of its sides
 NORMALS = ("outward", "inward")
 
 
@@ -718,15 +719,18 @@ class SurfaceTool:
 
     def _trim(self, m, f, uv, inside):
         """A trimmed face's boundary in its parameters: its edges sampled every 1/BOUNDARY_SAMPLES
-        of the tool's size (at least 16 points an edge) as segments; their midpoints in a k-d
-        tree with each segment's normal pointing into the face (isInside at the points half a
-        segment to either side of the midpoint); the margin within which the sampled boundary
-        may differ from the true one (half the longest segment plus twice the largest deviation
-        of an edge's mid-parameter point from its segment). None where the sides are not told apart or where that
-        classifies the sampled parameters `uv` other than isInside does."""
+        of the tool's size (at least 16 points an edge, at most 4096) as segments; their
+        midpoints in a k-d tree with each segment's normal pointing into the face (the face lies
+        on one side of an edge all along it: that side found by isInside at SIDE_TESTS segments
+        spread along the edge, at the points 1/800 of the tool's size to either side of their
+        midpoints, and asked the same at all of them); the margin within which the sampled
+        boundary may differ from the true one (half the longest segment plus twice the largest
+        deviation of an edge's mid-parameter point from its segment). None where the sides are
+        not told apart or where that classifies the sampled parameters `uv` other than isInside
+        does."""
         from scipy.spatial import cKDTree
 
-        mids, normals, margin = [], [], 0.0
+        mids, normals, margin, ends_all = [], [], 0.0, []
         for e in m.getAdjacencies(2, f)[1]:
             e = abs(int(e))
             x0, y0, z0, x1, y1, z1 = m.getBoundingBox(1, e)
@@ -741,31 +745,51 @@ class SurfaceTool:
             keep = length > 0
             normal = np.c_[-chord[:, 1], chord[:, 0]][keep] / length[keep, None]
             centre = 0.5 * (ends[:-1] + ends[1:])[keep]
-            step = 0.5 * length[keep, None] * normal  # OCC's classifier takes points within its tolerance as inside
-            into = np.array([m.isInside(2, f, q, True) > 0 for q in centre + step])
-            out = np.array([m.isInside(2, f, q, True) > 0 for q in centre - step])
-            if np.any(into == out):  # the boundary's sides not told apart
+            # the side, at points clear of OCC's classifier's tolerance (it takes those within as inside)
+            test = np.unique(np.linspace(0, len(centre) - 1, SIDE_TESTS).round().astype(int))
+            step = 0.5 * self.size / 400 * normal[test]
+            into = np.array([m.isInside(2, f, q, True) > 0 for q in centre[test] + step])
+            out = np.array([m.isInside(2, f, q, True) > 0 for q in centre[test] - step])
+            if np.any(into == out) or np.any(into != into[0]):  # the boundary's sides not told apart
                 return None
             mids.append(centre)
-            normals.append(np.where(into[:, None], normal, -normal))
+            normals.append(normal if into[0] else -normal)
+            ends_all.append(ends)
             sag = np.linalg.norm(mid - 0.5 * (ends[:-1] + ends[1:]), axis=1)
             margin = max(margin, 0.5 * float(length.max()) + 2.0 * float(sag.max()))
         trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size, None)
         self._trims[f] = trim
+        self._trims[f] = trim[:3] + (self._raster(m, f, trim, np.vstack(ends_all)),)
         ins, sure = self._in_trim(f, uv)
-        if not bool(np.all(ins[sure] == inside[sure])):
-            return None
+        return self._trims[f] if bool(np.all(ins[sure] == inside[sure])) else None
+
+    def _raster(self, m, f, trim, boundary):
+        """The sides of trimmed face f in a raster of its parameter rectangle (at most RASTER
+        cells along each parameter, of about the margin's size): (origin, cell, inside, sure),
+        cell k centred at origin + k cell. A cell is sure where no sampled boundary point lies
+        within the margin and half the cell's diagonal of its centre: no boundary crosses it.
+        Sure cells that touch hold one side; each such region's is its first cell's (by the
+        nearest boundary segment). None where the face's sampled boundary leaves its parameter
+        rectangle (outside the rectangle a point is outside the face: the face lies within its
+        boundary's hull)."""
+        from scipy.ndimage import label
+
+        tree, normals, margin, _ = trim
         b0, b1 = (np.asarray(b, dtype=float) for b in m.getParametrizationBounds(2, f))
-        cells = np.minimum(np.ceil((b1 - b0) / trim[2]), RASTER).astype(int) + 1
-        cell = np.maximum((b1 - b0) / np.maximum(cells - 1, 1), 1e-9 * self.size)  # cell k centred at b0 + k cell
+        tol = 1e-9 * (b1 - b0 + 1.0)
+        if np.any(boundary < b0 - tol) or np.any(boundary > b1 + tol):
+            return None
+        cells = np.minimum(np.ceil((b1 - b0) / margin), RASTER).astype(int) + 1
+        cell = np.maximum((b1 - b0) / np.maximum(cells - 1, 1), 1e-9 * self.size)
         centres = np.stack(np.meshgrid(*(b0[a] + cell[a] * np.arange(cells[a]) for a in range(2)), indexing="ij"),
                            axis=-1).reshape(-1, 2)
-        dist, i = trim[0].query(centres)
-        ins = np.einsum("pi,pi->p", centres - trim[0].data[i], trim[1][i]) > 0
-        sure = dist > trim[2] + 0.5 * float(np.linalg.norm(cell))  # no boundary within the cell
-        raster = (b0, cell, ins.reshape(cells), sure.reshape(cells))
-        self._trims[f] = trim[:3] + (raster,)
-        return self._trims[f]
+        dist, _ = tree.query(centres, distance_upper_bound=margin + 0.5 * float(np.linalg.norm(cell)))
+        sure = np.isinf(dist).reshape(cells)
+        regions, count = label(sure)
+        first = np.unique(regions.ravel(), return_index=True)[1][1:]  # each region's first cell
+        _, i = tree.query(centres[first])
+        side = np.einsum("pi,pi->p", centres[first] - tree.data[i], normals[i]) > 0
+        return b0, cell, np.r_[False, side][regions], sure
 
     def _in_trim(self, f, uv):
         """(inside, sure) for parameters uv of trimmed face f: inside where uv lies on the inner
@@ -784,6 +808,7 @@ class SurfaceTool:
             k = np.floor((uv - origin) / cell + 0.5).astype(int)
             on = np.all((k >= 0) & (k < np.array(ins.shape)), axis=1)
             inside[on], sure[on] = ins[k[on, 0], k[on, 1]], known[k[on, 0], k[on, 1]]
+            sure[~on] = True  # outside the parameter rectangle: outside the face
         rest = np.flatnonzero(~sure)
         if rest.size:
             dist, i = tree.query(uv[rest])
