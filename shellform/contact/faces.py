@@ -25,6 +25,7 @@ projection must be checked against its trim by the tool).
 import numpy as np
 
 TWO_PI = 2.0 * np.pi
+MERIDIAN_SAMPLES = 1024  # points of a curve meridian whose angles about its fitted circle start Newton
 
 
 def _interval(p, lo, hi, tol):
@@ -239,11 +240,14 @@ class CurveRevolutions(_Kind):
 
     Where rho >= 0 the nearest u is the arc's nearest angle to y's, whatever v (Revolutions);
     along that meridian Newton minimises |X(u, v) - y|^2 over v, from the v of the nearest point
-    of the circle fitted to the meridian's samples (v interpolated in the samples' angles about
-    its centre). It stops where the step's square, times ten times the meridian's curvature,
-    lies below 1e-13 of the tool's size (quadratic convergence): the point is then within
-    round-off of the step's end. A pair whose Newton does not converge inside the face is not
-    inside (its distance inf): the face's nearest point lies on its boundary."""
+    of the circle fitted to the meridian (v interpolated in the angles about its centre of
+    MERIDIAN_SAMPLES points of the meridian; none where that angle lies beyond the meridian's
+    ends by more than ten times the meridian's largest departure from the circle in angle:
+    the face's nearest point lies on its boundary), until a step moves the point by less than 1e-13
+    of the tool's size (the point: the last evaluation plus that step; J and S the last
+    evaluation's). A pair whose Newton does not converge inside the face is not inside (its
+    distance inf): the face's nearest point lies on its boundary. `nearest` also returns the
+    pairs' X, J and S (gmsh's evaluations, which `derivatives` would repeat)."""
 
     def __init__(self, size: float, evaluate):
         super().__init__(size)
@@ -252,7 +256,8 @@ class CurveRevolutions(_Kind):
     def add(self, index, b0, b1, X, J, S, uv, middle, meridian) -> bool:
         """middle: gmsh's (u, v), X, J, S at the face's middle (the axis and the radial frame,
         as for Revolutions); meridian: gmsh's X, J, S at (u_m, v) for the samples' v. Kept where
-        the surface is the meridian turned about the axis by u at the samples, to round-off."""
+        the surface is the meridian turned about the axis by u at the samples, to round-off.
+        The start's table from the meridian at MERIDIAN_SAMPLES values of v (evaluate)."""
         (um, vm), Xm, Jm, Sm = middle
         rho = float(np.linalg.norm(Sm[0]))
         if not rho > 1e-9 * self.size:
@@ -280,14 +285,21 @@ class CurveRevolutions(_Kind):
         r = float(np.sqrt(sol[2] + c @ c))
         if not np.abs(np.linalg.norm(P - c, axis=1) - r).max() <= 1e-3 * r:
             return False
-        v, first = np.unique(uv[:, 1], return_index=True)
-        theta = np.arctan2(P[first, 1] - c[1], P[first, 0] - c[0])
+        v = np.linspace(b0[1], b1[1], MERIDIAN_SAMPLES)
+        Xq, Jq, _ = self.evaluate(index, np.c_[np.full(len(v), um), v])
+        Q, dQ = np.einsum("pi,ki->pk", Xq - A, wa), np.einsum("pi,ki->pk", Jq[:, 1], wa)
+        theta = np.arctan2(Q[:, 1] - c[1], Q[:, 0] - c[0])
+        # how far the angle about c of a point's foot may lie from its own: the meridian's
+        # distance from the circle over r and the angle between its tangent and the circle's
+        radial = (Q - c) / np.linalg.norm(Q - c, axis=1)[:, None]
+        slope = np.abs(np.einsum("pk,pk->p", dQ, radial)) / np.linalg.norm(dQ, axis=1)
+        slack = 10.0 * (np.abs(np.linalg.norm(Q - c, axis=1) - r).max() / r + slope.max()) + 1e-9
         mid = theta[len(theta) // 2]
         theta = np.mod(theta - mid + np.pi, TWO_PI) - np.pi  # about the middle sample's angle
         order = np.argsort(theta)
         if np.any(np.diff(v[order]) * np.sign(v[order][-1] - v[order][0]) <= 0):  # v monotone in the angle
             return False
-        params = {"A": A, "frame": frame, "c": c, "mid": mid, "theta": theta[order], "v": v[order]}
+        params = {"A": A, "frame": frame, "c": c, "mid": mid, "slack": slack, "theta": theta[order], "v": v[order]}
         return self._keep(index, b0, b1, params, X, J, S, uv, model)
 
     def _stack(self):
@@ -310,21 +322,28 @@ class CurveRevolutions(_Kind):
         s = np.stack([rho * np.cos(u - phi), q[:, 2]], axis=1) - P["c"]  # y in the meridian's plane
         theta = np.mod(np.arctan2(s[:, 1], s[:, 0]) - P["mid"] + np.pi, TWO_PI) - np.pi
         uv = np.stack([u, np.zeros(len(j))], axis=1)
-        d, inside = np.full(len(j), np.inf), np.zeros(len(j), dtype=bool)
+        inside = np.zeros(len(j), dtype=bool)
+        X, J, S = np.zeros((len(j), 3)), np.zeros((len(j), 2, 3)), np.zeros((len(j), 3, 3))
         for f in np.unique(j):
+            angles, v = self.samples[f]
             rows = np.flatnonzero(j == f)
-            start = np.c_[u[rows], np.interp(theta[rows], *self.samples[f])]
-            d[rows], inside[rows] = self._newton(f, start, y[rows])
+            # a foot beyond the meridian's ends (more than the slack): the face's nearest point on its boundary
+            rows = rows[(theta[rows] >= angles[0] - P["slack"][rows]) & (theta[rows] <= angles[-1] + P["slack"][rows])]
+            start = np.c_[u[rows], np.interp(theta[rows], angles, v)]
+            X[rows], J[rows], S[rows], inside[rows] = self._newton(f, start, y[rows])
             uv[rows] = start
         uv[:, 1] = np.where(inside, uv[:, 1], np.clip(uv[:, 1], lo[:, 1], hi[:, 1]))
-        return uv, np.where(inside, d, np.inf), inside & on_turn
+        r = X - y
+        d = np.where(inside, np.sqrt(np.einsum("pi,pi->p", r, r)), np.inf)
+        return uv, d, inside & on_turn, (X, J, S)
 
     def _newton(self, f, uv, y, iterations=8):
-        """Newton along v (u fixed) on face f from uv (modified in place) towards y: the
-        distances at the end, and where it converged within the face's v bounds."""
-        ok = np.zeros(len(y), dtype=bool)
-        todo = np.arange(len(y))
-        d = np.full(len(y), np.inf)
+        """Newton along v (u fixed) on face f from uv (modified in place) towards y: the points
+        X (the last evaluation plus its step), the last evaluation's J and S, and where it
+        converged within the face's v bounds."""
+        n = len(y)
+        ok, todo = np.zeros(n, dtype=bool), np.arange(n)
+        Xo, Jo, So = np.zeros((n, 3)), np.zeros((n, 2, 3)), np.zeros((n, 3, 3))
         for _ in range(iterations):
             X, J, S = self.evaluate(self.index[f], uv[todo])
             r = X - y[todo]
@@ -335,12 +354,11 @@ class CurveRevolutions(_Kind):
             step = np.where(good, -g / np.where(good, A, 1.0), 0.0)
             uv[todo, 1] += step
             move = Xv * step[:, None]
-            d[todo] = np.linalg.norm(r + move, axis=1)
-            kappa = np.linalg.norm(Xvv, axis=1) / np.einsum("pi,pi->p", Xv, Xv)
-            done = good & (10.0 * kappa * np.einsum("pi,pi->p", move, move) <= 1e-13 * self.size)
+            Xo[todo], Jo[todo], So[todo] = X + move, J, S
+            done = good & (np.einsum("pi,pi->p", move, move) < (1e-13 * self.size) ** 2)
             ok[todo[done]] = True
             todo = todo[~done]
             if todo.size == 0:
                 break
         lo, hi, eps = self.lo[f, 1], self.hi[f, 1], self.eps[f, 1]
-        return d, ok & (uv[:, 1] >= lo - eps) & (uv[:, 1] <= hi + eps)
+        return Xo, Jo, So, ok & (uv[:, 1] >= lo - eps) & (uv[:, 1] <= hi + eps)

@@ -409,11 +409,15 @@ class SurfaceTool:
         kind_of = self._kind_of[k]
         D, U = np.full((npts, nent), np.inf), np.zeros((npts, nent, 2))
         inside = np.zeros((npts, nent), dtype=bool)
+        evaluated = []  # a kind's pairs whose X, J, S its nearest gave
         for i, kind in enumerate(self._kinds):
             sel = np.flatnonzero(kind_of == i)
             if sel.size:
                 p, e = pi[sel], k[sel]
-                U[p, e], D[p, e], inside[p, e] = kind.nearest(y[p], self._position[e])
+                out = kind.nearest(y[p], self._position[e])
+                U[p, e], D[p, e], inside[p, e] = out[:3]
+                if len(out) > 3:
+                    evaluated.append((i, p, e, out[3]))
         sel = np.flatnonzero(kind_of == len(self._kinds))  # the trimmed planes
         if sel.size:
             p, e = pi[sel], k[sel]
@@ -434,9 +438,12 @@ class SurfaceTool:
         if self._rest.size:
             found &= self._lower(y, self._rest).min(axis=1) > dist * (1 + 1e-9) + 1e-9 * self.size
         c, J, S = np.zeros((npts, 3)), np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3))
+        for i, p, e, (Xe, Je, Se) in evaluated:
+            w = found[p] & (best[p] == e)
+            c[p[w]], J[p[w]], S[p[w]] = Xe[w], Je[w], Se[w]
         for i, kind in enumerate(self._kinds + [self._trimmed_planes]):
             rows = np.flatnonzero(found & (self._kind_of[best] == i))
-            if rows.size:
+            if rows.size and i not in [v[0] for v in evaluated]:
                 c[rows], J[rows], S[rows] = kind.derivatives(self._position[best[rows]], par[rows])
         cross = np.cross(J[:, 0], J[:, 1])
         found &= np.einsum("pi,pi->p", cross, cross) > 1e-24 * np.einsum("pai,pai->p", J, J) ** 2  # not a pole
