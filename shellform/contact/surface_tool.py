@@ -79,6 +79,7 @@ import numpy as np
 
 from shellform.contact.cad_files import probe
 from shellform.contact.faces import CurveRevolutions, Cylinders, Planes, Revolutions
+from shellform.contact.faces import cross as faces_cross
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
@@ -118,6 +119,11 @@ class _Current:
             gmsh.model.setCurrent(self.previous)
 
 
+def _keys(y):
+    """Each point's coordinates as one opaque key (its bytes: equal exactly where the point is)."""
+    return np.ascontiguousarray(y).view(np.dtype((np.void, y.dtype.itemsize * 3))).ravel()
+
+
 class _Projections:
     """Points y (in a tool's model frame) with their closest points c, distances dist, signed
     distances d, normals n, entities (indices into the tool's entities) and parameters, lower
@@ -128,21 +134,32 @@ class _Projections:
     def __init__(self, y, c, dist, d, n, ent, par, bound, J, S, has):
         self.y, self.c, self.dist, self.d, self.n, self.ent, self.par, self.bound = y, c, dist, d, n, ent, par, bound
         self.J, self.S, self.has = J, S, has
-        self.tree = None
+        self.tree = self.order = None
+
 
     def nearest(self, y):
         """A remembered point near each of y (its index) and the distance to it: as many points
-        as remembered are taken row by row (the contact set's nodes again, moved or not); other
-        calls the nearest remembered point's (a k-d tree). 0 exactly where the point is given
-        again (in its row)."""
+        as remembered are taken row by row (the contact set's nodes again, moved or not); in
+        other calls a point given again is found by its coordinates' bytes (sorted), the others
+        take the nearest remembered point (a k-d tree). 0 exactly where the point is given
+        again."""
         if len(y) == len(self.y):
             r = y - self.y
             return np.arange(len(y)), np.sqrt(np.einsum("pi,pi->p", r, r))
-        if self.tree is None:
-            from scipy.spatial import cKDTree
+        if self.order is None:
+            self.keys = _keys(self.y)
+            self.order = np.argsort(self.keys)
+        keys = _keys(y)
+        at = np.minimum(np.searchsorted(self.keys, keys, sorter=self.order), len(self.y) - 1)
+        ref = self.order[at]
+        delta = np.where(self.keys[ref] == keys, 0.0, np.inf)
+        moved = np.flatnonzero(delta > 0.0)
+        if moved.size:
+            if self.tree is None:
+                from scipy.spatial import cKDTree
 
-            self.tree = cKDTree(self.y)
-        delta, ref = self.tree.query(y)
+                self.tree = cKDTree(self.y)
+            delta[moved], ref[moved] = self.tree.query(y[moved])
         return ref, delta
 
 
@@ -445,7 +462,7 @@ class SurfaceTool:
             rows = np.flatnonzero(found & (self._kind_of[best] == i))
             if rows.size and i not in [v[0] for v in evaluated]:
                 c[rows], J[rows], S[rows] = kind.derivatives(self._position[best[rows]], par[rows])
-        cross = np.cross(J[:, 0], J[:, 1])
+        cross = faces_cross(J[:, 0], J[:, 1])
         found &= np.einsum("pi,pi->p", cross, cross) > 1e-24 * np.einsum("pai,pai->p", J, J) ** 2  # not a pole
         r = y - c
         dist = np.where(found, np.sqrt(np.einsum("pi,pi->p", r, r)), dist)
@@ -485,9 +502,13 @@ class SurfaceTool:
     def _lower(self, y, entities=slice(None)):
         """The distance of points y to the entities' bounding boxes (points, entities; every
         entity unless given): a lower bound of their distance to the entity."""
-        box = self._box[entities]
-        out = np.maximum(np.maximum(box[None, :, 0] - y[:, None], y[:, None] - box[None, :, 1]), 0.0)
-        return np.sqrt(np.einsum("pei,pei->pe", out, out))
+        lo, hi = self._box[entities, 0], self._box[entities, 1]
+        square = 0.0
+        for a in range(3):
+            t = np.maximum(lo[:, a] - y[:, a, None], y[:, a, None] - hi[:, a])
+            np.maximum(t, 0.0, out=t)
+            square = square + t * t
+        return np.sqrt(square)
 
     def _search(self, m, y):
         """Closest points: first the local projection from the nearest sample (_local), where
@@ -832,10 +853,10 @@ class SurfaceTool:
         d = dist.copy()
         rows = np.flatnonzero(has)
         if rows.size:
-            cross = np.cross(J[rows, 0], J[rows, 1])
+            cross = faces_cross(J[rows, 0], J[rows, 1])
             n[rows] = (self.sign * self._orientation[ent[rows]] / np.linalg.norm(cross, axis=1))[:, None] * cross
             d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], n[rows])
-        for k in np.unique(ent[~has]):
+        for k in np.unique(ent[~has]) if not has.all() else ():
             dim, t = self._ents[k]
             rows = np.flatnonzero((ent == k) & ~has)
             if dim == 2:
