@@ -364,12 +364,18 @@ class SurfaceTool:
         shift = self.translation + np.array([0.0, 0.0, dz])
         y = x - shift  # in the model's frame
         npts = len(y)
+        last = self._last if npts else None
+        if last is not None:
+            ref, delta = last.nearest(y)
+            if not delta.any():  # every point given again: the remembered points stay
+                self.counts["repeated"] += npts
+                return (last.c[ref] + shift, last.d[ref], last.n[ref], last.ent[ref], last.par[ref], last.J[ref],
+                        last.S[ref], last.has[ref])
         c, dist, ent, par = np.zeros_like(y), np.full(npts, np.inf), np.full(npts, -1), np.zeros((npts, 2))
         d, n, bound = np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, len(self._ents)))
         J, S, has = np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3)), np.zeros(npts, dtype=bool)
-        last, todo = self._last if npts else None, np.ones(npts, dtype=bool)
+        todo = np.ones(npts, dtype=bool)
         if last is not None:
-            ref, delta = last.nearest(y)
             same = np.flatnonzero(delta == 0.0)
             r = ref[same]
             c[same], dist[same], ent[same], par[same] = last.c[r], last.dist[r], last.ent[r], last.par[r]
@@ -377,8 +383,6 @@ class SurfaceTool:
             J[same], S[same], has[same] = last.J[r], last.S[r], last.has[r]
             todo[same] = False
             self.counts["repeated"] += same.size
-            if same.size == npts:  # every point given again: the remembered points stay
-                return c + shift, d, n, ent, par, J, S, has
         with _Current(self.model) as gmsh:
             m = gmsh.model
             new = np.flatnonzero(todo)
