@@ -8,8 +8,22 @@ what the analytic tools give (tools.py): for points x,
                           unit normal pointing from the tool towards the point;
     shape(x, offset, dz)  H = dn/dx (n, 3, 3), the Hessian of the signed distance.
 
-The surface is evaluated, not meshed (docs/tools.md). For a point x the closest surface point
-c is found in two steps:
+The surface is evaluated, not meshed (docs/tools.md). Most faces of a tool are elementary
+surfaces that numpy evaluates from their parameters (faces.py: planes, cylinders, surfaces of
+revolution of a circle or of a curve), fitted from gmsh's evaluations and verified against them
+when the tool is built. For a point x the closest surface point c is found
+
+    exact       on those faces, all at once: each one's nearest point whose bounding box lies
+                within an upper bound of the distance (the last answer of the point's
+                remembered neighbour plus the distance to it; a sample's), in closed form (a
+                curve meridian: its turn in closed form, Newton along it), a trimmed plane's
+                foot point where its trim holds it (a raster of its sides, the sampled boundary
+                near it, isInside within the sampling's margin). The nearest of these is the
+                closest point where it lies inside its face (not on an edge) and no entity they
+                do not answer for (a face of another kind, an edge no filled one bounds) lies
+                nearer by its bounding box;
+
+and where not, in two steps with gmsh:
 
     local       Newton on the face of the nearest of points sampled on every face and edge (a
                 k-d tree; both faces of a sample on an edge), from the sample's parameters; a
@@ -24,22 +38,25 @@ c is found in two steps:
                 to its range (the nearest point of a face whose projection falls outside it
                 lies on its boundary).
 
-A second, non-global minimum of the distance inside one face is not found.
+A second, non-global minimum of the distance inside one face is not found by the gmsh steps
+(the closed forms are global on their face).
 
 Every point also gets lower bounds of its distance to every face and edge (the bounding
-boxes', raised by the projections computed on the way). The tool remembers its last call's
-points with their closest points, the face's derivatives there and these bounds
-(_Projections). A point given again takes its last answer (shape on the points of the last
-gap call: H from the derivatives Newton ended with); a point at distance delta from the
-nearest remembered one whose closest point lay on a face
+boxes', raised by the projections computed on the way, the closed forms' distances). The tool
+remembers its last call's points with their closest points, the face's derivatives there and
+these bounds (_Projections; the bounds of points the exact pass answered computed where asked).
+A point given again takes its last answer (shape on the points of the last gap call: H from
+the derivatives its face gave); a point the exact pass leaves, at distance delta from the
+nearest remembered one whose closest point lay on a face,
 
     warm        Newton on that face from the remembered (u, v); a point it finds inside the
                 face is sure where every other entity's bound less delta (the distance is
-                1-Lipschitz) lies farther (a plane or a cylinder that fills its parameter
-                rectangle: its exact distance); where not, the candidates are the entities whose
-                bounds allow them nearer, the face's point the seed.
+                1-Lipschitz) lies farther (a face in closed form: its exact distance); where
+                not, the candidates are the entities whose bounds allow them nearer, the face's
+                point the seed.
 
-The other points are searched as above.
+The other points are searched as above. `counts` counts the points answered each way
+(repeated, exact, warm, searched).
 
 Signed distance and normal. The faces' normals (getNormal, oriented by OCC's face orientation:
 outward for the faces of a solid) point to the side of the sheet; ``normals = "inward"`` turns
