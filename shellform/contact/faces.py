@@ -92,6 +92,16 @@ class _Kind:
         self.lo, self.hi, self.eps = (np.array(v).reshape(-1, 2) for v in (self.b0, self.b1, self.tol))
         self.p = {k: np.array([q[k] for q in self._params]) for k in (self._params[0] if self._params else ())
                   if k not in ("theta", "v")}
+        self.p.update(lo=self.lo, hi=self.hi, eps=self.eps)
+        # every face's parameters in one row, gathered for pairs by one index (_gather)
+        self._packed = np.hstack([v.reshape(len(self.lo), -1) for v in self.p.values()]) if self._params else None
+        ends = np.cumsum([0] + [int(np.prod(v.shape[1:])) for v in self.p.values()])
+        self._slices = [(k, slice(a, b), v.shape[1:]) for (k, v), a, b in zip(self.p.items(), ends[:-1], ends[1:])]
+
+    def _gather(self, j):
+        """The parameters of faces j (one per pair): name -> array (pairs, ...)."""
+        rows = self._packed[j]
+        return {k: rows[:, cut].reshape((len(j),) + shape) for k, cut, shape in self._slices}
 
 
 class Planes(_Kind):
@@ -108,14 +118,16 @@ class Planes(_Kind):
         return self._keep(index, b0, b1, {"O": O, "E": E}, X, J, S, uv)
 
     def nearest(self, y, j):
-        O, E = self.p["O"][j], self.p["E"][j]
+        P = self._gather(j)
+        O, E = P["O"], P["E"]
         foot = np.einsum("pi,pai->pa", y - O, E)
-        uv, inside = _interval(foot, self.lo[j], self.hi[j], self.eps[j])
+        uv, inside = _interval(foot, P["lo"], P["hi"], P["eps"])
         r = y - O - np.einsum("pa,pai->pi", uv, E)
         return uv, np.sqrt(np.einsum("pi,pi->p", r, r)), inside.all(axis=1)
 
     def derivatives(self, j, uv):
-        O, E = self.p["O"][j], self.p["E"][j]
+        P = self._gather(j)
+        O, E = P["O"], P["E"]
         return O + np.einsum("pa,pai->pi", uv, E), E.copy(), np.zeros((len(j), 3, 3))
 
 
@@ -136,7 +148,8 @@ class Cylinders(_Kind):
         return self._keep(index, b0, b1, {"O": X0 - R * E[0], "E": E, "R": R}, X, J, S, uv)
 
     def nearest(self, y, j):
-        O, E, R, lo, hi, eps = self.p["O"][j], self.p["E"][j], self.p["R"][j], self.lo[j], self.hi[j], self.eps[j]
+        P = self._gather(j)
+        O, E, R, lo, hi, eps = P["O"], P["E"], P["R"], P["lo"], P["hi"], P["eps"]
         q = np.einsum("pi,pai->pa", y - O, E)  # y in the cylinder's frame
         phi = np.arctan2(q[:, 1], q[:, 0])
         u, on_arc = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
@@ -147,7 +160,8 @@ class Cylinders(_Kind):
         return np.stack([u, v], axis=1), d, on_arc & on_line
 
     def derivatives(self, j, uv):
-        O, E, R = self.p["O"][j], self.p["E"][j], self.p["R"][j][:, None]
+        P = self._gather(j)
+        O, E, R = P["O"], P["E"], P["R"][:, None]
         c, s = np.cos(uv[:, :1]), np.sin(uv[:, :1])
         radial = c * E[:, 0] + s * E[:, 1]
         X = O + R * radial + uv[:, 1:] * E[:, 2]
@@ -209,8 +223,8 @@ class Revolutions(_Kind):
         return self._keep(index, b0, b1, params, X, J, S, uv)
 
     def nearest(self, y, j):
-        P = {k: v[j] for k, v in self.p.items()}
-        lo, hi, eps = self.lo[j], self.hi[j], self.eps[j]
+        P = self._gather(j)
+        lo, hi, eps = P["lo"], P["hi"], P["eps"]
         q = np.einsum("pi,pki->pk", y - P["A"], P["frame"])  # y along w_0, b_0 and a
         rho, phi = np.hypot(q[:, 0], q[:, 1]), np.arctan2(q[:, 1], q[:, 0])
         u, on_turn = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
@@ -224,7 +238,7 @@ class Revolutions(_Kind):
         return np.stack([u, v], axis=1), d, on_turn & on_arc
 
     def derivatives(self, j, uv):
-        P = {k: v[j] for k, v in self.p.items()}
+        P = self._gather(j)
         cu, su, cv, sv = np.cos(uv[:, :1]), np.sin(uv[:, :1]), np.cos(uv[:, 1:]), np.sin(uv[:, 1:])
         w = cu * P["w0"] + su * P["b0"]
         b = -su * P["w0"] + cu * P["b0"]
@@ -320,8 +334,8 @@ class CurveRevolutions(_Kind):
         return X, J, S
 
     def nearest(self, y, j):
-        P = {k: v[j] for k, v in self.p.items()}
-        lo, hi, eps = self.lo[j], self.hi[j], self.eps[j]
+        P = self._gather(j)
+        lo, hi, eps = P["lo"], P["hi"], P["eps"]
         q = np.einsum("pi,pki->pk", y - P["A"], P["frame"])
         rho, phi = np.hypot(q[:, 0], q[:, 1]), np.arctan2(q[:, 1], q[:, 0])
         u, on_turn = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
