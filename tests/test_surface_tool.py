@@ -4,7 +4,8 @@ written to STEP and read back, against the analytic tools of the same scene (too
 normal and shape operator at random points near every region of their surfaces, and on the
 seams between a fillet and the face it meets. The accuracy asked: 1e-6 mm in the gap, 1e-6 in
 the normal, 1e-5 of the largest curvature in H (measured: 3e-8 mm, 1e-7 and 2e-6 on the punch's
-nose corner, a torus onto which OCC projects iteratively; 1e-14 on the die's planes, cylinders and tori)."""
+nose corner, in STEP a surface of revolution of a B-spline that approximates the nose's circle;
+1e-14 on the die's planes, cylinders and tori)."""
 
 import importlib.util
 import json
