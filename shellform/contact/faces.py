@@ -24,15 +24,10 @@ projection must be checked against its trim by the tool).
 
 import numpy as np
 
+from shellform._jit import njit
+
 TWO_PI = 2.0 * np.pi
 MERIDIAN_SAMPLES = 1024  # points of a curve meridian whose angles about its fitted circle start Newton
-
-
-def _interval(p, lo, hi, tol):
-    """The parameter nearest to p in [lo, hi]: p itself where it lies within tol of the
-    interval (inside True), else the nearer bound."""
-    inside = (p >= lo - tol) & (p <= hi + tol)
-    return np.where(inside, p, np.clip(p, lo, hi)), inside
 
 
 def _arc(phi, lo, hi, tol):
@@ -56,6 +51,113 @@ def cross(a, b):
 
 def _close(a, b, tol) -> bool:
     return bool(np.abs(np.asarray(a) - np.asarray(b)).max(initial=0.0) <= tol)
+
+
+# -- the closed forms, compiled (numba: one call a kind instead of tens of numpy calls) ----------
+# A kind's faces' parameters are rows of one array (_Kind._packed), in the order of its LAYOUT.
+
+
+@njit
+def _interval1(p, lo, hi, tol):
+    """The parameter nearest to p in [lo, hi]: p itself where it lies within tol of the
+    interval (inside True), else the nearer bound."""
+    if p >= lo - tol and p <= hi + tol:
+        return p, True
+    return min(max(p, lo), hi), False
+
+
+@njit
+def _arc1(phi, lo, hi, tol):
+    """_arc of one angle."""
+    span = hi - lo
+    after = (phi - lo) % TWO_PI  # as np.mod: fmod (exact), turned non-negative
+    before = TWO_PI - after
+    if after <= span + tol:
+        return lo + after, True
+    if before <= tol:
+        return lo - before, True
+    return (hi, False) if after - span < before else (lo, False)
+
+
+@njit
+def _planes_nearest(y, j, rows, uv, d, inside):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
+        u, iu = _interval1(dx * q[3] + dy * q[4] + dz * q[5], q[9], q[11], q[13])
+        v, iv = _interval1(dx * q[6] + dy * q[7] + dz * q[8], q[10], q[12], q[14])
+        rx, ry, rz = dx - (u * q[3] + v * q[6]), dy - (u * q[4] + v * q[7]), dz - (u * q[5] + v * q[8])
+        uv[p, 0], uv[p, 1], d[p], inside[p] = u, v, np.sqrt(rx * rx + ry * ry + rz * rz), iu and iv
+
+
+@njit
+def _planes_derivatives(j, uv, rows, X, J, S):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        for i in range(3):
+            X[p, i] = q[i] + uv[p, 0] * q[3 + i] + uv[p, 1] * q[6 + i]
+            J[p, 0, i], J[p, 1, i] = q[3 + i], q[6 + i]
+            S[p, 0, i] = S[p, 1, i] = S[p, 2, i] = 0.0
+
+
+@njit
+def _cylinders_nearest(y, j, rows, uv, d, inside):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
+        qx, qy, qz = dx * q[3] + dy * q[4] + dz * q[5], dx * q[6] + dy * q[7] + dz * q[8], \
+            dx * q[9] + dy * q[10] + dz * q[11]
+        phi = np.arctan2(qy, qx)
+        u, iu = _arc1(phi, q[13], q[15], q[17])
+        v, iv = _interval1(qz, q[14], q[16], q[18])
+        rho, turn = np.hypot(qx, qy), u - phi
+        d[p] = np.sqrt((rho * np.cos(turn) - q[12]) ** 2 + (rho * np.sin(turn)) ** 2 + (qz - v) ** 2)
+        uv[p, 0], uv[p, 1], inside[p] = u, v, iu and iv
+
+
+@njit
+def _cylinders_derivatives(j, uv, rows, X, J, S):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        c, s, R = np.cos(uv[p, 0]), np.sin(uv[p, 0]), q[12]
+        for i in range(3):
+            radial = c * q[3 + i] + s * q[6 + i]
+            X[p, i] = q[i] + R * radial + uv[p, 1] * q[9 + i]
+            J[p, 0, i], J[p, 1, i] = R * (-s * q[3 + i] + c * q[6 + i]), q[9 + i]
+            S[p, 0, i], S[p, 1, i], S[p, 2, i] = -R * radial, 0.0, 0.0
+
+
+@njit
+def _revolutions_nearest(y, j, rows, uv, d, inside):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
+        qw, qb, qa = dx * q[12] + dy * q[13] + dz * q[14], dx * q[15] + dy * q[16] + dz * q[17], \
+            dx * q[18] + dy * q[19] + dz * q[20]  # y along w_0, b_0 and a
+        rho, phi = np.hypot(qw, qb), np.arctan2(qb, qw)
+        u, iu = _arc1(phi, q[28], q[30], q[32])
+        turn = u - phi
+        sx, sy = rho * np.cos(turn) - q[21], qa - q[22]  # y in the meridian's plane, from c
+        v, iv = _arc1(np.arctan2(sx * q[26] + sy * q[27], sx * q[24] + sy * q[25]), q[29], q[31], q[33])
+        cv, sv = np.cos(v), np.sin(v)
+        mr, mh = q[21] + q[23] * (cv * q[24] + sv * q[26]), q[22] + q[23] * (cv * q[25] + sv * q[27])
+        d[p] = np.sqrt((rho * np.cos(turn) - mr) ** 2 + (qa - mh) ** 2 + (rho * np.sin(turn)) ** 2)
+        uv[p, 0], uv[p, 1], inside[p] = u, v, iu and iv
+
+
+@njit
+def _revolutions_derivatives(j, uv, rows, X, J, S):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        cu, su, cv, sv, r = np.cos(uv[p, 0]), np.sin(uv[p, 0]), np.cos(uv[p, 1]), np.sin(uv[p, 1]), q[23]
+        m0, m1 = q[21] + r * (cv * q[24] + sv * q[26]), q[22] + r * (cv * q[25] + sv * q[27])  # (rho, h)
+        d0, d1 = r * (-sv * q[24] + cv * q[26]), r * (-sv * q[25] + cv * q[27])
+        e0, e1 = -r * (cv * q[24] + sv * q[26]), -r * (cv * q[25] + sv * q[27])
+        for i in range(3):
+            w, b, a = cu * q[6 + i] + su * q[9 + i], -su * q[6 + i] + cu * q[9 + i], q[3 + i]
+            X[p, i] = q[i] + m0 * w + m1 * a
+            J[p, 0, i], J[p, 1, i] = m0 * b, d0 * w + d1 * a
+            S[p, 0, i], S[p, 1, i], S[p, 2, i] = -m0 * w, e0 * w + e1 * a, d0 * b
 
 
 class _Kind:
@@ -98,10 +200,28 @@ class _Kind:
         ends = np.cumsum([0] + [int(np.prod(v.shape[1:])) for v in self.p.values()])
         self._slices = [(k, slice(a, b), v.shape[1:]) for (k, v), a, b in zip(self.p.items(), ends[:-1], ends[1:])]
 
+        if self._params and self.LAYOUT is not None:  # the compiled kernels' columns
+            assert [(k, cut.start) for k, cut, _ in self._slices] == list(self.LAYOUT.items()), self._slices
+
+    LAYOUT = None  # name -> first column of the packed rows, for the compiled kernels
+    KERNELS = None  # (nearest, derivatives) compiled
+
     def _gather(self, j):
         """The parameters of faces j (one per pair): name -> array (pairs, ...)."""
         rows = self._packed[j]
         return {k: rows[:, cut].reshape((len(j),) + shape) for k, cut, shape in self._slices}
+
+    def nearest(self, y, j):
+        n = len(j)
+        uv, d, inside = np.empty((n, 2)), np.empty(n), np.empty(n, dtype=np.bool_)
+        self.KERNELS[0](np.ascontiguousarray(y), np.asarray(j, dtype=np.int64), self._packed, uv, d, inside)
+        return uv, d, inside
+
+    def derivatives(self, j, uv):
+        n = len(j)
+        X, J, S = np.empty((n, 3)), np.empty((n, 2, 3)), np.empty((n, 3, 3))
+        self.KERNELS[1](np.asarray(j, dtype=np.int64), np.ascontiguousarray(uv, dtype=float), self._packed, X, J, S)
+        return X, J, S
 
 
 class Planes(_Kind):
@@ -110,6 +230,9 @@ class Planes(_Kind):
     sides are orthogonal. A trimmed plane is given infinite bounds: the foot point of the
     plane."""
 
+    LAYOUT = {"O": 0, "E": 3, "lo": 9, "hi": 11, "eps": 13}
+    KERNELS = (_planes_nearest, _planes_derivatives)
+
     def add(self, index, b0, b1, X, J, S, uv) -> bool:
         E = J[0]
         if not _close(E @ E.T, np.eye(2), 1e-12) or not _close(J, E, 1e-12 * np.abs(E).max()):
@@ -117,24 +240,13 @@ class Planes(_Kind):
         O = X[0] - uv[0] @ E
         return self._keep(index, b0, b1, {"O": O, "E": E}, X, J, S, uv)
 
-    def nearest(self, y, j):
-        P = self._gather(j)
-        O, E = P["O"], P["E"]
-        foot = np.einsum("pi,pai->pa", y - O, E)
-        uv, inside = _interval(foot, P["lo"], P["hi"], P["eps"])
-        r = y - O - np.einsum("pa,pai->pi", uv, E)
-        return uv, np.sqrt(np.einsum("pi,pi->p", r, r)), inside.all(axis=1)
-
-    def derivatives(self, j, uv):
-        P = self._gather(j)
-        O, E = P["O"], P["E"]
-        return O + np.einsum("pa,pai->pi", uv, E), E.copy(), np.zeros((len(j), 3, 3))
-
-
 class Cylinders(_Kind):
     """Cylinders X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's cylinders), an
     arc u in [u0, u1] times a segment v in [v0, v1]: the nearest point's u is the arc's nearest
     angle to y's angle about the axis, its v y's height clamped."""
+
+    LAYOUT = {"O": 0, "E": 3, "R": 12, "lo": 13, "hi": 15, "eps": 17}
+    KERNELS = (_cylinders_nearest, _cylinders_derivatives)
 
     def add(self, index, b0, b1, X, J, S, uv, origin) -> bool:
         """origin: gmsh's X, J, S at (u, v) = (0, 0), from which E and R are read."""
@@ -146,30 +258,6 @@ class Cylinders(_Kind):
         if not _close(E @ E.T, np.eye(3), 1e-12):
             return False
         return self._keep(index, b0, b1, {"O": X0 - R * E[0], "E": E, "R": R}, X, J, S, uv)
-
-    def nearest(self, y, j):
-        P = self._gather(j)
-        O, E, R, lo, hi, eps = P["O"], P["E"], P["R"], P["lo"], P["hi"], P["eps"]
-        q = np.einsum("pi,pai->pa", y - O, E)  # y in the cylinder's frame
-        phi = np.arctan2(q[:, 1], q[:, 0])
-        u, on_arc = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
-        v, on_line = _interval(q[:, 2], lo[:, 1], hi[:, 1], eps[:, 1])
-        rho = np.hypot(q[:, 0], q[:, 1])
-        turn = u - phi
-        d = np.sqrt((rho * np.cos(turn) - R) ** 2 + (rho * np.sin(turn)) ** 2 + (q[:, 2] - v) ** 2)
-        return np.stack([u, v], axis=1), d, on_arc & on_line
-
-    def derivatives(self, j, uv):
-        P = self._gather(j)
-        O, E, R = P["O"], P["E"], P["R"][:, None]
-        c, s = np.cos(uv[:, :1]), np.sin(uv[:, :1])
-        radial = c * E[:, 0] + s * E[:, 1]
-        X = O + R * radial + uv[:, 1:] * E[:, 2]
-        J = np.stack([R * (-s * E[:, 0] + c * E[:, 1]), E[:, 2]], axis=1)
-        S = np.zeros((len(j), 3, 3))
-        S[:, 0] = -R * radial
-        return X, J, S
-
 
 class Revolutions(_Kind):
     """Surfaces swept by a circle arc turning about an axis in the arc's plane: tori, spheres and
@@ -185,6 +273,10 @@ class Revolutions(_Kind):
     for every v the nearest u is the arc's nearest angle to phi_y, whatever v. In the half-plane
     of that u, y lies at (rho_y cos(u - phi_y), h_y) and rho_y sin(u - phi_y) out of it, and the
     nearest v is the meridian arc's nearest angle to y's angle about the circle's centre c."""
+
+    LAYOUT = {"A": 0, "a": 3, "w0": 6, "b0": 9, "frame": 12, "c": 21, "r": 23, "f1": 24, "f2": 26, "lo": 28, "hi": 30,
+              "eps": 32}
+    KERNELS = (_revolutions_nearest, _revolutions_derivatives)
 
     def add(self, index, b0, b1, X, J, S, uv, middle) -> bool:
         """middle: gmsh's (u, v), X, J, S at a point where the face is not on the axis (rho >
@@ -221,36 +313,6 @@ class Revolutions(_Kind):
         params = {"A": A, "a": a, "w0": w0, "b0": b0_, "frame": np.array([w0, b0_, a]), "c": c, "r": r, "f1": f1,
                   "f2": f2}
         return self._keep(index, b0, b1, params, X, J, S, uv)
-
-    def nearest(self, y, j):
-        P = self._gather(j)
-        lo, hi, eps = P["lo"], P["hi"], P["eps"]
-        q = np.einsum("pi,pki->pk", y - P["A"], P["frame"])  # y along w_0, b_0 and a
-        rho, phi = np.hypot(q[:, 0], q[:, 1]), np.arctan2(q[:, 1], q[:, 0])
-        u, on_turn = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
-        turn = u - phi
-        s = np.stack([rho * np.cos(turn), q[:, 2]], axis=1) - P["c"]  # y in the meridian's plane, from c
-        angle = np.arctan2(np.einsum("pk,pk->p", s, P["f2"]), np.einsum("pk,pk->p", s, P["f1"]))
-        v, on_arc = _arc(angle, lo[:, 1], hi[:, 1], eps[:, 1])
-        meridian = P["c"] + P["r"][:, None] * (np.cos(v)[:, None] * P["f1"] + np.sin(v)[:, None] * P["f2"])
-        d = np.sqrt((rho * np.cos(turn) - meridian[:, 0]) ** 2 + (q[:, 2] - meridian[:, 1]) ** 2
-                    + (rho * np.sin(turn)) ** 2)
-        return np.stack([u, v], axis=1), d, on_turn & on_arc
-
-    def derivatives(self, j, uv):
-        P = self._gather(j)
-        cu, su, cv, sv = np.cos(uv[:, :1]), np.sin(uv[:, :1]), np.cos(uv[:, 1:]), np.sin(uv[:, 1:])
-        w = cu * P["w0"] + su * P["b0"]
-        b = -su * P["w0"] + cu * P["b0"]
-        r = P["r"][:, None]
-        m = P["c"] + r * (cv * P["f1"] + sv * P["f2"])  # (rho, h)
-        dm = r * (-sv * P["f1"] + cv * P["f2"])
-        ddm = -r * (cv * P["f1"] + sv * P["f2"])
-        X = P["A"] + m[:, :1] * w + m[:, 1:] * P["a"]
-        J = np.stack([m[:, :1] * b, dm[:, :1] * w + dm[:, 1:] * P["a"]], axis=1)
-        S = np.stack([-m[:, :1] * w, ddm[:, :1] * w + ddm[:, 1:] * P["a"], dm[:, :1] * b], axis=1)
-        return X, J, S
-
 
 class CurveRevolutions(_Kind):
     """Surfaces of revolution whose meridian is not a circle (OCC's surfaces of revolution of a
