@@ -160,6 +160,69 @@ def _revolutions_derivatives(j, uv, rows, X, J, S):
             S[p, 0, i], S[p, 1, i], S[p, 2, i] = -m0 * w, e0 * w + e1 * a, d0 * b
 
 
+@njit
+def _within(y, reach, lo, hi, pi, k):
+    count = 0
+    for p in range(y.shape[0]):
+        for f in range(lo.shape[0]):
+            square = 0.0
+            for i in range(3):
+                t = max(lo[f, i] - y[p, i], y[p, i] - hi[f, i], 0.0)
+                square += t * t
+            if np.sqrt(square) <= reach[p]:
+                pi[count], k[count] = p, f
+                count += 1
+    return count
+
+
+def within(y, reach, lo, hi):
+    """The pairs (point, box) whose box [lo, hi] lies within reach of the point (its distance to
+    the box): point and box indices, by point then box."""
+    pi, k = np.empty(len(y) * len(lo), dtype=np.int64), np.empty(len(y) * len(lo), dtype=np.int64)
+    count = _within(np.ascontiguousarray(y, dtype=float), np.ascontiguousarray(reach, dtype=float),
+                    np.ascontiguousarray(lo), np.ascontiguousarray(hi), pi, k)
+    return pi[:count], k[:count]
+
+
+@njit
+def _shape_operators(J, S, n, d, H, regular):
+    for p in range(len(d)):
+        b = np.zeros(3)
+        for a in range(3):
+            b[a] = -(S[p, a, 0] * n[p, 0] + S[p, a, 1] * n[p, 1] + S[p, a, 2] * n[p, 2])
+        g0 = J[p, 0, 0] ** 2 + J[p, 0, 1] ** 2 + J[p, 0, 2] ** 2
+        g1 = J[p, 1, 0] ** 2 + J[p, 1, 1] ** 2 + J[p, 1, 2] ** 2
+        g2 = J[p, 0, 0] * J[p, 1, 0] + J[p, 0, 1] * J[p, 1, 1] + J[p, 0, 2] * J[p, 1, 2]
+        det = g0 * g1 - g2 ** 2
+        regular[p] = det > 1e-12 * (g0 + g1) ** 2
+        if not regular[p]:
+            continue
+        k0, k1, k2 = g0 + d[p] * b[0], g1 + d[p] * b[1], g2 + d[p] * b[2]  # G + d B
+        m00, m01 = b[0] * k1 - b[2] * k2, b[2] * k0 - b[0] * k2  # B adj(G + d B)
+        m10, m11 = b[2] * k1 - b[1] * k2, b[1] * k0 - b[2] * k2
+        scale = 1.0 / (det * (k0 * k1 - k2 ** 2))
+        w00 = (g1 * m00 - g2 * m10) * scale  # adj(G) B adj(G + d B) / (det G det(G + d B))
+        w11 = (g0 * m11 - g2 * m01) * scale
+        w01 = 0.5 * ((g1 * m01 - g2 * m11) + (g0 * m10 - g2 * m00)) * scale
+        for j in range(3):
+            v0 = w00 * J[p, 0, j] + w01 * J[p, 1, j]
+            v1 = w01 * J[p, 0, j] + w11 * J[p, 1, j]
+            for i in range(3):
+                H[p, i, j] = J[p, 0, i] * v0 + J[p, 1, i] * v1
+
+
+def shape_operators(J, S, n, d):
+    """H0 (I + d H0)^-1 of surfaces at distance d (docs/tools.md), from the derivatives J (X_u,
+    X_v) and S (X_uu, X_vv, X_uv) and the normals n: with G = J J^T, B_ab = -n . X_ab and A =
+    G^-1 J (the dual basis; A J^T = I) it is J^T W J, W = G^-1 B (G + d B)^-1 (2 x 2, symmetric):
+    H0 (I + d H0)^-1 = A^T B (I + d A A^T B)^-1 A and A A^T = G^-1. Returns H and where G is
+    regular (H is left 0 where it is singular: a pole)."""
+    H, regular = np.zeros((len(d), 3, 3)), np.empty(len(d), dtype=np.bool_)
+    _shape_operators(np.ascontiguousarray(J, dtype=float), np.ascontiguousarray(S, dtype=float),
+                     np.ascontiguousarray(n, dtype=float), np.ascontiguousarray(d, dtype=float), H, regular)
+    return H, regular
+
+
 class _Kind:
     """The faces of one kind: their indices in the tool (`index`), parameter bounds and
     tolerances, and each kind's parameters (arrays with the face first)."""

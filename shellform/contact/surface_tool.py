@@ -97,6 +97,8 @@ import numpy as np
 from shellform.contact.cad_files import probe
 from shellform.contact.faces import CurveRevolutions, Cylinders, Planes, Revolutions
 from shellform.contact.faces import cross as faces_cross
+from shellform.contact.faces import shape_operators
+from shellform.contact.faces import within as faces_within
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
@@ -441,8 +443,7 @@ class SurfaceTool:
         J, S and found."""
         npts, nent = len(y), len(self._ents)
         faces = self._exact_index
-        near = self._lower(y, faces) <= (upper * (1 + 1e-9) + 1e-9 * self.size)[:, None]
-        pi, k = np.nonzero(near)
+        pi, k = faces_within(y, upper * (1 + 1e-9) + 1e-9 * self.size, self._box[faces, 0], self._box[faces, 1])
         k = faces[k]
         kind_of = self._kind_of[k]
         D, U = np.full((npts, nent), np.inf), np.zeros((npts, nent, 2))
@@ -953,30 +954,14 @@ class SurfaceTool:
 
     @staticmethod
     def _hessian(J, S, n, d):
-        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv). With A =
-        G^-1 J (the dual basis; A J^T = I) it is J^T W J, W = G^-1 B (G + d B)^-1 (2 x 2,
-        symmetric): H0 (I + d H0)^-1 = A^T B (I + d A A^T B)^-1 A and A A^T = G^-1. Where G is
-        singular (a pole) H0 from G's pseudo-inverse."""
-        b = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
-        g = np.stack([np.einsum("pi,pi->p", J[:, 0], J[:, 0]), np.einsum("pi,pi->p", J[:, 1], J[:, 1]),
-                      np.einsum("pi,pi->p", J[:, 0], J[:, 1])], axis=1)
-        det = g[:, 0] * g[:, 1] - g[:, 2] ** 2
-        regular = det > 1e-12 * (g[:, 0] + g[:, 1]) ** 2
-        k = g + d[:, None] * b  # G + d B
-        # B adj(K) / det(K), then adj(G) / det(G) times it
-        dk = k[:, 0] * k[:, 1] - k[:, 2] ** 2
-        m00, m01 = b[:, 0] * k[:, 1] - b[:, 2] * k[:, 2], b[:, 2] * k[:, 0] - b[:, 0] * k[:, 2]
-        m10, m11 = b[:, 2] * k[:, 1] - b[:, 1] * k[:, 2], b[:, 1] * k[:, 0] - b[:, 2] * k[:, 2]
-        scale = 1.0 / (np.where(regular, det, 1.0) * dk)
-        w00 = (g[:, 1] * m00 - g[:, 2] * m10) * scale
-        w11 = (g[:, 0] * m11 - g[:, 2] * m01) * scale
-        w01 = 0.5 * ((g[:, 1] * m01 - g[:, 2] * m11) + (g[:, 0] * m10 - g[:, 2] * m00)) * scale
-        W = np.stack([np.stack([w00, w01], 1), np.stack([w01, w11], 1)], 1)
-        H = np.matmul(J.transpose(0, 2, 1), np.matmul(W, J))
+        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv)
+        (faces.shape_operators); where G is singular (a pole) H0 from G's pseudo-inverse."""
+        H, regular = shape_operators(J, S, n, d)
         if not regular.all():  # a singular parametrisation (a pole): the pseudo-inverse
             i = ~regular
-            G = np.stack([np.stack([g[i, 0], g[i, 2]], 1), np.stack([g[i, 2], g[i, 1]], 1)], 1)
-            B = np.stack([np.stack([b[i, 0], b[i, 2]], 1), np.stack([b[i, 2], b[i, 1]], 1)], 1)
+            G = np.einsum("pai,pbi->pab", J[i], J[i])
+            b = -np.einsum("pki,pi->pk", S[i], n[i])  # -n . (X_uu, X_vv, X_uv)
+            B = np.stack([np.stack([b[:, 0], b[:, 2]], 1), np.stack([b[:, 2], b[:, 1]], 1)], 1)
             A = np.einsum("pai,pab->pbi", J[i], np.linalg.pinv(G))
             H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
             H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
