@@ -1,5 +1,5 @@
-"""Elementary faces of a CAD tool evaluated in numpy from their parameters (docs/tools.md, "How a
-surface is evaluated").
+"""Elementary faces of a CAD tool evaluated from their parameters, without gmsh (docs/tools.md,
+"How a surface is evaluated").
 
 A CAD tool's faces are mostly OpenCASCADE's elementary surfaces: planes, cylinders, tori,
 spheres and surfaces of revolution of a circle arc (a fillet's corner). Each kind's class holds
@@ -19,7 +19,11 @@ For points y and faces j of the kind (pairs: an index of a face of the kind per 
                           of face j (an index per point) at parameters uv, as gmsh orders them.
 
 The nearest point is exact where the face fills its parameter rectangle (a trimmed face's
-projection must be checked against its trim by the tool).
+projection must be checked against its trim by the tool). Planes, cylinders and revolutions of
+a circle do both in loops compiled by numba over the pairs (their parameters rows of one array,
+in each kind's LAYOUT); a curve meridian's Newton calls gmsh. Also here, compiled: the pairs of
+points and boxes within reach (within) and the distance's Hessian from a face's derivatives
+(shape_operators).
 """
 
 import numpy as np

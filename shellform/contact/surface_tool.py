@@ -9,9 +9,9 @@ what the analytic tools give (tools.py): for points x,
     shape(x, offset, dz)  H = dn/dx (n, 3, 3), the Hessian of the signed distance.
 
 The surface is evaluated, not meshed (docs/tools.md). Most faces of a tool are elementary
-surfaces that numpy evaluates from their parameters (faces.py: planes, cylinders, surfaces of
-revolution of a circle or of a curve), fitted from gmsh's evaluations and verified against them
-when the tool is built. For a point x the closest surface point c is found
+surfaces evaluated from their parameters without gmsh (faces.py: planes, cylinders, surfaces of
+revolution of a circle in compiled loops; of a curve, Newton along its meridian with gmsh),
+fitted from gmsh's evaluations and verified against them when the tool is built. For a point x the closest surface point c is found
 
     exact       on those faces, all at once: each one's nearest point whose bounding box lies
                 within an upper bound of the distance (the last answer of the point's
