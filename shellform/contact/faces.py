@@ -420,7 +420,8 @@ class CurveRevolutions(_Kind):
         frame = np.array([w0, b0_, a])
         Xr, Jr, Sr = meridian
         wa = np.array([w, a])
-        P, dP, ddP = (np.einsum("pi,ki->pk", V, wa) for V in (Xr - A, Jr[:, 1], Sr[:, 1]))  # (rho, h) and its v-derivatives
+        # the meridian's (rho, h) at the samples and its v-derivatives
+        P, dP, ddP = (np.einsum("pi,ki->pk", V, wa) for V in (Xr - A, Jr[:, 1], Sr[:, 1]))
         if np.min(P[:, 0]) < 0.0 or b1[0] - b0[0] > TWO_PI + 1e-12:
             return False
         cu, su = np.cos(uv[:, :1]), np.sin(uv[:, :1])

@@ -11,7 +11,8 @@ what the analytic tools give (tools.py): for points x,
 The surface is evaluated, not meshed (docs/tools.md). Most faces of a tool are elementary
 surfaces evaluated from their parameters without gmsh (faces.py: planes, cylinders, surfaces of
 revolution of a circle in compiled loops; of a curve, Newton along its meridian with gmsh),
-fitted from gmsh's evaluations and verified against them when the tool is built. For a point x the closest surface point c is found
+fitted from gmsh's evaluations and verified against them when the tool is built. For a point
+x the closest surface point c is found
 
     exact       on those faces, all at once: each one's nearest point whose bounding box lies
                 within an upper bound of the distance (the last answer of the point's
@@ -361,7 +362,8 @@ class SurfaceTool:
         """gmsh's X, J (X_u, X_v) and S (X_uu, X_vv, X_uv) of face k (an index) at parameters uv
         (the tool's model current)."""
         m, f, flat = _gmsh().model, self._ents[k][1], np.ravel(uv)
-        return (np.asarray(m.getValue(2, f, flat)).reshape(-1, 3), np.asarray(m.getDerivative(2, f, flat)).reshape(-1, 2, 3),
+        return (np.asarray(m.getValue(2, f, flat)).reshape(-1, 3),
+                np.asarray(m.getDerivative(2, f, flat)).reshape(-1, 2, 3),
                 np.asarray(m.getSecondDerivative(2, f, flat)).reshape(-1, 3, 3))
 
     # -- evaluation --------------------------------------------------------------------------
