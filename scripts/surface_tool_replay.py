@@ -66,7 +66,24 @@ print(f"run: n {n}, {stroke:g} mm, {len(p.driver.history)} increments, {iteratio
 t = s.material.thickness
 analytic_scene = scene.load("demos/numisheet93_aluminium.toml")
 sets = [("analytic", square_cup_tools(analytic_scene.tools, t))]
-sets += [(label, module.cad_cup_tools(s.tools, t)) for label, module in modules]
+
+
+def cup_tools(module):
+    """The cup's tools of `module`: shellform.contact.surface_tool or another version of
+    surface_tool.py (its SurfaceTool placed by cad_tools), or of cad_tools.py."""
+    if hasattr(module, "cad_cup_tools"):
+        return module.cad_cup_tools(s.tools, t)
+    from shellform.contact import cad_tools
+
+    current = cad_tools.SurfaceTool
+    cad_tools.SurfaceTool = module.SurfaceTool
+    try:
+        return cad_tools.cad_cup_tools(s.tools, t)
+    finally:
+        cad_tools.SurfaceTool = current
+
+
+sets += [(label, cup_tools(module)) for label, module in modules]
 answers = {}
 print(f"{'tools':28} {'gap s':>7} {'shape s':>8} {'gap ms/call':>12} {'shape ms/call':>14} {'ms/iteration':>13} "
       f"{'|dgap| mm':>10} {'|dn|':>8} {'|dH|':>8}")

@@ -28,7 +28,7 @@ from numba import types
 from numba.extending import intrinsic
 
 _PACKAGE = Path(__file__).resolve().parent
-_NUMBA_MODULES = ("_jit.py", "assembly", "material", "contact/frames.py", "nonlinear/model.py",
+_NUMBA_MODULES = ("_jit.py", "assembly", "material", "contact/frames.py", "contact/faces.py", "nonlinear/model.py",
                   "nonlinear/assemble.py")
 
 

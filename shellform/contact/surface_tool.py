@@ -8,8 +8,23 @@ what the analytic tools give (tools.py): for points x,
                           unit normal pointing from the tool towards the point;
     shape(x, offset, dz)  H = dn/dx (n, 3, 3), the Hessian of the signed distance.
 
-The surface is evaluated, not meshed (docs/tools.md). For a point x the closest surface point
-c is found in two steps:
+The surface is evaluated, not meshed (docs/tools.md). Most faces of a tool are elementary
+surfaces evaluated from their parameters without gmsh (faces.py: planes, cylinders, surfaces of
+revolution of a circle in compiled loops; of a curve, Newton along its meridian with gmsh),
+fitted from gmsh's evaluations and verified against them when the tool is built. For a point
+x the closest surface point c is found
+
+    exact       on those faces, all at once: each one's nearest point whose bounding box lies
+                within an upper bound of the distance (the last answer of the point's
+                remembered neighbour plus the distance to it; a sample's), in closed form (a
+                curve meridian: its turn in closed form, Newton along it), a trimmed plane's
+                foot point where its trim holds it (a raster of its sides, the sampled boundary
+                near it, isInside within the sampling's margin). The nearest of these is the
+                closest point where it lies inside its face (not on an edge) and no entity they
+                do not answer for (a face of another kind, an edge no filled one bounds) lies
+                nearer by its bounding box;
+
+and where not, in two steps with gmsh:
 
     local       Newton on the face of the nearest of points sampled on every face and edge (a
                 k-d tree; both faces of a sample on an edge), from the sample's parameters; a
@@ -24,22 +39,25 @@ c is found in two steps:
                 to its range (the nearest point of a face whose projection falls outside it
                 lies on its boundary).
 
-A second, non-global minimum of the distance inside one face is not found.
+A second, non-global minimum of the distance inside one face is not found by the gmsh steps
+(the closed forms are global on their face).
 
 Every point also gets lower bounds of its distance to every face and edge (the bounding
-boxes', raised by the projections computed on the way). The tool remembers its last call's
-points with their closest points, the face's derivatives there and these bounds
-(_Projections). A point given again takes its last answer (shape on the points of the last
-gap call: H from the derivatives Newton ended with); a point at distance delta from the
-nearest remembered one whose closest point lay on a face
+boxes', raised by the projections computed on the way, the closed forms' distances). The tool
+remembers its last call's points with their closest points, the face's derivatives there and
+these bounds (_Projections; the bounds of points the exact pass answered computed where asked).
+A point given again takes its last answer (shape on the points of the last gap call: H from
+the derivatives its face gave); a point the exact pass leaves, at distance delta from the
+nearest remembered one whose closest point lay on a face,
 
     warm        Newton on that face from the remembered (u, v); a point it finds inside the
                 face is sure where every other entity's bound less delta (the distance is
-                1-Lipschitz) lies farther (a plane or a cylinder that fills its parameter
-                rectangle: its exact distance); where not, the candidates are the entities whose
-                bounds allow them nearer, the face's point the seed.
+                1-Lipschitz) lies farther (a face in closed form: its exact distance); where
+                not, the candidates are the entities whose bounds allow them nearer, the face's
+                point the seed.
 
-The other points are searched as above.
+The other points are searched as above. `counts` counts the points answered each way
+(repeated, exact, warm, searched).
 
 Signed distance and normal. The faces' normals (getNormal, oriented by OCC's face orientation:
 outward for the faces of a solid) point to the side of the sheet; ``normals = "inward"`` turns
@@ -78,12 +96,18 @@ from pathlib import Path
 import numpy as np
 
 from shellform.contact.cad_files import probe
+from shellform.contact.faces import CurveRevolutions, Cylinders, Planes, Revolutions
+from shellform.contact.faces import cross as faces_cross
+from shellform.contact.faces import within as faces_within
 from shellform.contact.holder_edge import closed_loops
+from shellform.contact.surface_geometry import distance_hessian
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over
 SAMPLES = 24  # points per parametric direction sampled on a face (per edge: along it) for the upper bounds
-BOUNDARY_SAMPLES = 400  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
+BOUNDARY_SAMPLES = 4000  # a trimmed face's boundary sampled every 1/BOUNDARY_SAMPLES of the tool's size
+SIDE_TESTS = 9  # segments of an edge of a trimmed face at which the face's side is asked
+RASTER = 256  # at most as many cells along each parameter of a trimmed face's raster of its sides
 NORMALS = ("outward", "inward")
 
 
@@ -116,6 +140,11 @@ class _Current:
             gmsh.model.setCurrent(self.previous)
 
 
+def _keys(y):
+    """Each point's coordinates as one opaque key (its bytes: equal exactly where the point is)."""
+    return np.ascontiguousarray(y).view(np.dtype((np.void, y.dtype.itemsize * 3))).ravel()
+
+
 class _Projections:
     """Points y (in a tool's model frame) with their closest points c, distances dist, signed
     distances d, normals n, entities (indices into the tool's entities) and parameters, lower
@@ -124,16 +153,34 @@ class _Projections:
     X_vv, X_uv)."""
 
     def __init__(self, y, c, dist, d, n, ent, par, bound, J, S, has):
-        from scipy.spatial import cKDTree
-
         self.y, self.c, self.dist, self.d, self.n, self.ent, self.par, self.bound = y, c, dist, d, n, ent, par, bound
         self.J, self.S, self.has = J, S, has
-        self.tree = cKDTree(y)
+        self.tree = self.order = None
+
 
     def nearest(self, y):
-        """The nearest remembered point of each of y (its index) and the distance to it (0
-        exactly where the point is given again)."""
-        delta, ref = self.tree.query(y)
+        """A remembered point near each of y (its index) and the distance to it: as many points
+        as remembered are taken row by row (the contact set's nodes again, moved or not); in
+        other calls a point given again is found by its coordinates' bytes (sorted), the others
+        take the nearest remembered point (a k-d tree). 0 exactly where the point is given
+        again."""
+        if len(y) == len(self.y):
+            r = y - self.y
+            return np.arange(len(y)), np.sqrt(np.einsum("pi,pi->p", r, r))
+        if self.order is None:
+            self.keys = _keys(self.y)
+            self.order = np.argsort(self.keys)
+        keys = _keys(y)
+        at = np.minimum(np.searchsorted(self.keys, keys, sorter=self.order), len(self.y) - 1)
+        ref = self.order[at]
+        delta = np.where(self.keys[ref] == keys, 0.0, np.inf)
+        moved = np.flatnonzero(delta > 0.0)
+        if moved.size:
+            if self.tree is None:
+                from scipy.spatial import cKDTree
+
+                self.tree = cKDTree(self.y)
+            delta[moved], ref[moved] = self.tree.query(y[moved])
         return ref, delta
 
 
@@ -169,7 +216,7 @@ class SurfaceTool:
                                    for e in self.edges}
             self._setup(gmsh)
             self._last = None  # the last call's points and their closest points (_Projections)
-            self.counts = {"repeated": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
+            self.counts = {"repeated": 0, "exact": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
             self._index = {de: k for k, de in enumerate(self._ents)}
             self._is_face = np.array([d == 2 for d, _ in self._ents])
             self._face_edges = {self._index[(2, f)]: np.array([self._index[(1, abs(int(e)))]
@@ -222,8 +269,11 @@ class SurfaceTool:
             raise InputError(field, f"{path}: {exc}") from None
 
     def _setup(self, gmsh):
-        """Bounding boxes, parametric bounds, whether each face fills its parametric bounds, and
-        the sampled points of the upper bounds."""
+        """Bounding boxes, parametric bounds, whether each face fills its parametric bounds, the
+        sampled points of the upper bounds, and the faces evaluated in numpy (faces.py): the
+        planes, cylinders and surfaces of revolution of a circle that fill their parameter
+        rectangle (their nearest points in closed form), and the trimmed planes (their foot
+        points, checked against the trim)."""
         m = gmsh.model
         self._ents = [(2, f) for f in self.faces] + [(1, e) for e in self.edges]
         self._box = np.array([m.getBoundingBox(d, t) for d, t in self._ents]).reshape(-1, 2, 3)
@@ -231,7 +281,12 @@ class SurfaceTool:
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
         self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
-        self._rectangles, self._cylinders = [], []
+        # the faces evaluated in numpy that fill their rectangle: the first three in closed form,
+        # also on their boundary; the surfaces of revolution of a curve only inside
+        self._kinds = [Planes(self.size), Cylinders(self.size), Revolutions(self.size),
+                       CurveRevolutions(self.size, self._evaluate)]
+        self._covering = self._kinds[:3]
+        self._trimmed_planes = Planes(self.size)
         points, owner, params = [], [], []
         s = np.linspace(0.0, 1.0, SAMPLES)
         for k, (d, t) in enumerate(self._ents):
@@ -253,10 +308,7 @@ class SurfaceTool:
                 J = np.asarray(m.getDerivative(2, t, uv.ravel())).reshape(-1, 2, 3)
                 normal = np.asarray(m.getNormal(t, uv.ravel())).reshape(-1, 3)
                 self._orient[t] = 1.0 if np.einsum("pi,pi->", np.cross(J[:, 0], J[:, 1]), normal) >= 0 else -1.0
-                if (d, t) in self._flat and self._filled[t]:
-                    self._rectangle(k, xyz, uv, J, b0, b1)
-                elif m.getType(d, t) == "Cylinder" and self._filled[t]:
-                    self._cylinder(m, k, t, xyz, uv, b0, b1)
+                self._fit(m, k, t, b0, b1, uv, xyz, J)
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
@@ -267,62 +319,54 @@ class SurfaceTool:
 
         self._tree = cKDTree(np.vstack(points))
         self._sample_entity, self._sample_param = np.concatenate(owner), np.vstack(params)
+        self._index_of = {de: k for k, de in enumerate(self._ents)}
+        self._exact_faces = np.zeros(len(self._ents), dtype=bool)  # evaluated in numpy
+        covered = np.zeros(len(self._ents), dtype=bool)  # an exact face's, or an edge of a filled one
+        for kind in self._kinds + [self._trimmed_planes]:
+            self._exact_faces[kind.index] = True
+        for kind in self._covering:
+            covered[kind.index] = True
+        filled = covered.copy()
+        covered |= self._exact_faces
+        for k, (d, t) in enumerate(self._ents):
+            if d == 1:
+                covered[k] = any(filled[self._index_of[(2, f)]] for f in self._face_adjacent[t])
+        self._rest = np.flatnonzero(~covered)  # the entities the exact faces do not answer for
+        self._kind_of, self._position = np.full(len(self._ents), -1), np.zeros(len(self._ents), dtype=int)
+        for i, kind in enumerate(self._kinds + [self._trimmed_planes]):  # kind i's face, at its position
+            self._kind_of[kind.index], self._position[kind.index] = i, np.arange(len(kind))
+        self._exact_index = np.flatnonzero(self._exact_faces)
+        self._orientation = np.array([self._orient.get(t, 1.0) if d == 2 else 0.0 for d, t in self._ents])
 
-    def _rectangle(self, k, xyz, uv, J, b0, b1):
-        """Face k, a plane that fills its parameter rectangle, kept as a rectangle where its
-        parametrisation is X = O + u E_u + v E_v with E_u, E_v orthonormal (OCC's planes; checked at
-        its samples xyz, uv): its nearest point to y is X at the clamped (E . (y - O))."""
-        E = J[0]
-        if np.abs(E @ E.T - np.eye(2)).max() > 1e-12 or np.abs(J - E).max() > 1e-12:
-            return
-        O = xyz[0] - uv[0] @ E
-        if np.abs(O + uv @ E - xyz).max() > 1e-9 * self.size:
-            return
-        self._rectangles.append((k, O, E, b0, b1))
+    def _fit(self, m, k, f, b0, b1, uv, xyz, J):
+        """Face k (tag f) evaluated in numpy where gmsh names it a plane, a cylinder or a surface
+        of revolution (a torus, a sphere) and the kind's parametrisation fitted from it is gmsh's
+        at its samples uv (faces.py)."""
+        kind = m.getType(2, f)
+        S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)
+        filled = self._filled[f]
+        if kind == "Plane":
+            (self._kinds[0] if filled else self._trimmed_planes).add(
+                k, b0 if filled else np.full(2, -np.inf), b1 if filled else np.full(2, np.inf), xyz, J, S, uv)
+        elif kind == "Cylinder" and filled:
+            origin = [np.asarray(g(2, f, [0.0, 0.0])).reshape(shape) for g, shape in
+                      ((m.getValue, 3), (m.getDerivative, (2, 3)), (m.getSecondDerivative, (3, 3)))]
+            self._kinds[1].add(k, b0, b1, xyz, J, S, uv, origin)
+        elif kind in ("Torus", "Sphere", "Surface of Revolution") and filled:
+            mid = 0.5 * (b0 + b1)
+            middle = [mid] + [np.asarray(g(2, f, mid)).reshape(shape) for g, shape in
+                              ((m.getValue, 3), (m.getDerivative, (2, 3)), (m.getSecondDerivative, (3, 3)))]
+            if not self._kinds[2].add(k, b0, b1, xyz, J, S, uv, middle) and kind == "Surface of Revolution":
+                meridian = self._evaluate(k, np.c_[np.full(len(uv), mid[0]), uv[:, 1]])
+                self._kinds[3].add(k, b0, b1, xyz, J, S, uv, middle, meridian)
 
-    def _cylinder(self, m, k, f, xyz, uv, b0, b1):
-        """Face k (tag f), a cylinder that fills its parameter rectangle, kept where its
-        parametrisation is X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's
-        cylinders; E and R from the derivatives at (0, 0), checked at its samples xyz, uv): the
-        patch is an arc times a segment, its nearest point to y the arc's nearest to y's
-        projection onto the axis' plane and the segment's nearest to y's height."""
-        J = np.asarray(m.getDerivative(2, f, [0.0, 0.0])).reshape(2, 3)
-        S = np.asarray(m.getSecondDerivative(2, f, [0.0, 0.0])).reshape(3, 3)
-        R = float(np.linalg.norm(S[0]))
-        if not R > 1e-9 * self.size or b1[0] - b0[0] > 2 * np.pi + 1e-12:
-            return
-        E = np.array([-S[0] / R, J[0] / R, J[1]])
-        if np.abs(E @ E.T - np.eye(3)).max() > 1e-12:
-            return
-        O = np.asarray(m.getValue(2, f, [0.0, 0.0])) - R * E[0]
-        X = O + R * (np.cos(uv[:, :1]) * E[0] + np.sin(uv[:, :1]) * E[1]) + uv[:, 1:] * E[2]
-        if np.abs(X - xyz).max() > 1e-9 * self.size:
-            return
-        self._cylinders.append((k, O, E, R, b0, b1))
-
-    def _rectangle_distances(self, y):
-        """The faces kept as rectangles or cylinders (their indices) and the points' distances
-        to them."""
-        ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
-        if self._rectangles:
-            k, O, E, b0, b1 = (np.array(v) for v in zip(*self._rectangles))
-            uv = np.clip(np.einsum("pfi,fai->pfa", y[:, None] - O[None], E), b0[None], b1[None])
-            ks.append(k)
-            ds.append(np.linalg.norm(y[:, None] - O[None] - np.einsum("pfa,fai->pfi", uv, E), axis=2))
-        if self._cylinders:
-            k, O, E, R, b0, b1 = (np.array(v) for v in zip(*self._cylinders))
-            q = np.einsum("pfi,fai->pfa", y[:, None] - O[None], E)  # (x, y, z) in each cylinder's frame
-            phi = np.arctan2(q[..., 1], q[..., 0])
-            span = b1[None, :, 0] - b0[None, :, 0]
-            after = np.mod(phi - b0[None, :, 0], 2 * np.pi)  # the angle past the arc's start
-            u = np.where(after <= span, b0[None, :, 0] + after,  # on the arc, else its nearer end
-                         np.where(after - span < 2 * np.pi - after, b1[None, :, 0], b0[None, :, 0]))
-            rho = np.hypot(q[..., 0], q[..., 1])
-            plane = np.hypot(rho * np.cos(phi) - R * np.cos(u), rho * np.sin(phi) - R * np.sin(u))
-            height = q[..., 2] - np.clip(q[..., 2], b0[None, :, 1], b1[None, :, 1])
-            ks.append(k)
-            ds.append(np.hypot(plane, height))
-        return np.concatenate(ks), np.hstack(ds)
+    def _evaluate(self, k, uv):
+        """gmsh's X, J (X_u, X_v) and S (X_uu, X_vv, X_uv) of face k (an index) at parameters uv
+        (the tool's model current)."""
+        m, f, flat = _gmsh().model, self._ents[k][1], np.ravel(uv)
+        return (np.asarray(m.getValue(2, f, flat)).reshape(-1, 3),
+                np.asarray(m.getDerivative(2, f, flat)).reshape(-1, 2, 3),
+                np.asarray(m.getSecondDerivative(2, f, flat)).reshape(-1, 3, 3))
 
     # -- evaluation --------------------------------------------------------------------------
     def closest(self, x, dz: float = 0.0):
@@ -343,12 +387,18 @@ class SurfaceTool:
         shift = self.translation + np.array([0.0, 0.0, dz])
         y = x - shift  # in the model's frame
         npts = len(y)
+        last = self._last if npts else None
+        if last is not None:
+            ref, delta = last.nearest(y)
+            if not delta.any():  # every point given again: the remembered points stay
+                self.counts["repeated"] += npts
+                return (last.c[ref] + shift, last.d[ref], last.n[ref], last.ent[ref], last.par[ref], last.J[ref],
+                        last.S[ref], last.has[ref])
         c, dist, ent, par = np.zeros_like(y), np.full(npts, np.inf), np.full(npts, -1), np.zeros((npts, 2))
         d, n, bound = np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, len(self._ents)))
         J, S, has = np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3)), np.zeros(npts, dtype=bool)
-        last, todo = self._last if npts else None, np.ones(npts, dtype=bool)
+        todo = np.ones(npts, dtype=bool)
         if last is not None:
-            ref, delta = last.nearest(y)
             same = np.flatnonzero(delta == 0.0)
             r = ref[same]
             c[same], dist[same], ent[same], par[same] = last.c[r], last.dist[r], last.ent[r], last.par[r]
@@ -356,11 +406,18 @@ class SurfaceTool:
             J[same], S[same], has[same] = last.J[r], last.S[r], last.has[r]
             todo[same] = False
             self.counts["repeated"] += same.size
-            if same.size == npts:  # every point given again: the remembered points stay
-                return c + shift, d, n, ent, par, J, S, has
         with _Current(self.model) as gmsh:
             m = gmsh.model
             new = np.flatnonzero(todo)
+            if new.size and self._exact_faces.any():
+                upper = last.dist[ref[new]] + delta[new] if last is not None else self._tree.query(y[new])[0]
+                out = self._exact(m, y[new], upper)
+                found = out[-1]
+                rows = new[found]
+                c[rows], dist[rows], ent[rows], par[rows], J[rows], S[rows] = (v[found] for v in out[:6])
+                has[rows], bound[rows] = True, np.nan  # their bounds computed where asked (_remembered_bounds)
+                todo[rows] = False
+                self.counts["exact"] += rows.size
             if last is not None:
                 warm = np.flatnonzero(todo & self._is_face[np.maximum(last.ent[ref], 0)] & (last.ent[ref] >= 0))
                 if warm.size:
@@ -376,11 +433,108 @@ class SurfaceTool:
             self._last = _Projections(y, c, dist, d, n, ent, par, bound, J, S, has)
         return c + shift, d.copy(), n.copy(), ent.copy(), par.copy(), J, S, has
 
-    def _lower(self, y):
-        """The distance of points y to every entity's bounding box (points, entities): a lower
-        bound of their distance to the entity."""
-        return np.linalg.norm(np.maximum(self._box[None, :, 0] - y[:, None], 0.0)
-                              + np.maximum(y[:, None] - self._box[None, :, 1], 0.0), axis=2)
+    def _exact(self, m, y, upper):
+        """Closest points on the faces evaluated in numpy (faces.py) of points y whose distance
+        is at most `upper`: the nearest point in closed form of each filled face whose bounding
+        box lies within upper, each trimmed plane's foot point where it lies inside the trim
+        (its sampled boundary, isInside within the sampling's margin; checked only where it may
+        be the nearest). The nearest of these is the closest point (found) where it lies inside
+        its face's parameter rectangle (not on its boundary: an edge's point, answered by the
+        search as before), the face's parametrisation is regular there, and every entity no
+        exact face answers for (a face of another kind, an edge that bounds no filled exact
+        face) lies farther by its bounding box (less 1e-9 of the tool's size: a tie goes to
+        the search). Ties between faces go to the lower face tag. Returns c, dist, ent, par,
+        J, S and found."""
+        npts, nent = len(y), len(self._ents)
+        faces = self._exact_index
+        pi, k = faces_within(y, upper * (1 + 1e-9) + 1e-9 * self.size, self._box[faces, 0], self._box[faces, 1])
+        k = faces[k]
+        kind_of = self._kind_of[k]
+        D, U = np.full((npts, nent), np.inf), np.zeros((npts, nent, 2))
+        inside = np.zeros((npts, nent), dtype=bool)
+        evaluated = []  # a kind's pairs whose X, J, S its nearest gave
+        for i, kind in enumerate(self._kinds):
+            sel = np.flatnonzero(kind_of == i)
+            if sel.size:
+                p, e = pi[sel], k[sel]
+                out = kind.nearest(y[p], self._position[e])
+                U[p, e], D[p, e], inside[p, e] = out[:3]
+                if len(out) > 3:
+                    evaluated.append((i, p, e, out[3]))
+        sel = np.flatnonzero(kind_of == len(self._kinds))  # the trimmed planes
+        if sel.size:
+            p, e = pi[sel], k[sel]
+            uv, d, _ = self._trimmed_planes.nearest(y[p], self._position[e])
+            check = np.flatnonzero(d <= D.min(axis=1)[p] * (1 + 1e-9) + 1e-9 * self.size)
+            for e0 in np.unique(e[check]):
+                rows = check[e[check] == e0]
+                f = self._ents[e0][1]
+                ins, sure = self._in_trim(f, uv[rows])
+                for i in np.flatnonzero(~sure):
+                    ins[i] = m.isInside(2, f, uv[rows[i]], True) > 0
+                rows = rows[ins]
+                U[p[rows], e0], D[p[rows], e0], inside[p[rows], e0] = uv[rows], d[rows], True
+        best = np.argmin(D, axis=1)
+        r = np.arange(npts)
+        dist, par = D[r, best], U[r, best]
+        found = np.isfinite(dist) & inside[r, best]
+        if self._rest.size:
+            found &= self._lower(y, self._rest).min(axis=1) > dist * (1 + 1e-9) + 1e-9 * self.size
+        c, J, S = np.zeros((npts, 3)), np.zeros((npts, 2, 3)), np.zeros((npts, 3, 3))
+        for i, p, e, (Xe, Je, Se) in evaluated:
+            w = found[p] & (best[p] == e)
+            c[p[w]], J[p[w]], S[p[w]] = Xe[w], Je[w], Se[w]
+        for i, kind in enumerate(self._kinds + [self._trimmed_planes]):
+            rows = np.flatnonzero(found & (self._kind_of[best] == i))
+            if rows.size and i not in [v[0] for v in evaluated]:
+                c[rows], J[rows], S[rows] = kind.derivatives(self._position[best[rows]], par[rows])
+        cross = faces_cross(J[:, 0], J[:, 1])
+        found &= np.einsum("pi,pi->p", cross, cross) > 1e-24 * np.einsum("pai,pai->p", J, J) ** 2  # not a pole
+        r = y - c
+        dist = np.where(found, np.sqrt(np.einsum("pi,pi->p", r, r)), dist)
+        return c, dist, best, par, J, S, found
+
+    def _face_distances(self, y, kinds):
+        """The faces of `kinds` (their indices) and the points' distances to them (points,
+        faces), in closed form (faces.py; a trimmed plane's: to its plane)."""
+        ks, ds = [np.zeros(0, dtype=int)], [np.zeros((len(y), 0))]
+        for kind in kinds:
+            if len(kind):
+                j = np.tile(np.arange(len(kind)), len(y))
+                ks.append(np.asarray(kind.index))
+                ds.append(kind.nearest(np.repeat(y, len(kind), axis=0), j)[1].reshape(len(y), -1))
+        return np.concatenate(ks), np.hstack(ds)
+
+    def _exact_distances(self, y):
+        """The faces evaluated in numpy that fill their parameter rectangle (their indices) and
+        the points' distances to them (in closed form)."""
+        return self._face_distances(y, self._covering)
+
+    def _remembered_bounds(self, last, ref):
+        """The lower bounds of the remembered points ref's distances to every entity (points,
+        entities); those of points the exact pass answered computed now: the bounding boxes',
+        raised to the exact faces' distances and the trimmed planes' distances to their
+        planes."""
+        bound = last.bound[ref]
+        miss = np.flatnonzero(np.isnan(bound[:, 0]))
+        if miss.size:
+            y = last.y[ref[miss]]
+            sub = self._lower(y)
+            k, d = self._face_distances(y, self._covering + [self._trimmed_planes])
+            sub[:, k] = np.maximum(sub[:, k], d)
+            bound[miss] = sub
+        return bound
+
+    def _lower(self, y, entities=slice(None)):
+        """The distance of points y to the entities' bounding boxes (points, entities; every
+        entity unless given): a lower bound of their distance to the entity."""
+        lo, hi = self._box[entities, 0], self._box[entities, 1]
+        square = 0.0
+        for a in range(3):
+            t = np.maximum(lo[:, a] - y[:, a, None], y[:, a, None] - hi[:, a])
+            np.maximum(t, 0.0, out=t)
+            square = square + t * t
+        return np.sqrt(square)
 
     def _search(self, m, y):
         """Closest points: first the local projection from the nearest sample (_local), where
@@ -517,7 +671,7 @@ class SurfaceTool:
             X[sel], ok[sel], J[sel], S[sel] = self._newton(m, self._ents[k][1], uv, y[warm[sel]])
             uvs[sel] = uv
             d[sel] = np.linalg.norm(y[warm[sel]] - X[sel], axis=1)
-        lower = last.bound[ref] - delta[:, None]
+        lower = self._remembered_bounds(last, ref) - delta[:, None]
         known = np.zeros_like(lower, dtype=bool)
         for k in np.unique(ks):
             sel = np.flatnonzero((ks == k) & ok)
@@ -526,7 +680,7 @@ class SurfaceTool:
         sure = ok & (d <= others)
         i = np.flatnonzero(ok & ~sure)
         if i.size:  # the rectangles' and cylinders' distances
-            k, exact = self._rectangle_distances(y[warm[i]])
+            k, exact = self._exact_distances(y[warm[i]])
             lower[np.ix_(i, k)] = np.maximum(lower[np.ix_(i, k)], exact)
             others = np.where(known[i], np.inf, lower[i] - 1e-9 * self.size).min(axis=1)
             sure[i] = d[i] <= others
@@ -619,15 +773,18 @@ class SurfaceTool:
 
     def _trim(self, m, f, uv, inside):
         """A trimmed face's boundary in its parameters: its edges sampled every 1/BOUNDARY_SAMPLES
-        of the tool's size (at least 16 points an edge) as segments; their midpoints in a k-d
-        tree with each segment's normal pointing into the face (isInside at the points half a
-        segment to either side of the midpoint); the margin within which the sampled boundary
-        may differ from the true one (half the longest segment plus twice the largest deviation
-        of an edge's mid-parameter point from its segment). None where the sides are not told apart or where that
-        classifies the sampled parameters `uv` other than isInside does."""
+        of the tool's size (at least 16 points an edge, at most 4096) as segments; their
+        midpoints in a k-d tree with each segment's normal pointing into the face (the face lies
+        on one side of an edge all along it: that side found by isInside at SIDE_TESTS segments
+        spread along the edge, at the points 1/800 of the tool's size to either side of their
+        midpoints, and asked the same at all of them); the margin within which the sampled
+        boundary may differ from the true one (half the longest segment plus twice the largest
+        deviation of an edge's mid-parameter point from its segment). None where the sides are
+        not told apart or where that classifies the sampled parameters `uv` other than isInside
+        does."""
         from scipy.spatial import cKDTree
 
-        mids, normals, margin = [], [], 0.0
+        mids, normals, margin, ends_all = [], [], 0.0, []
         for e in m.getAdjacencies(2, f)[1]:
             e = abs(int(e))
             x0, y0, z0, x1, y1, z1 = m.getBoundingBox(1, e)
@@ -642,31 +799,76 @@ class SurfaceTool:
             keep = length > 0
             normal = np.c_[-chord[:, 1], chord[:, 0]][keep] / length[keep, None]
             centre = 0.5 * (ends[:-1] + ends[1:])[keep]
-            step = 0.5 * length[keep, None] * normal  # OCC's classifier takes points within its tolerance as inside
-            into = np.array([m.isInside(2, f, q, True) > 0 for q in centre + step])
-            out = np.array([m.isInside(2, f, q, True) > 0 for q in centre - step])
-            if np.any(into == out):  # the boundary's sides not told apart
+            # the side, at points clear of OCC's classifier's tolerance (it takes those within as inside)
+            test = np.unique(np.linspace(0, len(centre) - 1, SIDE_TESTS).round().astype(int))
+            step = 0.5 * self.size / 400 * normal[test]
+            into = np.array([m.isInside(2, f, q, True) > 0 for q in centre[test] + step])
+            out = np.array([m.isInside(2, f, q, True) > 0 for q in centre[test] - step])
+            if np.any(into == out) or np.any(into != into[0]):  # the boundary's sides not told apart
                 return None
             mids.append(centre)
-            normals.append(np.where(into[:, None], normal, -normal))
+            normals.append(normal if into[0] else -normal)
+            ends_all.append(ends)
             sag = np.linalg.norm(mid - 0.5 * (ends[:-1] + ends[1:]), axis=1)
             margin = max(margin, 0.5 * float(length.max()) + 2.0 * float(sag.max()))
-        trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size)
+        trim = (cKDTree(np.vstack(mids)), np.vstack(normals), margin * (1 + 1e-6) + 1e-9 * self.size, None)
         self._trims[f] = trim
+        self._trims[f] = trim[:3] + (self._raster(m, f, trim, np.vstack(ends_all)),)
         ins, sure = self._in_trim(f, uv)
-        return trim if bool(np.all(ins[sure] == inside[sure])) else None
+        return self._trims[f] if bool(np.all(ins[sure] == inside[sure])) else None
+
+    def _raster(self, m, f, trim, boundary):
+        """The sides of trimmed face f in a raster of its parameter rectangle (at most RASTER
+        cells along each parameter, of about the margin's size): (origin, cell, inside, sure),
+        cell k centred at origin + k cell. A cell is sure where no sampled boundary point lies
+        within the margin and half the cell's diagonal of its centre: no boundary crosses it.
+        Sure cells that touch hold one side; each such region's is its first cell's (by the
+        nearest boundary segment). None where the face's sampled boundary leaves its parameter
+        rectangle (outside the rectangle a point is outside the face: the face lies within its
+        boundary's hull)."""
+        from scipy.ndimage import label
+
+        tree, normals, margin, _ = trim
+        b0, b1 = (np.asarray(b, dtype=float) for b in m.getParametrizationBounds(2, f))
+        tol = 1e-9 * (b1 - b0 + 1.0)
+        if np.any(boundary < b0 - tol) or np.any(boundary > b1 + tol):
+            return None
+        cells = np.minimum(np.ceil((b1 - b0) / margin), RASTER).astype(int) + 1
+        cell = np.maximum((b1 - b0) / np.maximum(cells - 1, 1), 1e-9 * self.size)
+        centres = np.stack(np.meshgrid(*(b0[a] + cell[a] * np.arange(cells[a]) for a in range(2)), indexing="ij"),
+                           axis=-1).reshape(-1, 2)
+        dist, _ = tree.query(centres, distance_upper_bound=margin + 0.5 * float(np.linalg.norm(cell)))
+        sure = np.isinf(dist).reshape(cells)
+        regions, count = label(sure)
+        first = np.unique(regions.ravel(), return_index=True)[1][1:]  # each region's first cell
+        _, i = tree.query(centres[first])
+        side = np.einsum("pi,pi->p", centres[first] - tree.data[i], normals[i]) > 0
+        return b0, cell, np.r_[False, side][regions], sure
 
     def _in_trim(self, f, uv):
         """(inside, sure) for parameters uv of trimmed face f: inside where uv lies on the inner
         side of its nearest boundary segment, sure where it lies farther from the sampled
-        boundary than the margin (_trim); isInside decides the others."""
+        boundary than the margin (_trim); isInside decides the others. Looked up first in a
+        raster of the face's parameter rectangle (cells of about the margin's size), whose
+        cells no boundary crosses (their centres farther than the margin and half the cell's
+        diagonal from it) hold their side."""
         trim = self._trims.get(f)
         if trim is None:
             return np.zeros(len(uv), dtype=bool), np.zeros(len(uv), dtype=bool)
-        tree, normals, margin = trim
-        dist, i = tree.query(uv)
-        inside = np.einsum("pi,pi->p", uv - tree.data[i], normals[i]) > 0
-        return inside, dist > margin
+        tree, normals, margin, raster = trim
+        inside, sure = np.zeros(len(uv), dtype=bool), np.zeros(len(uv), dtype=bool)
+        if raster is not None:
+            origin, cell, ins, known = raster
+            k = np.floor((uv - origin) / cell + 0.5).astype(int)
+            on = np.all((k >= 0) & (k < np.array(ins.shape)), axis=1)
+            inside[on], sure[on] = ins[k[on, 0], k[on, 1]], known[k[on, 0], k[on, 1]]
+            sure[~on] = True  # outside the parameter rectangle: outside the face
+        rest = np.flatnonzero(~sure)
+        if rest.size:
+            dist, i = tree.query(uv[rest])
+            inside[rest] = np.einsum("pi,pi->p", uv[rest] - tree.data[i], normals[i]) > 0
+            sure[rest] = dist > margin
+        return inside, sure
 
     def _signed(self, gmsh, y, c, dist, ent, par, J, has):
         """Signed distances and normals (module docstring); on a face the normal X_u x X_v
@@ -675,18 +877,16 @@ class SurfaceTool:
         m = gmsh.model
         n = np.zeros((len(y), 3))
         d = dist.copy()
-        for k in np.unique(ent):
+        rows = np.flatnonzero(has)
+        if rows.size:
+            cross = faces_cross(J[rows, 0], J[rows, 1])
+            n[rows] = (self.sign * self._orientation[ent[rows]] / np.linalg.norm(cross, axis=1))[:, None] * cross
+            d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], n[rows])
+        for k in np.unique(ent[~has]) if not has.all() else ():
             dim, t = self._ents[k]
-            rows = np.flatnonzero(ent == k)
+            rows = np.flatnonzero((ent == k) & ~has)
             if dim == 2:
-                nc = np.zeros((rows.size, 3))
-                at = has[rows]
-                if at.any():
-                    cross = np.cross(J[rows[at], 0], J[rows[at], 1])
-                    nc[at] = self._orient[t] * cross / np.linalg.norm(cross, axis=1)[:, None]
-                if not at.all():
-                    nc[~at] = np.asarray(m.getNormal(t, par[rows[~at]].ravel())).reshape(-1, 3)
-                nc *= self.sign
+                nc = self.sign * np.asarray(m.getNormal(t, par[rows].ravel())).reshape(-1, 3)
                 n[rows] = nc
                 d[rows] = np.einsum("ij,ij->i", y[rows] - c[rows], nc)
             else:
@@ -723,7 +923,7 @@ class SurfaceTool:
         c, d, n, ent, par, J, S, has = self._closest(x, dz)
         H = np.zeros((len(x), 3, 3))
         if has.any():  # the derivatives of the Newton that found the point
-            H[has] = self._hessian(J[has], S[has], n[has], d[has])
+            H[has] = distance_hessian(J[has], S[has], n[has], d[has])
         if has.all():
             return H + 0.0
         with _Current(self.model) as gmsh:
@@ -754,24 +954,7 @@ class SurfaceTool:
         """H0 (I + d H0)^-1 at the face's parameters uv, n the (turned) normals, d the distances."""
         J = np.asarray(m.getDerivative(2, f, uv.ravel())).reshape(-1, 2, 3)  # rows X_u, X_v
         S = np.asarray(m.getSecondDerivative(2, f, uv.ravel())).reshape(-1, 3, 3)  # X_uu, X_vv, X_uv
-        return self._hessian(J, S, n, d)
-
-    @staticmethod
-    def _hessian(J, S, n, d):
-        """H0 (I + d H0)^-1 from the derivatives J (X_u, X_v) and S (X_uu, X_vv, X_uv)."""
-        B = -np.einsum("pki,pi->pk", S, n)  # -n . (X_uu, X_vv, X_uv)
-        B = np.stack([np.stack([B[:, 0], B[:, 2]], 1), np.stack([B[:, 2], B[:, 1]], 1)], 1)
-        G = np.einsum("pai,pbi->pab", J, J)
-        det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] * G[:, 1, 0]
-        regular = det > 1e-12 * (G[:, 0, 0] + G[:, 1, 1]) ** 2
-        Gi = np.stack([np.stack([G[:, 1, 1], -G[:, 0, 1]], 1), np.stack([-G[:, 1, 0], G[:, 0, 0]], 1)], 1) \
-            / np.where(regular, det, 1.0)[:, None, None]
-        if not regular.all():  # a singular parametrisation (a pole): the pseudo-inverse
-            Gi[~regular] = np.linalg.pinv(G[~regular])
-        A = np.einsum("pai,pab->pbi", J, Gi)  # G^-1 J^T as (p, 2, 3): rows the dual basis
-        H0 = np.einsum("pai,pab,pbj->pij", A, B, A)
-        H0 = 0.5 * (H0 + H0.transpose(0, 2, 1))
-        return H0 @ np.linalg.inv(np.eye(3) + d[:, None, None] * H0)
+        return distance_hessian(J, S, n, d)
 
     # -- the binder ----------------------------------------------------------------------------
     def flat_top_boundary(self, spacing: float = 0.25) -> list[np.ndarray]:
@@ -798,7 +981,6 @@ class SurfaceTool:
                 if _degenerate(gmsh, c):
                     continue
                 t0, t1 = (float(np.ravel(v)[0]) for v in m.getParametrizationBounds(1, c))
-                x0, x1 = (np.asarray(m.getValue(1, c, [t])) for t in (t0, t1))
                 steps = max(int(np.ceil(_curve_length(m, c, t0, t1) / spacing)), 2)
                 pieces.append(np.asarray(m.getValue(1, c, np.linspace(t0, t1, steps + 1))).reshape(-1, 3))
         return closed_loops(pieces, 1e-6 * self.size)
@@ -807,4 +989,3 @@ class SurfaceTool:
 def _curve_length(m, c, t0, t1, n=64):
     x = np.asarray(m.getValue(1, c, np.linspace(t0, t1, n + 1))).reshape(-1, 3)
     return float(np.linalg.norm(np.diff(x, axis=0), axis=1).sum())
-

@@ -1,0 +1,514 @@
+"""Elementary faces of a CAD tool evaluated from their parameters, without gmsh (docs/tools.md,
+"How a surface is evaluated").
+
+A CAD tool's faces are mostly OpenCASCADE's elementary surfaces: planes, cylinders, tori,
+spheres and surfaces of revolution of a circle arc (a fillet's corner). Each kind's class holds
+the faces of that kind of one tool, their geometric parameters fitted once from gmsh's
+evaluations of the face (gmsh names the surface's kind, not its parameters) and verified
+against gmsh's point, first and second derivatives at the face's samples: a face whose
+parametrisation is not the one fitted is refused (`add` returns False) and left to gmsh.
+
+For points y and faces j of the kind (pairs: an index of a face of the kind per point):
+
+    nearest(y, j)         the nearest point of face j's parameter rectangle to y in closed form:
+                          its parameters, its distance, and whether it lies inside the
+                          rectangle (within `tol` of each bound: the parameters are then the
+                          untrimmed surface's foot point, which may lie up to `tol` outside),
+                          not clamped onto its boundary;
+    derivatives(j, uv)    the point X and its derivatives J = (X_u, X_v), S = (X_uu, X_vv, X_uv)
+                          of face j (an index per point) at parameters uv, as gmsh orders them.
+
+The nearest point is exact where the face fills its parameter rectangle (a trimmed face's
+projection must be checked against its trim by the tool). Planes, cylinders and revolutions of
+a circle do both in loops compiled by numba over the pairs (their parameters rows of one array,
+in each kind's LAYOUT); a curve meridian's Newton calls gmsh. Also here, compiled: the pairs of
+points and boxes within reach (within) and the distance's Hessian from a face's derivatives
+(shape_operators).
+"""
+
+import numpy as np
+
+from shellform._jit import njit
+
+TWO_PI = 2.0 * np.pi
+MERIDIAN_SAMPLES = 1024  # points of a curve meridian whose angles about its fitted circle start Newton
+
+
+def _arc(phi, lo, hi, tol):
+    """The angle nearest to the angle phi in the arc [lo, hi] (angles modulo 2 pi, hi - lo <=
+    2 pi): phi's representative where it lies within tol of the arc (inside True), else the
+    arc's nearer end by angle (on a circle the distance grows with the angle between)."""
+    span = hi - lo
+    after = np.mod(phi - lo, TWO_PI)  # the angle past the arc's start, in [0, 2 pi)
+    before = TWO_PI - after  # the angle before its start
+    on = after <= span + tol
+    early = ~on & (before <= tol)
+    u = np.where(on, lo + after, np.where(early, lo - before, np.where(after - span < before, hi, lo)))
+    return u, on | early
+
+
+def cross(a, b):
+    """a x b of (points, 3) arrays (numpy's cross, fewer calls)."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+
+
+def _close(a, b, tol) -> bool:
+    return bool(np.abs(np.asarray(a) - np.asarray(b)).max(initial=0.0) <= tol)
+
+
+# -- the closed forms, compiled (numba: one call a kind instead of tens of numpy calls) ----------
+# A kind's faces' parameters are rows of one array (_Kind._packed), in the order of its LAYOUT.
+
+
+@njit
+def _interval1(p, lo, hi, tol):
+    """The parameter nearest to p in [lo, hi]: p itself where it lies within tol of the
+    interval (inside True), else the nearer bound."""
+    if p >= lo - tol and p <= hi + tol:
+        return p, True
+    return min(max(p, lo), hi), False
+
+
+@njit
+def _arc1(phi, lo, hi, tol):
+    """_arc of one angle."""
+    span = hi - lo
+    after = (phi - lo) % TWO_PI  # as np.mod: fmod (exact), turned non-negative
+    before = TWO_PI - after
+    if after <= span + tol:
+        return lo + after, True
+    if before <= tol:
+        return lo - before, True
+    return (hi, False) if after - span < before else (lo, False)
+
+
+@njit
+def _planes_nearest(y, j, rows, uv, d, inside):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
+        u, iu = _interval1(dx * q[3] + dy * q[4] + dz * q[5], q[9], q[11], q[13])
+        v, iv = _interval1(dx * q[6] + dy * q[7] + dz * q[8], q[10], q[12], q[14])
+        rx, ry, rz = dx - (u * q[3] + v * q[6]), dy - (u * q[4] + v * q[7]), dz - (u * q[5] + v * q[8])
+        uv[p, 0], uv[p, 1], d[p], inside[p] = u, v, np.sqrt(rx * rx + ry * ry + rz * rz), iu and iv
+
+
+@njit
+def _planes_derivatives(j, uv, rows, X, J, S):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        for i in range(3):
+            X[p, i] = q[i] + uv[p, 0] * q[3 + i] + uv[p, 1] * q[6 + i]
+            J[p, 0, i], J[p, 1, i] = q[3 + i], q[6 + i]
+            S[p, 0, i] = S[p, 1, i] = S[p, 2, i] = 0.0
+
+
+@njit
+def _cylinders_nearest(y, j, rows, uv, d, inside):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
+        qx, qy, qz = dx * q[3] + dy * q[4] + dz * q[5], dx * q[6] + dy * q[7] + dz * q[8], \
+            dx * q[9] + dy * q[10] + dz * q[11]
+        phi = np.arctan2(qy, qx)
+        u, iu = _arc1(phi, q[13], q[15], q[17])
+        v, iv = _interval1(qz, q[14], q[16], q[18])
+        rho, turn = np.hypot(qx, qy), u - phi
+        d[p] = np.sqrt((rho * np.cos(turn) - q[12]) ** 2 + (rho * np.sin(turn)) ** 2 + (qz - v) ** 2)
+        uv[p, 0], uv[p, 1], inside[p] = u, v, iu and iv
+
+
+@njit
+def _cylinders_derivatives(j, uv, rows, X, J, S):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        c, s, R = np.cos(uv[p, 0]), np.sin(uv[p, 0]), q[12]
+        for i in range(3):
+            radial = c * q[3 + i] + s * q[6 + i]
+            X[p, i] = q[i] + R * radial + uv[p, 1] * q[9 + i]
+            J[p, 0, i], J[p, 1, i] = R * (-s * q[3 + i] + c * q[6 + i]), q[9 + i]
+            S[p, 0, i], S[p, 1, i], S[p, 2, i] = -R * radial, 0.0, 0.0
+
+
+@njit
+def _revolutions_nearest(y, j, rows, uv, d, inside):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
+        qw, qb, qa = dx * q[12] + dy * q[13] + dz * q[14], dx * q[15] + dy * q[16] + dz * q[17], \
+            dx * q[18] + dy * q[19] + dz * q[20]  # y along w_0, b_0 and a
+        rho, phi = np.hypot(qw, qb), np.arctan2(qb, qw)
+        u, iu = _arc1(phi, q[28], q[30], q[32])
+        turn = u - phi
+        sx, sy = rho * np.cos(turn) - q[21], qa - q[22]  # y in the meridian's plane, from c
+        v, iv = _arc1(np.arctan2(sx * q[26] + sy * q[27], sx * q[24] + sy * q[25]), q[29], q[31], q[33])
+        cv, sv = np.cos(v), np.sin(v)
+        mr, mh = q[21] + q[23] * (cv * q[24] + sv * q[26]), q[22] + q[23] * (cv * q[25] + sv * q[27])
+        d[p] = np.sqrt((rho * np.cos(turn) - mr) ** 2 + (qa - mh) ** 2 + (rho * np.sin(turn)) ** 2)
+        uv[p, 0], uv[p, 1], inside[p] = u, v, iu and iv
+
+
+@njit
+def _revolutions_derivatives(j, uv, rows, X, J, S):
+    for p in range(len(j)):
+        q = rows[j[p]]
+        cu, su, cv, sv, r = np.cos(uv[p, 0]), np.sin(uv[p, 0]), np.cos(uv[p, 1]), np.sin(uv[p, 1]), q[23]
+        m0, m1 = q[21] + r * (cv * q[24] + sv * q[26]), q[22] + r * (cv * q[25] + sv * q[27])  # (rho, h)
+        d0, d1 = r * (-sv * q[24] + cv * q[26]), r * (-sv * q[25] + cv * q[27])
+        e0, e1 = -r * (cv * q[24] + sv * q[26]), -r * (cv * q[25] + sv * q[27])
+        for i in range(3):
+            w, b, a = cu * q[6 + i] + su * q[9 + i], -su * q[6 + i] + cu * q[9 + i], q[3 + i]
+            X[p, i] = q[i] + m0 * w + m1 * a
+            J[p, 0, i], J[p, 1, i] = m0 * b, d0 * w + d1 * a
+            S[p, 0, i], S[p, 1, i], S[p, 2, i] = -m0 * w, e0 * w + e1 * a, d0 * b
+
+
+@njit
+def _within(y, reach, lo, hi, pi, k):
+    count = 0
+    for p in range(y.shape[0]):
+        for f in range(lo.shape[0]):
+            square = 0.0
+            for i in range(3):
+                t = max(lo[f, i] - y[p, i], y[p, i] - hi[f, i], 0.0)
+                square += t * t
+            if np.sqrt(square) <= reach[p]:
+                pi[count], k[count] = p, f
+                count += 1
+    return count
+
+
+def within(y, reach, lo, hi):
+    """The pairs (point, box) whose box [lo, hi] lies within reach of the point (its distance to
+    the box): point and box indices, by point then box."""
+    pi, k = np.empty(len(y) * len(lo), dtype=np.int64), np.empty(len(y) * len(lo), dtype=np.int64)
+    count = _within(np.ascontiguousarray(y, dtype=float), np.ascontiguousarray(reach, dtype=float),
+                    np.ascontiguousarray(lo), np.ascontiguousarray(hi), pi, k)
+    return pi[:count], k[:count]
+
+
+@njit
+def _shape_operators(J, S, n, d, H, regular):
+    for p in range(len(d)):
+        b = np.zeros(3)
+        for a in range(3):
+            b[a] = -(S[p, a, 0] * n[p, 0] + S[p, a, 1] * n[p, 1] + S[p, a, 2] * n[p, 2])
+        g0 = J[p, 0, 0] ** 2 + J[p, 0, 1] ** 2 + J[p, 0, 2] ** 2
+        g1 = J[p, 1, 0] ** 2 + J[p, 1, 1] ** 2 + J[p, 1, 2] ** 2
+        g2 = J[p, 0, 0] * J[p, 1, 0] + J[p, 0, 1] * J[p, 1, 1] + J[p, 0, 2] * J[p, 1, 2]
+        det = g0 * g1 - g2 ** 2
+        regular[p] = det > 1e-12 * (g0 + g1) ** 2
+        if not regular[p]:
+            continue
+        k0, k1, k2 = g0 + d[p] * b[0], g1 + d[p] * b[1], g2 + d[p] * b[2]  # G + d B
+        m00, m01 = b[0] * k1 - b[2] * k2, b[2] * k0 - b[0] * k2  # B adj(G + d B)
+        m10, m11 = b[2] * k1 - b[1] * k2, b[1] * k0 - b[2] * k2
+        scale = 1.0 / (det * (k0 * k1 - k2 ** 2))
+        w00 = (g1 * m00 - g2 * m10) * scale  # adj(G) B adj(G + d B) / (det G det(G + d B))
+        w11 = (g0 * m11 - g2 * m01) * scale
+        w01 = 0.5 * ((g1 * m01 - g2 * m11) + (g0 * m10 - g2 * m00)) * scale
+        for j in range(3):
+            v0 = w00 * J[p, 0, j] + w01 * J[p, 1, j]
+            v1 = w01 * J[p, 0, j] + w11 * J[p, 1, j]
+            for i in range(3):
+                H[p, i, j] = J[p, 0, i] * v0 + J[p, 1, i] * v1
+
+
+def shape_operators(J, S, n, d):
+    """H0 (I + d H0)^-1 of surfaces at distance d (docs/tools.md), from the derivatives J (X_u,
+    X_v) and S (X_uu, X_vv, X_uv) and the normals n: with G = J J^T, B_ab = -n . X_ab and A =
+    G^-1 J (the dual basis; A J^T = I) it is J^T W J, W = G^-1 B (G + d B)^-1 (2 x 2, symmetric):
+    H0 (I + d H0)^-1 = A^T B (I + d A A^T B)^-1 A and A A^T = G^-1. Returns H and where G is
+    regular (H is left 0 where it is singular: a pole)."""
+    H, regular = np.zeros((len(d), 3, 3)), np.empty(len(d), dtype=np.bool_)
+    _shape_operators(np.ascontiguousarray(J, dtype=float), np.ascontiguousarray(S, dtype=float),
+                     np.ascontiguousarray(n, dtype=float), np.ascontiguousarray(d, dtype=float), H, regular)
+    return H, regular
+
+
+class _Kind:
+    """The faces of one kind: their indices in the tool (`index`), parameter bounds and
+    tolerances, and each kind's parameters (arrays with the face first)."""
+
+    def __init__(self, size: float):
+        self.size = size
+        self.index, self.b0, self.b1, self.tol, self._params = [], [], [], [], []
+
+    def __len__(self):
+        return len(self.index)
+
+    def _keep(self, index, b0, b1, params, X, J, S, uv, model=None) -> bool:
+        """Keeps the face where the fitted parametrisation (`model`: X, J, S at uv; this kind's
+        derivatives unless given) gives gmsh's X, J and S at its samples uv to round-off (1e-12
+        of the tool's size, the derivatives of their own size)."""
+        self._params.append(params)
+        self.index.append(index)
+        self.b0.append(np.asarray(b0, dtype=float))
+        self.b1.append(np.asarray(b1, dtype=float))
+        self.tol.append(1e-9 * (np.asarray(b1, dtype=float) - b0 + 1.0))
+        self._stack()
+        Xf, Jf, Sf = model if model is not None else self.derivatives(np.full(len(uv), len(self) - 1), uv)
+        scale = max(np.abs(J).max(initial=0.0), np.abs(S).max(initial=0.0), 1.0)
+        if _close(Xf, X, 1e-12 * self.size) and _close(Jf, J, 1e-12 * scale) and _close(Sf, S, 1e-12 * scale):
+            return True
+        for rows in (self._params, self.index, self.b0, self.b1, self.tol):
+            rows.pop()
+        self._stack()
+        return False
+
+    def _stack(self):
+        self.lo, self.hi, self.eps = (np.array(v).reshape(-1, 2) for v in (self.b0, self.b1, self.tol))
+        self.p = {k: np.array([q[k] for q in self._params]) for k in (self._params[0] if self._params else ())
+                  if k not in ("theta", "v")}
+        self.p.update(lo=self.lo, hi=self.hi, eps=self.eps)
+        # every face's parameters in one row, gathered for pairs by one index (_gather)
+        self._packed = np.hstack([v.reshape(len(self.lo), -1) for v in self.p.values()]) if self._params else None
+        ends = np.cumsum([0] + [int(np.prod(v.shape[1:])) for v in self.p.values()])
+        self._slices = [(k, slice(a, b), v.shape[1:]) for (k, v), a, b in zip(self.p.items(), ends[:-1], ends[1:])]
+
+        if self._params and self.LAYOUT is not None:  # the compiled kernels' columns
+            assert [(k, cut.start) for k, cut, _ in self._slices] == list(self.LAYOUT.items()), self._slices
+
+    LAYOUT = None  # name -> first column of the packed rows, for the compiled kernels
+    KERNELS = None  # (nearest, derivatives) compiled
+
+    def _gather(self, j):
+        """The parameters of faces j (one per pair): name -> array (pairs, ...)."""
+        rows = self._packed[j]
+        return {k: rows[:, cut].reshape((len(j),) + shape) for k, cut, shape in self._slices}
+
+    def nearest(self, y, j):
+        n = len(j)
+        uv, d, inside = np.empty((n, 2)), np.empty(n), np.empty(n, dtype=np.bool_)
+        self.KERNELS[0](np.ascontiguousarray(y), np.asarray(j, dtype=np.int64), self._packed, uv, d, inside)
+        return uv, d, inside
+
+    def derivatives(self, j, uv):
+        n = len(j)
+        X, J, S = np.empty((n, 3)), np.empty((n, 2, 3)), np.empty((n, 3, 3))
+        self.KERNELS[1](np.asarray(j, dtype=np.int64), np.ascontiguousarray(uv, dtype=float), self._packed, X, J, S)
+        return X, J, S
+
+
+class Planes(_Kind):
+    """Planes X = O + u E_u + v E_v, E_u and E_v orthonormal (OCC's planes). The nearest point
+    of the rectangle [u0, u1] x [v0, v1] is X at the clamped (E . (y - O)): the rectangle's
+    sides are orthogonal. A trimmed plane is given infinite bounds: the foot point of the
+    plane."""
+
+    LAYOUT = {"O": 0, "E": 3, "lo": 9, "hi": 11, "eps": 13}
+    KERNELS = (_planes_nearest, _planes_derivatives)
+
+    def add(self, index, b0, b1, X, J, S, uv) -> bool:
+        E = J[0]
+        if not _close(E @ E.T, np.eye(2), 1e-12) or not _close(J, E, 1e-12 * np.abs(E).max()):
+            return False
+        O = X[0] - uv[0] @ E
+        return self._keep(index, b0, b1, {"O": O, "E": E}, X, J, S, uv)
+
+class Cylinders(_Kind):
+    """Cylinders X = O + R (cos u E_x + sin u E_y) + v E_z, E orthonormal (OCC's cylinders), an
+    arc u in [u0, u1] times a segment v in [v0, v1]: the nearest point's u is the arc's nearest
+    angle to y's angle about the axis, its v y's height clamped."""
+
+    LAYOUT = {"O": 0, "E": 3, "R": 12, "lo": 13, "hi": 15, "eps": 17}
+    KERNELS = (_cylinders_nearest, _cylinders_derivatives)
+
+    def add(self, index, b0, b1, X, J, S, uv, origin) -> bool:
+        """origin: gmsh's X, J, S at (u, v) = (0, 0), from which E and R are read."""
+        X0, J0, S0 = origin
+        R = float(np.linalg.norm(S0[0]))
+        if not R > 1e-9 * self.size or b1[0] - b0[0] > TWO_PI + 1e-12:
+            return False
+        E = np.array([-S0[0] / R, J0[0] / R, J0[1]])
+        if not _close(E @ E.T, np.eye(3), 1e-12):
+            return False
+        return self._keep(index, b0, b1, {"O": X0 - R * E[0], "E": E, "R": R}, X, J, S, uv)
+
+class Revolutions(_Kind):
+    """Surfaces swept by a circle arc turning about an axis in the arc's plane: tori, spheres and
+    OCC's surfaces of revolution of a circle (a fillet's corner). With A a point of the axis,
+    a its direction, w(u) = cos u w_0 + sin u b_0 (b_0 = a x w_0) the radial direction at the
+    turn u, and the meridian arc (rho(v), h(v)) = c + r (cos v f_1 + sin v f_2) in the
+    half-plane (w, a),
+
+        X(u, v) = A + rho(v) w(u) + h(v) a.
+
+    Where rho >= 0 on the arc (it does not cross the axis), |X - y|^2 = rho_y^2 + rho^2 -
+    2 rho_y rho cos(u - phi_y) + (h_y - h)^2 (y at radius rho_y, angle phi_y and height h_y):
+    for every v the nearest u is the arc's nearest angle to phi_y, whatever v. In the half-plane
+    of that u, y lies at (rho_y cos(u - phi_y), h_y) and rho_y sin(u - phi_y) out of it, and the
+    nearest v is the meridian arc's nearest angle to y's angle about the circle's centre c."""
+
+    LAYOUT = {"A": 0, "a": 3, "w0": 6, "b0": 9, "frame": 12, "c": 21, "r": 23, "f1": 24, "f2": 26, "lo": 28, "hi": 30,
+              "eps": 32}
+    KERNELS = (_revolutions_nearest, _revolutions_derivatives)
+
+    def add(self, index, b0, b1, X, J, S, uv, middle) -> bool:
+        """middle: gmsh's (u, v), X, J, S at a point where the face is not on the axis (rho >
+        0), from which the axis, the radial frame and the meridian circle are read: X_uu = -rho
+        w, X_u = rho b, and the meridian's (rho, h)'' = -((rho, h) - c)."""
+        (um, vm), Xm, Jm, Sm = middle
+        rho = float(np.linalg.norm(Sm[0]))
+        if not rho > 1e-9 * self.size:
+            return False
+        w, b = -Sm[0] / rho, Jm[0] / rho
+        a = np.cross(w, b)
+        A = Xm + Sm[0]  # the centre of the parallel through Xm, on the axis
+        w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
+        if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
+            return False
+        p, dp, ddp = np.array([rho, 0.0]), Jm[1] @ np.array([w, a]).T, Sm[1] @ np.array([w, a]).T
+        r = float(np.linalg.norm(ddp))
+        if not r > 1e-9 * self.size:
+            return False
+        c = p + ddp
+        f1 = (np.cos(vm) * (p - c) - np.sin(vm) * dp) / r
+        f2 = (np.sin(vm) * (p - c) + np.cos(vm) * dp) / r
+        if not _close(np.array([f1, f2]) @ np.array([f1, f2]).T, np.eye(2), 1e-12):
+            return False
+        # the meridian arc stays on one side of the axis: rho(v) >= 0 at its ends and extremes
+        psi = np.arctan2(f2[0], f1[0])  # rho(v) = c_0 + m cos(v - psi)
+        m = np.hypot(f1[0], f2[0]) * r
+        v = np.array([b0[1], b1[1]])
+        v = np.concatenate([v, psi + np.pi + TWO_PI * np.arange(np.ceil((b0[1] - psi - np.pi) / TWO_PI),
+                                                                np.floor((b1[1] - psi - np.pi) / TWO_PI) + 1)])
+        if np.min(c[0] + m * np.cos(v - psi)) < -1e-12 * self.size or b1[0] - b0[0] > TWO_PI + 1e-12 \
+                or b1[1] - b0[1] > TWO_PI + 1e-12:
+            return False
+        params = {"A": A, "a": a, "w0": w0, "b0": b0_, "frame": np.array([w0, b0_, a]), "c": c, "r": r, "f1": f1,
+                  "f2": f2}
+        return self._keep(index, b0, b1, params, X, J, S, uv)
+
+class CurveRevolutions(_Kind):
+    """Surfaces of revolution whose meridian is not a circle (OCC's surfaces of revolution of a
+    B-spline: a fillet's corner written to STEP, whose meridian approximates a circle), X(u, v)
+    = A + rho(v) w(u) + h(v) a as for Revolutions, the meridian (rho, h)(v) evaluated by gmsh:
+    `evaluate(j, uv)` gives X, J, S of face j at parameters uv.
+
+    Where rho >= 0 the nearest u is the arc's nearest angle to y's, whatever v (Revolutions);
+    along that meridian Newton minimises |X(u, v) - y|^2 over v, from the v of the nearest point
+    of the circle fitted to the meridian (v interpolated in the angles about its centre of
+    MERIDIAN_SAMPLES points of the meridian; none where that angle lies beyond the meridian's
+    ends by more than ten times the meridian's largest departure from the circle in angle:
+    the face's nearest point lies on its boundary), until a step moves the point by less than 1e-13
+    of the tool's size (the point: the last evaluation plus that step; J and S the last
+    evaluation's). A pair whose Newton does not converge inside the face is not inside (its
+    distance inf): the face's nearest point lies on its boundary. `nearest` also returns the
+    pairs' X, J and S (gmsh's evaluations, which `derivatives` would repeat)."""
+
+    def __init__(self, size: float, evaluate):
+        super().__init__(size)
+        self.evaluate = evaluate
+
+    def add(self, index, b0, b1, X, J, S, uv, middle, meridian) -> bool:
+        """middle: gmsh's (u, v), X, J, S at the face's middle (the axis and the radial frame,
+        as for Revolutions); meridian: gmsh's X, J, S at (u_m, v) for the samples' v. Kept where
+        the surface is the meridian turned about the axis by u at the samples, to round-off.
+        The start's table from the meridian at MERIDIAN_SAMPLES values of v (evaluate)."""
+        (um, vm), Xm, Jm, Sm = middle
+        rho = float(np.linalg.norm(Sm[0]))
+        if not rho > 1e-9 * self.size:
+            return False
+        w, b = -Sm[0] / rho, Jm[0] / rho
+        a = np.cross(w, b)
+        if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
+            return False
+        A = Xm + Sm[0]
+        w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
+        frame = np.array([w0, b0_, a])
+        Xr, Jr, Sr = meridian
+        wa = np.array([w, a])
+        # the meridian's (rho, h) at the samples and its v-derivatives
+        P, dP, ddP = (np.einsum("pi,ki->pk", V, wa) for V in (Xr - A, Jr[:, 1], Sr[:, 1]))
+        if np.min(P[:, 0]) < 0.0 or b1[0] - b0[0] > TWO_PI + 1e-12:
+            return False
+        cu, su = np.cos(uv[:, :1]), np.sin(uv[:, :1])
+        wu, bu = cu * w0 + su * b0_, -su * w0 + cu * b0_
+        model = (A + P[:, :1] * wu + P[:, 1:] * a,
+                 np.stack([P[:, :1] * bu, dP[:, :1] * wu + dP[:, 1:] * a], axis=1),
+                 np.stack([-P[:, :1] * wu, ddP[:, :1] * wu + ddP[:, 1:] * a, dP[:, :1] * bu], axis=1))
+        # the circle nearest the meridian's samples (|P - c|^2 = r^2: linear in c and r^2 - |c|^2)
+        sol = np.linalg.lstsq(np.c_[2.0 * P, np.ones(len(P))], np.einsum("pk,pk->p", P, P), rcond=None)[0]
+        c = sol[:2]
+        r = float(np.sqrt(sol[2] + c @ c))
+        if not np.abs(np.linalg.norm(P - c, axis=1) - r).max() <= 1e-3 * r:
+            return False
+        v = np.linspace(b0[1], b1[1], MERIDIAN_SAMPLES)
+        Xq, Jq, _ = self.evaluate(index, np.c_[np.full(len(v), um), v])
+        Q, dQ = np.einsum("pi,ki->pk", Xq - A, wa), np.einsum("pi,ki->pk", Jq[:, 1], wa)
+        theta = np.arctan2(Q[:, 1] - c[1], Q[:, 0] - c[0])
+        # how far the angle about c of a point's foot may lie from its own: the meridian's
+        # distance from the circle over r and the angle between its tangent and the circle's
+        radial = (Q - c) / np.linalg.norm(Q - c, axis=1)[:, None]
+        slope = np.abs(np.einsum("pk,pk->p", dQ, radial)) / np.linalg.norm(dQ, axis=1)
+        slack = 10.0 * (np.abs(np.linalg.norm(Q - c, axis=1) - r).max() / r + slope.max()) + 1e-9
+        mid = theta[len(theta) // 2]
+        theta = np.mod(theta - mid + np.pi, TWO_PI) - np.pi  # about the middle sample's angle
+        order = np.argsort(theta)
+        if np.any(np.diff(v[order]) * np.sign(v[order][-1] - v[order][0]) <= 0):  # v monotone in the angle
+            return False
+        params = {"A": A, "frame": frame, "c": c, "mid": mid, "slack": slack, "theta": theta[order], "v": v[order]}
+        return self._keep(index, b0, b1, params, X, J, S, uv, model)
+
+    def _stack(self):
+        super()._stack()
+        self.samples = [(q["theta"], q["v"]) for q in self._params]  # per face, of their own lengths
+
+    def derivatives(self, j, uv):
+        X, J, S = np.zeros((len(j), 3)), np.zeros((len(j), 2, 3)), np.zeros((len(j), 3, 3))
+        for f in np.unique(j):
+            rows = np.flatnonzero(j == f)
+            X[rows], J[rows], S[rows] = self.evaluate(self.index[f], uv[rows])
+        return X, J, S
+
+    def nearest(self, y, j):
+        P = self._gather(j)
+        lo, hi, eps = P["lo"], P["hi"], P["eps"]
+        q = np.einsum("pi,pki->pk", y - P["A"], P["frame"])
+        rho, phi = np.hypot(q[:, 0], q[:, 1]), np.arctan2(q[:, 1], q[:, 0])
+        u, on_turn = _arc(phi, lo[:, 0], hi[:, 0], eps[:, 0])
+        s = np.stack([rho * np.cos(u - phi), q[:, 2]], axis=1) - P["c"]  # y in the meridian's plane
+        theta = np.mod(np.arctan2(s[:, 1], s[:, 0]) - P["mid"] + np.pi, TWO_PI) - np.pi
+        uv = np.stack([u, np.zeros(len(j))], axis=1)
+        inside = np.zeros(len(j), dtype=bool)
+        X, J, S = np.zeros((len(j), 3)), np.zeros((len(j), 2, 3)), np.zeros((len(j), 3, 3))
+        for f in np.unique(j):
+            angles, v = self.samples[f]
+            rows = np.flatnonzero(j == f)
+            # a foot beyond the meridian's ends (more than the slack): the face's nearest point on its boundary
+            rows = rows[(theta[rows] >= angles[0] - P["slack"][rows]) & (theta[rows] <= angles[-1] + P["slack"][rows])]
+            start = np.c_[u[rows], np.interp(theta[rows], angles, v)]
+            X[rows], J[rows], S[rows], inside[rows] = self._newton(f, start, y[rows])
+            uv[rows] = start
+        uv[:, 1] = np.where(inside, uv[:, 1], np.clip(uv[:, 1], lo[:, 1], hi[:, 1]))
+        r = X - y
+        d = np.where(inside, np.sqrt(np.einsum("pi,pi->p", r, r)), np.inf)
+        return uv, d, inside & on_turn, (X, J, S)
+
+    def _newton(self, f, uv, y, iterations=8):
+        """Newton along v (u fixed) on face f from uv (modified in place) towards y: the points
+        X (the last evaluation plus its step), the last evaluation's J and S, and where it
+        converged within the face's v bounds."""
+        n = len(y)
+        ok, todo = np.zeros(n, dtype=bool), np.arange(n)
+        Xo, Jo, So = np.zeros((n, 3)), np.zeros((n, 2, 3)), np.zeros((n, 3, 3))
+        for _ in range(iterations):
+            X, J, S = self.evaluate(self.index[f], uv[todo])
+            r = X - y[todo]
+            Xv, Xvv = J[:, 1], S[:, 1]
+            g = np.einsum("pi,pi->p", Xv, r)
+            A = np.einsum("pi,pi->p", Xv, Xv) + np.einsum("pi,pi->p", Xvv, r)
+            good = A > 0
+            step = np.where(good, -g / np.where(good, A, 1.0), 0.0)
+            uv[todo, 1] += step
+            move = Xv * step[:, None]
+            Xo[todo], Jo[todo], So[todo] = X + move, J, S
+            done = good & (np.einsum("pi,pi->p", move, move) < (1e-13 * self.size) ** 2)
+            ok[todo[done]] = True
+            todo = todo[~done]
+            if todo.size == 0:
+                break
+        lo, hi, eps = self.lo[f, 1], self.hi[f, 1], self.eps[f, 1]
+        return Xo, Jo, So, ok & (uv[:, 1] >= lo - eps) & (uv[:, 1] <= hi + eps)
