@@ -93,6 +93,7 @@ boundary curve). Lengths are in the file's units, mm.
 """
 
 import re
+from itertools import chain
 from pathlib import Path
 
 import numpy as np
@@ -109,6 +110,9 @@ PLANE_ANGLE = 150.0  # degrees: coplanar facets spanning this much at a vertex m
 PARALLEL = 1e-12  # 1 - (n_a . n_b)^2 below this: Nagata's c = 0 (parallel or opposite normals)
 NEWTON_ITERATIONS = 30  # the most Newton iterations of a projection
 NEAREST_SAMPLES = 4  # samples whose triangles give each point's first upper bound
+BALL_MARGIN = 0.5  # the search's ball reaches this times the sampling's spacing beyond the candidates'
+INTERIOR = 1e-9  # a warm start's point lies this far inside its triangle's (u, v)
+TIE = 1e-9  # times the tool's size: a warm start's point is this much nearer than every other patch
 NORMALS = ("outward", "inward")
 
 
@@ -470,6 +474,26 @@ def _flat_closest(y, p0, p1, p2):
     return best_u, best_v, dist
 
 
+class _Remembered:
+    """A call's points y (tool frame) and their answers: closest points c, signed distances d,
+    normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge), a
+    lower bound of the distances to every other patch (second), and each point's neighbour
+    list near[start:start + length] (patches), every patch outside it farther than `rest`."""
+
+    def __init__(self, y, c, d, n, H, t, u, v, kind, second, rest, start, length, near):
+        from scipy.spatial import cKDTree
+
+        self.tree = cKDTree(y)
+        self.c, self.d, self.n, self.H, self.t, self.u, self.v, self.kind = c, d, n, H, t, u, v, kind
+        self.second, self.rest, self.start, self.length, self.near = second, rest, start, length, near
+
+
+def _ranges(start, length):
+    """The concatenated index ranges start[i] .. start[i] + length[i] - 1."""
+    total = int(length.sum())
+    return np.repeat(start - np.cumsum(length) + length, length) + np.arange(total)
+
+
 class MeshTool:
     """A rigid tool: quadratic triangular patches (T, 6, 3), X(u, v) = a_0 + a_1 u + a_2 v + a_3 u^2
     + a_4 v^2 + a_5 u v on u, v >= 0, u + v <= 1 (nagata_patches of a mesh; flat facets have
@@ -513,8 +537,9 @@ class MeshTool:
         self._samples = cKDTree(np.vstack(points))
         self._sample_owner = np.concatenate(owner)
         self._reach = float((reach + self.bulge).max()) * (1 + 1e-9) + 1e-12 * self.size
-        self._last = None  # the last call's points (tool frame) and their answers
-        self.counts = {"repeated": 0, "searched": 0}
+        self._margin = BALL_MARGIN * spacing
+        self._last = None  # the last call's points (tool frame) and their answers (_Remembered)
+        self.counts = {"repeated": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
 
     def flat_top_boundary(self) -> list[np.ndarray]:
         """The boundary loops, in the model's frame ((m, 3) points at the mesh's vertices), of the
@@ -572,53 +597,146 @@ class MeshTool:
         return c + self.translation + np.array([0.0, 0.0, dz]), d.copy(), n.copy()
 
     def _answers(self, x, dz):
-        """Closest points c (tool frame), signed distances, normals and H; points given again
-        (the same point in the tool's frame as in the last call) take their last answers."""
+        """Closest points c (tool frame), signed distances, normals and H (module docstring:
+        points given again take their last answers, moved points start warm, the rest are
+        searched)."""
         y = x - self.translation - np.array([0.0, 0.0, dz])
         npts = len(y)
-        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
-        todo = np.ones(npts, dtype=bool)
         last = self._last
         if last is not None and npts:
-            delta, ref = last[0].query(y)
-            same = np.flatnonzero(delta == 0.0)
-            r = ref[same]
-            c[same], d[same], n[same], H[same] = last[1][r], last[2][r], last[3][r], last[4][r]
-            todo[same] = False
-            self.counts["repeated"] += same.size
-            if same.size == npts:
-                return c, d, n, H
-        rest = np.flatnonzero(todo)
-        self.counts["searched"] += rest.size
-        if rest.size:
-            c[rest], d[rest], n[rest], H[rest] = self._search(y[rest])
+            delta, ref = last.tree.query(y)
+            same = delta == 0.0
+            if same.all():  # every point given again: the remembered points stay
+                self.counts["repeated"] += npts
+                return last.c[ref], last.d[ref], last.n[ref], last.H[ref]
+        else:
+            delta, ref, same = np.zeros(npts), np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
+        t, kind = np.zeros(npts, dtype=np.int64), np.full(npts, -1)
+        u, v, second, rest = np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts)
+        kept = np.flatnonzero(same)  # points that keep their remembered neighbour lists
+        todo = ~same
+        if last is not None and npts:
+            r = ref[kept]
+            t[kept], u[kept], v[kept], kind[kept] = last.t[r], last.u[r], last.v[r], last.kind[r]
+            second[kept], rest[kept] = last.second[r], last.rest[r]
+            self.counts["repeated"] += kept.size
+            moved = np.flatnonzero(todo)
+            r = ref[moved]
+            second[moved], rest[moved] = last.second[r] - delta[moved], last.rest[r] - delta[moved]
+            warm = moved[last.kind[r] < 0]
+            if warm.size:  # Newton on the remembered patch
+                r = ref[warm]
+                u[warm], v[warm], sure = self._warm(y[warm], last.t[r], last.u[r], last.v[r], second[warm])
+                rows = warm[sure]
+                t[rows], todo[rows] = last.t[ref[rows]], False
+            local = np.flatnonzero(todo)
+            if local.size:  # the remembered neighbours' exact distances
+                start, length = last.start[ref[local]], last.length[ref[local]]
+                p = np.repeat(np.arange(local.size), length)
+                found, (tl, ul, vl, kl, sl) = self._local(y[local], p, last.near[_ranges(start, length)],
+                                                          rest[local])
+                rows = local[found]
+                t[rows], u[rows], v[rows], kind[rows], second[rows] = tl, ul, vl, kl, sl
+                todo[rows] = False
+            kept = np.flatnonzero(~todo)
+            self.counts["warm"] += int(kept.size - np.count_nonzero(same))
+        searched = np.flatnonzero(todo)
+        self.counts["searched"] += searched.size
+        lists = None
+        if searched.size:
+            (t[searched], u[searched], v[searched], kind[searched], second[searched]), rest[searched], lists = \
+                self._search(y[searched])
+        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
+        rows = np.flatnonzero(same)
+        if rows.size:
+            r = ref[rows]
+            c[rows], d[rows], n[rows], H[rows] = last.c[r], last.d[r], last.n[r], last.H[r]
+        new = np.flatnonzero(~same)
+        if new.size:
+            c[new], d[new], n[new], H[new] = self._signed(y[new], t[new], u[new], v[new], kind[new])
         if npts:
-            from scipy.spatial import cKDTree
-
-            self._last = (cKDTree(y), c, d, n, H)
+            # each point's neighbour list: the remembered one's, or the search's
+            length, start = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=np.int64)
+            pool = last.near if last is not None else np.zeros(0, dtype=np.int64)
+            if kept.size:
+                length[kept], start[kept] = last.length[ref[kept]], last.start[ref[kept]]
+            if searched.size:
+                length[searched] = np.diff(lists[0])
+                start[searched] = lists[0][:-1] + len(pool)
+                pool = np.concatenate([pool, lists[1]])
+            near = pool[_ranges(start, length)]
+            start = np.cumsum(length) - length
+            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, second, rest, start, length, near)
         return c, d, n, H
 
+    def _warm(self, y, t, u, v, bound):
+        """Points y near remembered points whose closest points lay inside patches t at (u, v),
+        every other patch no nearer than `bound`: Newton on t from (u, v). Returns the new
+        (u, v) and which are sure: converged strictly inside the triangle (INTERIOR), nearer
+        than bound by TIE of the tool's size."""
+        u, v, inside = self._project(y, t, u, v)
+        X, _, _ = _evaluate(self.patches[t], u, v)
+        dist = np.linalg.norm(y - X, axis=1)
+        eps = INTERIOR
+        return u, v, inside & (u >= eps) & (v >= eps) & (u + v <= 1.0 - eps) & (dist <= bound - TIE * self.size)
+
     def _search(self, y):
-        """Closest points, signed distances, normals and H of points y (tool frame)."""
-        npts = len(y)
+        """The closest points of points y (tool frame), as _nearest gives them, the lower bound
+        `rest` of the distances to the patches outside each point's neighbour list, and the lists
+        (offsets (points + 1) into the patches' indices)."""
+        npts, T = len(y), len(self.patches)
         # a first upper bound of each point's distance: the triangles of its nearest samples
         k = min(NEAREST_SAMPLES, self._samples.n)
         _, near = self._samples.query(y, k=k)
-        near = self._sample_owner[np.asarray(near).reshape(npts, k)]
-        P = self.corners[near.ravel()]
+        near = self._sample_owner[np.asarray(near).reshape(npts, k)].ravel()
+        P = self.corners[near]
         _, _, flat = _flat_closest(np.repeat(y, k, axis=0), P[:, 0], P[:, 1], P[:, 2])
-        upper = (flat + self.bulge[near.ravel()]).reshape(npts, k).min(axis=1)
-        # candidates: every triangle with a sample within upper + reach, and lower bound <= upper
-        lists = self._samples.query_ball_point(y, upper + self._reach)
-        lengths = np.fromiter((len(s) for s in lists), dtype=np.int64, count=npts)
-        samples = np.fromiter((i for s in lists for i in s), dtype=np.int64, count=int(lengths.sum()))
-        pair = np.unique(np.repeat(np.arange(npts), lengths) * len(self.patches) + self._sample_owner[samples])
-        p, t = pair // len(self.patches), pair % len(self.patches)
+        upper = (flat + self.bulge[near]).reshape(npts, k).min(axis=1)
+        # every triangle with a sample within upper + reach + margin: the others lie beyond upper + margin
+        rest = upper + self._margin
+        lists = self._samples.query_ball_point(y, rest + self._reach)
+        lengths = np.fromiter(map(len, lists), dtype=np.int64, count=npts)
+        samples = np.fromiter(chain.from_iterable(lists), dtype=np.int64, count=int(lengths.sum()))
+        pair = np.unique(np.repeat(np.arange(npts) * T, lengths) + self._sample_owner[samples])
+        p, t = pair // T, pair % T
         P = self.corners[t]
         u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
-        keep = flat - self.bulge[t] <= upper[p] * (1 + 1e-12) + 1e-12 * self.size
+        lower = flat - self.bulge[t]
+        # the neighbour list: the triangles whose lower bound lies within rest
+        keep = lower <= rest[p]
+        p, t, u, v, lower = p[keep], t[keep], u[keep], v[keep], lower[keep]
+        offsets = np.searchsorted(p, np.arange(npts + 1))
+        return self._nearest(y, p, t, u, v, lower, upper, rest), rest, (offsets, t)
+
+    def _local(self, y, p, t, rest):
+        """The closest points of points y whose neighbour lists p, t (point, patch pairs) hold
+        every patch nearer than `rest`: found where the list's least upper bound (flat distance
+        plus bulge) lies below rest by TIE of the tool's size (_nearest on the list). Returns
+        which were found and their answers (_nearest's)."""
+        P = self.corners[t]
+        u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
+        upper = np.full(len(y), np.inf)
+        np.minimum.at(upper, p, flat + self.bulge[t])
+        found = upper <= rest - TIE * self.size
+        keep = found[p]
+        index = np.cumsum(found) - 1
+        i = np.flatnonzero(found)
+        return found, self._nearest(y[i], index[p[keep]], t[keep], u[keep], v[keep], flat[keep] - self.bulge[t[keep]],
+                                    upper[i], rest[i])
+
+    def _nearest(self, y, p, t, u, v, lower, upper, rest):
+        """The closest points of points y among pairs p, t (point, patch; p sorted) with lower
+        bounds `lower` of their distances and flat closest points (u, v), every patch not in
+        the pairs farther than `rest` (>= upper): the candidates, lower <= upper, projected
+        (Newton; the edge curves where the minimiser leaves the triangle), the nearest taken.
+        Returns its patch t, (u, v), kind (-1 inside, 0, 1, 2 the edge) and a lower bound of
+        the distances to every other patch: the least of rest, the other pairs' lower bounds and
+        the other candidates' distances."""
+        npts = len(y)
+        keep = lower <= upper[p] * (1 + 1e-12) + 1e-12 * self.size
+        second = rest.copy()
+        np.minimum.at(second, p[~keep], lower[~keep])
         p, t, u, v = p[keep], t[keep], u[keep], v[keep]
-        # Newton on each candidate patch; the edges where its minimiser leaves the triangle
         u, v, inside = self._project(y[p], t, u, v)
         X, _, _ = _evaluate(self.patches[t], u, v)
         dist = np.where(inside, np.linalg.norm(y[p] - X, axis=1), np.inf)
@@ -633,10 +751,12 @@ class MeshTool:
                 rows = out[better]
                 dist[rows], u[rows], v[rows], kind[rows] = de[better], ue[better], ve[better], e
         order = np.lexsort((dist, p))
-        firsts = order[np.r_[True, p[order][1:] != p[order][:-1]]]
+        head = np.r_[True, p[order][1:] != p[order][:-1]]
         best = np.empty(npts, dtype=np.int64)
-        best[p[firsts]] = firsts
-        return self._signed(y, t[best], u[best], v[best], kind[best])
+        best[p[order[head]]] = order[head]
+        runner = order[1:][~head[1:]]  # the candidates after each point's nearest
+        np.minimum.at(second, p[runner], dist[runner])
+        return t[best], u[best], v[best], kind[best], second
 
     def _project(self, y, t, u, v):
         """Newton on patches t from (u, v): the minimisers of |X - y|^2 and whether each lies
