@@ -474,6 +474,10 @@ def _flat_closest(y, p0, p1, p2):
     return best_u, best_v, dist
 
 
+_EDGE_START = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])  # (u, v) at each edge's start
+_EDGE_DIRECTION = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])  # d(u, v)/ds along each edge
+
+
 class _Remembered:
     """A call's points y (tool frame) and their answers: closest points c, signed distances d,
     normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge), a
@@ -624,9 +628,11 @@ class MeshTool:
             r = ref[moved]
             second[moved], rest[moved] = last.second[r] - delta[moved], last.rest[r] - delta[moved]
             warm = moved[last.kind[r] < 0]
+            upper = np.full(npts, np.inf)  # the distance to a point on the surface, where one is known
             if warm.size:  # Newton on the remembered patch
                 r = ref[warm]
-                u[warm], v[warm], sure = self._warm(y[warm], last.t[r], last.u[r], last.v[r], second[warm])
+                u[warm], v[warm], upper[warm], sure = self._warm(y[warm], last.t[r], last.u[r], last.v[r],
+                                                                 second[warm])
                 rows = warm[sure]
                 t[rows], todo[rows] = last.t[ref[rows]], False
             local = np.flatnonzero(todo)
@@ -634,7 +640,7 @@ class MeshTool:
                 start, length = last.start[ref[local]], last.length[ref[local]]
                 p = np.repeat(np.arange(local.size), length)
                 found, (tl, ul, vl, kl, sl) = self._local(y[local], p, last.near[_ranges(start, length)],
-                                                          rest[local])
+                                                          upper[local], rest[local])
                 rows = local[found]
                 t[rows], u[rows], v[rows], kind[rows], second[rows] = tl, ul, vl, kl, sl
                 todo[rows] = False
@@ -672,13 +678,15 @@ class MeshTool:
     def _warm(self, y, t, u, v, bound):
         """Points y near remembered points whose closest points lay inside patches t at (u, v),
         every other patch no nearer than `bound`: Newton on t from (u, v). Returns the new
-        (u, v) and which are sure: converged strictly inside the triangle (INTERIOR), nearer
-        than bound by TIE of the tool's size."""
+        (u, v), the distances to their points where these lie on the patch (else inf), and which
+        are sure: converged strictly inside the triangle (INTERIOR), nearer than bound by TIE of
+        the tool's size."""
         u, v, inside = self._project(y, t, u, v)
         X, _, _ = _evaluate(self.patches[t], u, v)
-        dist = np.linalg.norm(y - X, axis=1)
+        dist = np.where(inside, np.linalg.norm(y - X, axis=1), np.inf)
         eps = INTERIOR
-        return u, v, inside & (u >= eps) & (v >= eps) & (u + v <= 1.0 - eps) & (dist <= bound - TIE * self.size)
+        sure = inside & (u >= eps) & (v >= eps) & (u + v <= 1.0 - eps) & (dist <= bound - TIE * self.size)
+        return u, v, dist, sure
 
     def _search(self, y):
         """The closest points of points y (tool frame), as _nearest gives them, the lower bound
@@ -694,10 +702,12 @@ class MeshTool:
         upper = (flat + self.bulge[near]).reshape(npts, k).min(axis=1)
         # every triangle with a sample within upper + reach + margin: the others lie beyond upper + margin
         rest = upper + self._margin
-        lists = self._samples.query_ball_point(y, rest + self._reach)
+        lists = self._samples.query_ball_point(y, rest + self._reach, return_sorted=True)
         lengths = np.fromiter(map(len, lists), dtype=np.int64, count=npts)
         samples = np.fromiter(chain.from_iterable(lists), dtype=np.int64, count=int(lengths.sum()))
-        pair = np.unique(np.repeat(np.arange(npts) * T, lengths) + self._sample_owner[samples])
+        # a point's samples come sorted, a triangle's samples are consecutive: one pair per run
+        pair = np.repeat(np.arange(npts) * T, lengths) + self._sample_owner[samples]
+        pair = pair[np.r_[True, pair[1:] != pair[:-1]]]
         p, t = pair // T, pair % T
         P = self.corners[t]
         u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
@@ -708,14 +718,15 @@ class MeshTool:
         offsets = np.searchsorted(p, np.arange(npts + 1))
         return self._nearest(y, p, t, u, v, lower, upper, rest), rest, (offsets, t)
 
-    def _local(self, y, p, t, rest):
+    def _local(self, y, p, t, upper, rest):
         """The closest points of points y whose neighbour lists p, t (point, patch pairs) hold
-        every patch nearer than `rest`: found where the list's least upper bound (flat distance
-        plus bulge) lies below rest by TIE of the tool's size (_nearest on the list). Returns
-        which were found and their answers (_nearest's)."""
+        every patch nearer than `rest`, `upper` bounding their distances: found where the least
+        of upper and the list's upper bounds (flat distance plus bulge) lies below rest by TIE of
+        the tool's size (_nearest on the list). Returns which were found and their answers
+        (_nearest's)."""
         P = self.corners[t]
         u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
-        upper = np.full(len(y), np.inf)
+        upper = upper.copy()
         np.minimum.at(upper, p, flat + self.bulge[t])
         found = upper <= rest - TIE * self.size
         keep = found[p]
@@ -743,13 +754,7 @@ class MeshTool:
         kind = np.full(len(p), -1)  # -1 inside; 0, 1, 2 the edge
         out = np.flatnonzero(~inside)
         if out.size:
-            for e in range(3):
-                ue, ve = self._project_edge(y[p[out]], t[out], e)
-                Xe, _, _ = _evaluate(self.patches[t[out]], ue, ve)
-                de = np.linalg.norm(y[p[out]] - Xe, axis=1)
-                better = de < dist[out]
-                rows = out[better]
-                dist[rows], u[rows], v[rows], kind[rows] = de[better], ue[better], ve[better], e
+            u[out], v[out], dist[out], kind[out] = self._project_edges(y[p[out]], t[out])
         order = np.lexsort((dist, p))
         head = np.r_[True, p[order][1:] != p[order][:-1]]
         best = np.empty(npts, dtype=np.int64)
@@ -795,29 +800,41 @@ class MeshTool:
         inside = converged & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
         return np.where(inside, np.clip(u, 0, 1), u), np.where(inside, np.clip(v, 0, 1), v), inside
 
-    def _project_edge(self, y, t, e):
-        """The nearest points on edge e (0: u-axis, 1: u + v = 1, 2: v-axis) of patches t: their
-        (u, v), by Newton in the edge's parameter, clamped to [0, 1]."""
-        A = self.patches[t]
-        (u0, v0), (du, dv) = ((0.0, 0.0), (1.0, 0.0)) if e == 0 else (((1.0, 0.0), (-1.0, 1.0)) if e == 1 else
-                                                                      ((0.0, 0.0), (0.0, 1.0)))
+    def _project_edges(self, y, t):
+        """The nearest points on the three edge curves (0: u-axis, 1: u + v = 1, 2: v-axis) of
+        patches t, all at once: Newton in each edge's parameter from the flat edge's closest
+        point, clamped to [0, 1]. Returns the nearest edge's (u, v), distance and edge (the first
+        of equals)."""
+        m = len(t)
+        A = np.tile(self.patches[t], (3, 1, 1))
+        Y = np.tile(y, (3, 1))
+        e = np.repeat(np.arange(3), m)
+        u0, v0 = _EDGE_START[e, 0], _EDGE_START[e, 1]
+        du, dv = _EDGE_DIRECTION[e, 0], _EDGE_DIRECTION[e, 1]
         P = self.corners[t]
-        a, b = P[:, {0: 0, 1: 1, 2: 0}[e]], P[:, {0: 1, 1: 2, 2: 2}[e]]
-        s = np.clip(np.einsum("ij,ij->i", y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
-        second = 2.0 * A[:, 3] * du * du + 2.0 * A[:, 4] * dv * dv + 2.0 * A[:, 5] * du * dv  # x''
+        a = np.concatenate([P[:, 0], P[:, 1], P[:, 0]])
+        b = np.concatenate([P[:, 1], P[:, 2], P[:, 2]])
+        s = np.clip(np.einsum("ij,ij->i", Y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
+        second = 2.0 * (A[:, 3] * (du * du)[:, None] + A[:, 4] * (dv * dv)[:, None]
+                        + A[:, 5] * (du * dv)[:, None])  # x''
         for _ in range(NEWTON_ITERATIONS):
             X, Xu, Xv = _evaluate(A, u0 + du * s, v0 + dv * s)
-            r = X - y
-            first = Xu * du + Xv * dv
+            r = X - Y
+            first = Xu * du[:, None] + Xv * dv[:, None]
             g = np.einsum("ij,ij->i", first, r)
-            h = np.einsum("ij,ij->i", first, first) + np.einsum("ij,ij->i", second, r)
-            h = np.where(h > 0, h, np.einsum("ij,ij->i", first, first))
-            new = np.clip(s - g / h, 0.0, 1.0)
+            ff = np.einsum("ij,ij->i", first, first)
+            h = ff + np.einsum("ij,ij->i", second, r)
+            new = np.clip(s - g / np.where(h > 0, h, ff), 0.0, 1.0)
             done = np.abs(new - s).max() < 1e-13
             s = new
             if done:
                 break
-        return u0 + du * s, v0 + dv * s
+        u, v = u0 + du * s, v0 + dv * s
+        X, _, _ = _evaluate(A, u, v)
+        dist = np.linalg.norm(Y - X, axis=1).reshape(3, m)
+        edge = np.argmin(dist, axis=0)
+        pick = edge * m + np.arange(m)
+        return u[pick], v[pick], dist[edge, np.arange(m)], edge
 
     def _signed(self, y, t, u, v, kind):
         """Closest points, signed distances, normals and H at the closest points (u, v) of
