@@ -480,16 +480,18 @@ _EDGE_DIRECTION = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])  # d(u, v)/ds 
 
 class _Remembered:
     """A call's points y (tool frame) and their answers: closest points c, signed distances d,
-    normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge), a
-    lower bound of the distances to every other patch (second), and each point's neighbour
-    list near[start:start + length] (patches), every patch outside it farther than `rest`."""
+    normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge) and
+    distances; each point's neighbour list, `length` patches `near` with lower bounds `bound`
+    of their distances (the points' lists one after another), every patch outside the list
+    farther than `rest`."""
 
-    def __init__(self, y, c, d, n, H, t, u, v, kind, second, rest, start, length, near):
+    def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, length, near, bound):
         from scipy.spatial import cKDTree
 
         self.tree = cKDTree(y)
         self.c, self.d, self.n, self.H, self.t, self.u, self.v, self.kind = c, d, n, H, t, u, v, kind
-        self.second, self.rest, self.start, self.length, self.near = second, rest, start, length, near
+        self.dist, self.rest, self.length, self.near, self.bound = dist, rest, length, near, bound
+        self.start = np.cumsum(length) - length
 
 
 def _ranges(start, length):
@@ -602,8 +604,8 @@ class MeshTool:
 
     def _answers(self, x, dz):
         """Closest points c (tool frame), signed distances, normals and H (module docstring:
-        points given again take their last answers, moved points start warm, the rest are
-        searched)."""
+        points given again take their last answers, moved points start warm from their
+        remembered neighbours' bounds, the rest are searched)."""
         y = x - self.translation - np.array([0.0, 0.0, dz])
         npts = len(y)
         last = self._last
@@ -616,42 +618,41 @@ class MeshTool:
         else:
             delta, ref, same = np.zeros(npts), np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
         t, kind = np.zeros(npts, dtype=np.int64), np.full(npts, -1)
-        u, v, second, rest = np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts)
-        kept = np.flatnonzero(same)  # points that keep their remembered neighbour lists
+        u, v, dist, rest = np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts)
+        # each point's neighbour list: a range of the pool of (patch, lower bound) pairs
+        start, length = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=np.int64)
+        near, bound = [np.zeros(0, dtype=np.int64)], [np.zeros(0)]
         todo = ~same
         if last is not None and npts:
-            r = ref[kept]
-            t[kept], u[kept], v[kept], kind[kept] = last.t[r], last.u[r], last.v[r], last.kind[r]
-            second[kept], rest[kept] = last.second[r], last.rest[r]
-            self.counts["repeated"] += kept.size
+            near.append(last.near)
+            bound.append(last.bound)
+            rows = np.flatnonzero(same)
+            r = ref[rows]
+            t[rows], u[rows], v[rows], kind[rows], dist[rows] = last.t[r], last.u[r], last.v[r], last.kind[r], \
+                last.dist[r]
+            rest[rows], start[rows], length[rows] = last.rest[r], last.start[r], last.length[r]
+            self.counts["repeated"] += rows.size
             moved = np.flatnonzero(todo)
-            r = ref[moved]
-            second[moved], rest[moved] = last.second[r] - delta[moved], last.rest[r] - delta[moved]
-            warm = moved[last.kind[r] < 0]
-            upper = np.full(npts, np.inf)  # the distance to a point on the surface, where one is known
-            if warm.size:  # Newton on the remembered patch
-                r = ref[warm]
-                u[warm], v[warm], upper[warm], sure = self._warm(y[warm], last.t[r], last.u[r], last.v[r],
-                                                                 second[warm])
-                rows = warm[sure]
-                t[rows], todo[rows] = last.t[ref[rows]], False
-            local = np.flatnonzero(todo)
-            if local.size:  # the remembered neighbours' exact distances
-                start, length = last.start[ref[local]], last.length[ref[local]]
-                p = np.repeat(np.arange(local.size), length)
-                found, (tl, ul, vl, kl, sl) = self._local(y[local], p, last.near[_ranges(start, length)],
-                                                          upper[local], rest[local])
-                rows = local[found]
-                t[rows], u[rows], v[rows], kind[rows], second[rows] = tl, ul, vl, kl, sl
+            if moved.size:
+                r = ref[moved]
+                found, answers, pairs = self._warm(y[moved], last, r, delta[moved])
+                rows = moved[found]
+                t[rows], u[rows], v[rows], kind[rows], dist[rows], rest[rows] = answers
+                offset = len(last.near)
+                near.append(pairs[0])
+                bound.append(pairs[1])
+                start[rows], length[rows] = pairs[2] + offset, pairs[3]
                 todo[rows] = False
-            kept = np.flatnonzero(~todo)
-            self.counts["warm"] += int(kept.size - np.count_nonzero(same))
+                self.counts["warm"] += rows.size
         searched = np.flatnonzero(todo)
         self.counts["searched"] += searched.size
-        lists = None
         if searched.size:
-            (t[searched], u[searched], v[searched], kind[searched], second[searched]), rest[searched], lists = \
-                self._search(y[searched])
+            answers, pairs = self._search(y[searched])
+            t[searched], u[searched], v[searched], kind[searched], dist[searched], rest[searched] = answers
+            offset = sum(len(a) for a in near)
+            near.append(pairs[0])
+            bound.append(pairs[1])
+            start[searched], length[searched] = pairs[2] + offset, pairs[3]
         c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
         rows = np.flatnonzero(same)
         if rows.size:
@@ -661,46 +662,71 @@ class MeshTool:
         if new.size:
             c[new], d[new], n[new], H[new] = self._signed(y[new], t[new], u[new], v[new], kind[new])
         if npts:
-            # each point's neighbour list: the remembered one's, or the search's
-            length, start = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=np.int64)
-            pool = last.near if last is not None else np.zeros(0, dtype=np.int64)
-            if kept.size:
-                length[kept], start[kept] = last.length[ref[kept]], last.start[ref[kept]]
-            if searched.size:
-                length[searched] = np.diff(lists[0])
-                start[searched] = lists[0][:-1] + len(pool)
-                pool = np.concatenate([pool, lists[1]])
-            near = pool[_ranges(start, length)]
-            start = np.cumsum(length) - length
-            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, second, rest, start, length, near)
+            at = _ranges(start, length)
+            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, dist, rest, length, np.concatenate(near)[at],
+                                     np.concatenate(bound)[at])
         return c, d, n, H
 
-    def _warm(self, y, t, u, v, bound):
-        """Points y near remembered points whose closest points lay inside patches t at (u, v),
-        every other patch no nearer than `bound`: Newton on t from (u, v). Returns the new
-        (u, v), the distances to their points where these lie on the patch (else inf), and which
-        are sure: converged strictly inside the triangle (INTERIOR), nearer than bound by TIE of
-        the tool's size."""
-        u, v, inside = self._project(y, t, u, v)
-        X, _, _ = _evaluate(self.patches[t], u, v)
-        dist = np.where(inside, np.linalg.norm(y - X, axis=1), np.inf)
-        eps = INTERIOR
-        sure = inside & (u >= eps) & (v >= eps) & (u + v <= 1.0 - eps) & (dist <= bound - TIE * self.size)
-        return u, v, dist, sure
+    def _warm(self, y, last, ref, delta):
+        """Points y moved by delta from the remembered points ref (_Remembered last): their
+        closest points from the remembered neighbour lists (module docstring). Returns which
+        were found; their patches t, (u, v), kind, distances and bounds beyond their lists; and
+        their lists (patches, lower bounds, start and length of each found point's)."""
+        npts = len(y)
+        rest = last.rest[ref] - delta
+        # the remembered patch: Newton from the remembered (u, v)
+        own = last.t[ref]
+        uo, vo, do, ko = self._exact(y, own, last.u[ref].copy(), last.v[ref].copy())
+        upper = np.minimum(do, last.dist[ref] + delta)  # the distance is 1-Lipschitz
+        found = upper <= rest - TIE * self.size  # no patch outside the list may be nearer
+        length = last.length[ref]
+        at = _ranges(last.start[ref], length)
+        p = np.repeat(np.arange(npts), length)
+        t = last.near[at]
+        lower = last.bound[at] - delta[p]
+        mine = t == own[p]
+        lower[mine] = do[p[mine]]
+        limit = upper * (1 + 1e-12) + 1e-12 * self.size
+        cand = np.flatnonzero(found[p] & ~mine & (lower <= limit[p]))
+        if cand.size:  # the flat triangles' distances less the bulges
+            P = self.corners[t[cand]]
+            u, v, flat = _flat_closest(y[p[cand]], P[:, 0], P[:, 1], P[:, 2])
+            lower[cand] = np.maximum(lower[cand], flat - self.bulge[t[cand]])
+            closer = lower[cand] <= limit[p[cand]]
+            cand, u, v = cand[closer], u[closer], v[closer]
+        pc = p[cand]
+        if cand.size:
+            u, v, dc, kc = self._exact(y[pc], t[cand], u, v)
+            lower[cand] = dc
+        else:
+            u, v, dc, kc = np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
+        # the nearest: the remembered patch's point or a candidate's (the first of equals: the lesser patch)
+        pa = np.concatenate([np.arange(npts), pc])
+        ta = np.concatenate([own, t[cand]])
+        da = np.concatenate([do, dc])
+        order = np.lexsort((ta, da, pa))
+        head = order[np.r_[True, pa[order][1:] != pa[order][:-1]]]
+        ua, va, ka = np.concatenate([uo, u]), np.concatenate([vo, v]), np.concatenate([ko, kc])
+        best = head[found]
+        keep = found[p]
+        length = length[found]
+        answers = (ta[best], ua[best], va[best], ka[best], da[best], rest[found])
+        return found, answers, (t[keep], lower[keep], np.cumsum(length) - length, length)
 
     def _search(self, y):
-        """The closest points of points y (tool frame), as _nearest gives them, the lower bound
-        `rest` of the distances to the patches outside each point's neighbour list, and the lists
-        (offsets (points + 1) into the patches' indices)."""
+        """The closest points of points y (tool frame), as _warm gives them, and their lists: every
+        triangle with a sample within upper + margin + reach of a point, upper the least of its
+        nearest samples' triangles' upper bounds (flat distance plus bulge), is in its list
+        with the lower bound flat distance less bulge, where that lies within upper + margin
+        (every other patch lies beyond it); the candidates, lower bound <= upper, projected,
+        their distances their bounds."""
         npts, T = len(y), len(self.patches)
-        # a first upper bound of each point's distance: the triangles of its nearest samples
         k = min(NEAREST_SAMPLES, self._samples.n)
         _, near = self._samples.query(y, k=k)
         near = self._sample_owner[np.asarray(near).reshape(npts, k)].ravel()
         P = self.corners[near]
         _, _, flat = _flat_closest(np.repeat(y, k, axis=0), P[:, 0], P[:, 1], P[:, 2])
         upper = (flat + self.bulge[near]).reshape(npts, k).min(axis=1)
-        # every triangle with a sample within upper + reach + margin: the others lie beyond upper + margin
         rest = upper + self._margin
         lists = self._samples.query_ball_point(y, rest + self._reach, return_sorted=True)
         lengths = np.fromiter(map(len, lists), dtype=np.int64, count=npts)
@@ -712,56 +738,31 @@ class MeshTool:
         P = self.corners[t]
         u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
         lower = flat - self.bulge[t]
-        # the neighbour list: the triangles whose lower bound lies within rest
         keep = lower <= rest[p]
         p, t, u, v, lower = p[keep], t[keep], u[keep], v[keep], lower[keep]
-        offsets = np.searchsorted(p, np.arange(npts + 1))
-        return self._nearest(y, p, t, u, v, lower, upper, rest), rest, (offsets, t)
+        cand = np.flatnonzero(lower <= upper[p] * (1 + 1e-12) + 1e-12 * self.size)
+        pc, tc = p[cand], t[cand]
+        u, v, dc, kc = self._exact(y[pc], tc, u[cand], v[cand])
+        lower[cand] = dc
+        order = np.lexsort((tc, dc, pc))
+        best = np.zeros(npts, dtype=np.int64)
+        head = order[np.r_[True, pc[order][1:] != pc[order][:-1]]]
+        best[pc[head]] = head
+        length = np.bincount(p, minlength=npts)
+        return (tc[best], u[best], v[best], kc[best], dc[best], rest), (t, lower, np.cumsum(length) - length, length)
 
-    def _local(self, y, p, t, upper, rest):
-        """The closest points of points y whose neighbour lists p, t (point, patch pairs) hold
-        every patch nearer than `rest`, `upper` bounding their distances: found where the least
-        of upper and the list's upper bounds (flat distance plus bulge) lies below rest by TIE of
-        the tool's size (_nearest on the list). Returns which were found and their answers
-        (_nearest's)."""
-        P = self.corners[t]
-        u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
-        upper = upper.copy()
-        np.minimum.at(upper, p, flat + self.bulge[t])
-        found = upper <= rest - TIE * self.size
-        keep = found[p]
-        index = np.cumsum(found) - 1
-        i = np.flatnonzero(found)
-        return found, self._nearest(y[i], index[p[keep]], t[keep], u[keep], v[keep], flat[keep] - self.bulge[t[keep]],
-                                    upper[i], rest[i])
-
-    def _nearest(self, y, p, t, u, v, lower, upper, rest):
-        """The closest points of points y among pairs p, t (point, patch; p sorted) with lower
-        bounds `lower` of their distances and flat closest points (u, v), every patch not in
-        the pairs farther than `rest` (>= upper): the candidates, lower <= upper, projected
-        (Newton; the edge curves where the minimiser leaves the triangle), the nearest taken.
-        Returns its patch t, (u, v), kind (-1 inside, 0, 1, 2 the edge) and a lower bound of
-        the distances to every other patch: the least of rest, the other pairs' lower bounds and
-        the other candidates' distances."""
-        npts = len(y)
-        keep = lower <= upper[p] * (1 + 1e-12) + 1e-12 * self.size
-        second = rest.copy()
-        np.minimum.at(second, p[~keep], lower[~keep])
-        p, t, u, v = p[keep], t[keep], u[keep], v[keep]
-        u, v, inside = self._project(y[p], t, u, v)
+    def _exact(self, y, t, u, v):
+        """The nearest points of points y on patches t: Newton from (u, v); the edge curves
+        where the minimiser leaves the triangle. Their (u, v), distances and kind (-1 inside,
+        0, 1, 2 the edge)."""
+        u, v, inside = self._project(y, t, u, v)
         X, _, _ = _evaluate(self.patches[t], u, v)
-        dist = np.where(inside, np.linalg.norm(y[p] - X, axis=1), np.inf)
-        kind = np.full(len(p), -1)  # -1 inside; 0, 1, 2 the edge
+        dist = np.where(inside, np.linalg.norm(y - X, axis=1), np.inf)
+        kind = np.full(len(t), -1)
         out = np.flatnonzero(~inside)
         if out.size:
-            u[out], v[out], dist[out], kind[out] = self._project_edges(y[p[out]], t[out])
-        order = np.lexsort((dist, p))
-        head = np.r_[True, p[order][1:] != p[order][:-1]]
-        best = np.empty(npts, dtype=np.int64)
-        best[p[order[head]]] = order[head]
-        runner = order[1:][~head[1:]]  # the candidates after each point's nearest
-        np.minimum.at(second, p[runner], dist[runner])
-        return t[best], u[best], v[best], kind[best], second
+            u[out], v[out], dist[out], kind[out] = self._project_edges(y[out], t[out])
+        return u, v, dist, kind
 
     def _project(self, y, t, u, v):
         """Newton on patches t from (u, v): the minimisers of |X - y|^2 and whether each lies
