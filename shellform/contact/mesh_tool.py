@@ -78,9 +78,28 @@ edge, where the two patches' normals fans leave a gap, or beside a crease), d = 
 the sign of (y - c) . n_c, n = (y - c) / d, and H the Hessian of the distance to the curve:
 (I - n n^T - x' x'^T / (|x'|^2 - (y - c) . x'')) / d; at a vertex (I - n n^T) / d.
 
-The last call's points are remembered with their answers: a point given again (in the tool's
-frame: the same x and dz) takes its answer without a search (the contact set asks gap about three
-times and shape once per iterate at the same points).
+Neighbour lists. The search keeps for each point y the triangles whose samples lie within
+U + m + reach of it (U the least upper bound above, m = BALL_MARGIN times the sampling's
+spacing, reach the farthest any patch point lies from its triangle's nearest sample: the
+patches not kept lie farther than R = U + m) and whose lower bound (flat distance less b_T)
+lies within R: y's list, each triangle with a lower bound L_T of the distance to its patch,
+its distance itself where it was a candidate. Every patch outside the list lies farther than R.
+
+The last call's points are remembered with their answers, lists, L_T and R. A point given again
+(in the tool's frame: the same x and dz) takes its answer without a search (the contact set asks
+gap about three times and shape once per iterate at the same points). A moved point y', at
+distance delta from its nearest remembered point y (closest distance D there), starts warm.
+The distance to any set is 1-Lipschitz: the patches outside the list lie farther than R -
+delta, each listed patch farther than L_T - delta, and y' lies within U' = D + delta of the
+surface. Where U' <= R - delta - TIE (of the tool's size), the nearest patch is in the list and
+its lower bound is at most U': the candidates are the listed patches with L_T - delta <= U',
+their bounds raised to their flat distances less b_T (for the others than y's own patch), those
+still within U' projected as in the search (y's own patch by Newton from y's (u, v)), the
+nearest taken. Every patch left out lies provably farther than U' >= the distance found, so the
+answer is the search's (the same candidates' projections; ties at equal distances go to the
+lesser patch). The list goes on with the candidates' new distances and the others' L_T -
+delta, R - delta; where R - delta < U' + TIE (a point moved about m in all since its search)
+the point is searched afresh. `counts` counts the points answered each way.
 
 Reading a file: STL (binary, or ASCII), or a gmsh .msh in its ASCII format (2.2 or 4.1: its
 3-node triangles; the corners of 6-node ones), parsed here without gmsh, so no script (a FILE.opt
@@ -674,43 +693,33 @@ class MeshTool:
         their lists (patches, lower bounds, start and length of each found point's)."""
         npts = len(y)
         rest = last.rest[ref] - delta
-        # the remembered patch: Newton from the remembered (u, v)
-        own = last.t[ref]
-        uo, vo, do, ko = self._exact(y, own, last.u[ref].copy(), last.v[ref].copy())
-        upper = np.minimum(do, last.dist[ref] + delta)  # the distance is 1-Lipschitz
+        upper = last.dist[ref] + delta  # the distance is 1-Lipschitz
         found = upper <= rest - TIE * self.size  # no patch outside the list may be nearer
         length = last.length[ref]
         at = _ranges(last.start[ref], length)
         p = np.repeat(np.arange(npts), length)
         t = last.near[at]
         lower = last.bound[at] - delta[p]
-        mine = t == own[p]
-        lower[mine] = do[p[mine]]
         limit = upper * (1 + 1e-12) + 1e-12 * self.size
-        cand = np.flatnonzero(found[p] & ~mine & (lower <= limit[p]))
-        if cand.size:  # the flat triangles' distances less the bulges
-            P = self.corners[t[cand]]
-            u, v, flat = _flat_closest(y[p[cand]], P[:, 0], P[:, 1], P[:, 2])
-            lower[cand] = np.maximum(lower[cand], flat - self.bulge[t[cand]])
-            closer = lower[cand] <= limit[p[cand]]
-            cand, u, v = cand[closer], u[closer], v[closer]
-        pc = p[cand]
-        if cand.size:
-            u, v, dc, kc = self._exact(y[pc], t[cand], u, v)
-            lower[cand] = dc
-        else:
-            u, v, dc, kc = np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64)
-        # the nearest: the remembered patch's point or a candidate's (the first of equals: the lesser patch)
-        pa = np.concatenate([np.arange(npts), pc])
-        ta = np.concatenate([own, t[cand]])
-        da = np.concatenate([do, dc])
-        order = np.lexsort((ta, da, pa))
-        head = order[np.r_[True, pa[order][1:] != pa[order][:-1]]]
-        ua, va, ka = np.concatenate([uo, u]), np.concatenate([vo, v]), np.concatenate([ko, kc])
-        best = head[found]
+        cand = np.flatnonzero(found[p] & (lower <= limit[p]))
+        pc, tc = p[cand], t[cand]
+        own = tc == last.t[ref[pc]]  # the remembered patch: Newton from the remembered (u, v)
+        u, v = last.u[ref[pc]], last.v[ref[pc]]
+        other = np.flatnonzero(~own)
+        if other.size:  # the others' flat triangles' distances less the bulges
+            P = self.corners[tc[other]]
+            u[other], v[other], flat = _flat_closest(y[pc[other]], P[:, 0], P[:, 1], P[:, 2])
+            lower[cand[other]] = np.maximum(lower[cand[other]], flat - self.bulge[tc[other]])
+            closer = own | (lower[cand] <= limit[pc])
+            cand, pc, tc, u, v = cand[closer], pc[closer], tc[closer], u[closer], v[closer]
+        u, v, dc, kc = self._exact(y[pc], tc, u, v)
+        lower[cand] = dc
+        # the nearest: the first of equals by patch
+        order = np.lexsort((tc, dc, pc))
+        head = order[np.r_[True, pc[order][1:] != pc[order][:-1]]]
         keep = found[p]
         length = length[found]
-        answers = (ta[best], ua[best], va[best], ka[best], da[best], rest[found])
+        answers = (tc[head], u[head], v[head], kc[head], dc[head], rest[found])
         return found, answers, (t[keep], lower[keep], np.cumsum(length) - length, length)
 
     def _search(self, y):
