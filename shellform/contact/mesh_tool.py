@@ -825,15 +825,20 @@ class MeshTool:
         a = np.concatenate([P[:, 0], P[:, 1], P[:, 0]])
         b = np.concatenate([P[:, 1], P[:, 2], P[:, 2]])
         s = np.clip(np.einsum("ij,ij->i", Y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
-        second = 2.0 * (A[:, 3] * (du * du)[:, None] + A[:, 4] * (dv * dv)[:, None]
-                        + A[:, 5] * (du * dv)[:, None])  # x''
+        # the edge's curve x(s) = Q0 + Q1 s + Q2 s^2, less y
+        Q0 = A[:, 0] + A[:, 1] * u0[:, None] + A[:, 2] * v0[:, None] + A[:, 3] * (u0 * u0)[:, None] \
+            + A[:, 4] * (v0 * v0)[:, None] + A[:, 5] * (u0 * v0)[:, None] - Y
+        Q1 = (A[:, 1] + 2.0 * A[:, 3] * u0[:, None] + A[:, 5] * v0[:, None]) * du[:, None] \
+            + (A[:, 2] + 2.0 * A[:, 4] * v0[:, None] + A[:, 5] * u0[:, None]) * dv[:, None]
+        Q2 = A[:, 3] * (du * du)[:, None] + A[:, 4] * (dv * dv)[:, None] + A[:, 5] * (du * dv)[:, None]
+        # (x - y) . x' = c0 + c1 s + c2 s^2 + c3 s^3 and its derivative
+        c0, c1 = np.einsum("ij,ij->i", Q0, Q1), np.einsum("ij,ij->i", Q1, Q1) + 2.0 * np.einsum("ij,ij->i", Q0, Q2)
+        c2, c3 = 3.0 * np.einsum("ij,ij->i", Q1, Q2), 2.0 * np.einsum("ij,ij->i", Q2, Q2)
+        ff0 = np.einsum("ij,ij->i", Q1, Q1)
         for _ in range(NEWTON_ITERATIONS):
-            X, Xu, Xv = _evaluate(A, u0 + du * s, v0 + dv * s)
-            r = X - Y
-            first = Xu * du[:, None] + Xv * dv[:, None]
-            g = np.einsum("ij,ij->i", first, r)
-            ff = np.einsum("ij,ij->i", first, first)
-            h = ff + np.einsum("ij,ij->i", second, r)
+            g = c0 + s * (c1 + s * (c2 + s * c3))
+            h = c1 + s * (2.0 * c2 + 3.0 * c3 * s)
+            ff = ff0 + s * (4.0 * c2 / 3.0 + 2.0 * c3 * s)  # |x'|^2
             new = np.clip(s - g / np.where(h > 0, h, ff), 0.0, 1.0)
             done = np.abs(new - s).max() < 1e-13
             s = new
