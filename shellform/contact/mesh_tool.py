@@ -129,7 +129,7 @@ PLANE_ANGLE = 150.0  # degrees: coplanar facets spanning this much at a vertex m
 PARALLEL = 1e-12  # 1 - (n_a . n_b)^2 below this: Nagata's c = 0 (parallel or opposite normals)
 NEWTON_ITERATIONS = 30  # the most Newton iterations of a projection
 NEAREST_SAMPLES = 4  # samples whose triangles give each point's first upper bound
-BALL_MARGIN = 0.5  # the search's ball reaches this times the sampling's spacing beyond the candidates'
+BALL_MARGIN = 1.0  # the search's ball reaches this times the sampling's spacing beyond the candidates'
 INTERIOR = 1e-9  # a warm start's point lies this far inside its triangle's (u, v)
 TIE = 1e-9  # times the tool's size: a warm start's point is this much nearer than every other patch
 NORMALS = ("outward", "inward")
@@ -513,6 +513,15 @@ class _Remembered:
         self.start = np.cumsum(length) - length
 
 
+def _firsts(p, dist, t):
+    """Of pairs (point p, patch t) at distances dist: each point's nearest (the lesser patch of
+    equals), in the order of the points."""
+    order = np.lexsort((t, dist, p))
+    head = np.ones(order.size, dtype=bool)
+    head[1:] = p[order][1:] != p[order][:-1]
+    return order[head]
+
+
 def _ranges(start, length):
     """The concatenated index ranges start[i] .. start[i] + length[i] - 1."""
     total = int(length.sum())
@@ -715,8 +724,7 @@ class MeshTool:
         u, v, dc, kc = self._exact(y[pc], tc, u, v)
         lower[cand] = dc
         # the nearest: the first of equals by patch
-        order = np.lexsort((tc, dc, pc))
-        head = order[np.r_[True, pc[order][1:] != pc[order][:-1]]]
+        head = _firsts(pc, dc, tc)
         keep = found[p]
         length = length[found]
         answers = (tc[head], u[head], v[head], kc[head], dc[head], rest[found])
@@ -753,10 +761,7 @@ class MeshTool:
         pc, tc = p[cand], t[cand]
         u, v, dc, kc = self._exact(y[pc], tc, u[cand], v[cand])
         lower[cand] = dc
-        order = np.lexsort((tc, dc, pc))
-        best = np.zeros(npts, dtype=np.int64)
-        head = order[np.r_[True, pc[order][1:] != pc[order][:-1]]]
-        best[pc[head]] = head
+        best = _firsts(pc, dc, tc)  # every point has a candidate: the triangle that gave upper
         length = np.bincount(p, minlength=npts)
         return (tc[best], u[best], v[best], kc[best], dc[best], rest), (t, lower, np.cumsum(length) - length, length)
 
