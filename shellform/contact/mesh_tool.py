@@ -130,7 +130,6 @@ PARALLEL = 1e-12  # 1 - (n_a . n_b)^2 below this: Nagata's c = 0 (parallel or op
 NEWTON_ITERATIONS = 30  # the most Newton iterations of a projection
 NEAREST_SAMPLES = 4  # samples whose triangles give each point's first upper bound
 BALL_MARGIN = 1.0  # the search's ball reaches this times the sampling's spacing beyond the candidates'
-INTERIOR = 1e-9  # a warm start's point lies this far inside its triangle's (u, v)
 TIE = 1e-9  # times the tool's size: a warm start's point is this much nearer than every other patch
 NORMALS = ("outward", "inward")
 
