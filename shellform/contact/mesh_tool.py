@@ -87,15 +87,20 @@ its distance itself where it was a candidate. Every patch outside the list lies 
 
 The last call's points are remembered with their answers, lists, L_T and R. A point given again
 (in the tool's frame: the same x and dz) takes its answer without a search (the contact set asks
-gap about three times and shape once per iterate at the same points). A moved point y', at
-distance delta from its nearest remembered point y (closest distance D there), starts warm.
-The distance to any set is 1-Lipschitz: the patches outside the list lie farther than R -
-delta, each listed patch farther than L_T - delta, and y' lies within U' = D + delta of the
-surface. Where U' <= R - delta - TIE (of the tool's size), the nearest patch is in the list and
-its lower bound is at most U': the candidates are the listed patches with L_T - delta <= U',
-their bounds raised to their flat distances less b_T (for the others than y's own patch), those
-still within U' projected as in the search (y's own patch by Newton from y's (u, v)), the
-nearest taken. Every patch left out lies provably farther than U' >= the distance found, so the
+gap about three times and shape once per iterate at the same points). A moved point y' = y +
+delta e, y its nearest remembered point (|e| = 1, closest point c there), starts warm. The
+distance to any set is 1-Lipschitz: the patches outside the list lie farther than R - delta,
+each listed patch farther than L_T - delta; c lies on the surface, so y' lies within U' =
+|y' - c| of it. Where U' <= R - delta - TIE (of the tool's size), the nearest patch is in the
+list and its lower bound is at most U': the candidates are the listed patches with L_T - delta
+<= U'. For those other than y's own patch two more bounds: a patch lies within the sphere of
+its flat triangle's centroid and radius (farthest corner plus b_T), so seen from y its points
+x lie in a cone of half-angle a = asin(radius / |centroid - y|) around the centroid's
+direction; then |x - y'| >= w . (x - y') = |x - y| - delta w . e >= L_T - delta cos(max(0, p -
+a)), w the unit direction of x - y and p the angle between e and the cone's axis (a point
+moved across its far neighbours' directions hardly nears them); and the flat distance less b_T.
+The candidates still within U' are projected as in the search (y's own patch by Newton from
+y's (u, v)), the nearest taken. Every patch left out lies provably farther than U' >= the distance found, so the
 answer is the search's (the same candidates' projections; ties at equal distances go to the
 lesser patch). The list goes on with the candidates' new distances and the others' L_T -
 delta, R - delta; where R - delta < U' + TIE (a point moved about m in all since its search)
@@ -506,7 +511,7 @@ class _Remembered:
     def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, length, near, bound):
         from scipy.spatial import cKDTree
 
-        self.tree = cKDTree(y)
+        self.y, self.tree = y, cKDTree(y)
         self.c, self.d, self.n, self.H, self.t, self.u, self.v, self.kind = c, d, n, H, t, u, v, kind
         self.dist, self.rest, self.length, self.near, self.bound = dist, rest, length, near, bound
         self.start = np.cumsum(length) - length
@@ -551,6 +556,9 @@ class MeshTool:
         self.bulge = np.minimum(sizes.max(axis=1) / 3.0, sizes.sum(axis=1) / 4.0) * (1 + 1e-9)
         lo, hi = self.corners.reshape(-1, 3).min(axis=0), self.corners.reshape(-1, 3).max(axis=0)
         self.size = float(np.linalg.norm(hi - lo))
+        # each patch within a sphere: its flat triangle's centroid, the farthest corner plus the bulge
+        self.centre = self.corners.mean(axis=1)
+        self.radius = (np.linalg.norm(self.corners - self.centre[:, None], axis=2).max(axis=1) + self.bulge) * (1 + 1e-9)
         # samples on each flat triangle: a barycentric grid of m intervals, m = longest edge / spacing
         edges = np.linalg.norm(self.corners[:, [1, 2, 0]] - self.corners, axis=2)
         spacing = float(np.median(edges))
@@ -700,8 +708,8 @@ class MeshTool:
         were found; their patches t, (u, v), kind, distances and bounds beyond their lists; and
         their lists (patches, lower bounds, start and length of each found point's)."""
         npts = len(y)
-        rest = last.rest[ref] - delta
-        upper = last.dist[ref] + delta  # the distance is 1-Lipschitz
+        rest = last.rest[ref] - delta  # the distance is 1-Lipschitz
+        upper = np.linalg.norm(y - last.c[ref], axis=1)  # the remembered closest point lies on the surface
         found = upper <= rest - TIE * self.size  # no patch outside the list may be nearer
         length = last.length[ref]
         at = _ranges(last.start[ref], length)
@@ -712,6 +720,20 @@ class MeshTool:
         cand = np.flatnonzero(found[p] & (lower <= limit[p]))
         pc, tc = p[cand], t[cand]
         own = tc == last.t[ref[pc]]  # the remembered patch: Newton from the remembered (u, v)
+        other = np.flatnonzero(~own)
+        if other.size:  # the cone from the remembered point to each patch's sphere
+            i, k = pc[other], tc[other]
+            w = self.centre[k] - last.y[ref[i]]
+            step = y[i] - last.y[ref[i]]
+            far = np.linalg.norm(w, axis=1)
+            sin_a = np.minimum(self.radius[k] / far, 1.0)
+            cos_p = np.clip(np.einsum("ij,ij->i", w, step) / (far * delta[i]), -1.0, 1.0)
+            cos_a = np.sqrt(1.0 - sin_a * sin_a)
+            toward = np.where((cos_p >= cos_a) | (far <= self.radius[k]), 1.0,
+                              cos_p * cos_a + np.sqrt(1.0 - cos_p * cos_p) * sin_a)
+            lower[cand[other]] = np.maximum(lower[cand[other]], last.bound[at[cand[other]]] - delta[i] * toward)
+            closer = own | (lower[cand] <= limit[pc])
+            cand, pc, tc, own = cand[closer], pc[closer], tc[closer], own[closer]
         u, v = last.u[ref[pc]], last.v[ref[pc]]
         other = np.flatnonzero(~own)
         if other.size:  # the others' flat triangles' distances less the bulges
