@@ -558,7 +558,8 @@ class MeshTool:
         self.size = float(np.linalg.norm(hi - lo))
         # each patch within a sphere: its flat triangle's centroid, the farthest corner plus the bulge
         self.centre = self.corners.mean(axis=1)
-        self.radius = (np.linalg.norm(self.corners - self.centre[:, None], axis=2).max(axis=1) + self.bulge) * (1 + 1e-9)
+        self.radius = (np.linalg.norm(self.corners - self.centre[:, None], axis=2).max(axis=1) + self.bulge) \
+            * (1 + 1e-9)
         # samples on each flat triangle: a barycentric grid of m intervals, m = longest edge / spacing
         edges = np.linalg.norm(self.corners[:, [1, 2, 0]] - self.corners, axis=2)
         spacing = float(np.median(edges))
