@@ -37,13 +37,13 @@ from cup_tools_step import die, punch  # noqa: E402
 from cup_tools_stl import write_stl  # noqa: E402
 
 
-def flat_facets(path, translation, normals, field):
+def flat_facets(path, normals, field):
     """The triangles of a mesh file as flat patches: X = x_0 + (x_1 - x_0) u + (x_2 - x_0) v."""
     vertices, triangles = read_surface_mesh(path, field)
     x = vertices[triangles]
     patches = np.zeros((len(triangles), 6, 3))
     patches[:, 0], patches[:, 1], patches[:, 2] = x[:, 0], x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
-    return MeshTool(patches, translation, normals)
+    return MeshTool(patches, normals=normals)
 
 
 def run(s, label):
@@ -91,9 +91,9 @@ with tempfile.TemporaryDirectory() as folder:
 
         def faceted(spec, thickness):
             tools = nagata(spec, thickness)
-            tools["punch"] = flat_facets(spec.punch_file, spec.punch_translation, spec.punch_normals,
-                                         "tools.punch_file")
-            tools["die"] = flat_facets(spec.die_file, spec.die_translation, spec.die_normals, "tools.die_file")
+            # the placed tools (placement.Placed) keep their rotation, translation and axis
+            tools["punch"].tool = flat_facets(spec.punch_file, spec.punch_normals, "tools.punch_file")
+            tools["die"].tool = flat_facets(spec.die_file, spec.die_normals, "tools.die_file")
             return tools
 
         drawing.cad_cup_tools = faceted

@@ -169,7 +169,7 @@ def test_points_given_again_take_their_last_answers(stl):
     g, n = tool.gap(x, 0.4, -1.0)
     H = tool.shape(x[::3], 0.4, -1.0)
     g2, n2 = tool.gap(x, 0.4, -1.0)
-    assert tool.counts == {"repeated": 400, "searched": 300}
+    assert tool.counts == {"repeated": 400, "warm": 0, "searched": 300}
     assert np.array_equal(g, g2) and np.array_equal(n, n2)
     fresh = MeshTool.from_file(stl / "punch.stl", (0.0, 0.0, T / 2))
     assert np.abs(fresh.shape(x[::3], 0.4, -1.0) - H).max() < 1e-12
@@ -250,3 +250,60 @@ def test_a_scene_s_stl_files_make_mesh_tools(stl, tmp_path):
     with pytest.raises(InputError) as err:
         cad_cup_tools(spec, T)
     assert err.value.field == "tools.die_file"
+
+
+def _same_answers(tool, x, offset=0.4, dz=-1.0):
+    """tool's gap, normal and H at x against a fresh tool's (its search): the largest differences."""
+    fresh = MeshTool(tool.patches, tool.translation, "outward" if tool.sign > 0 else "inward")
+    g, n = tool.gap(x, offset, dz)
+    H = tool.shape(x, offset, dz)
+    g0, n0 = fresh.gap(x, offset, dz)
+    H0 = fresh.shape(x, offset, dz)
+    return np.abs(g - g0).max(), np.abs(n - n0).max(), np.abs(H - H0).max()
+
+
+@pytest.mark.parametrize("move, warm", [(1e-3, 0.9), (0.5, 0.5)])
+def test_moved_points_start_warm_with_the_search_s_answers(stl, move, warm):
+    """Points near the punch's flat face, nose and wall, and farther off, moved by 1e-3 and 0.5
+    mm in random directions after a first call: gap, normal and H equal a fresh tool's search
+    to 1e-10 mm; at least 90 % (1e-3 mm) and half (0.5 mm) of the moved points are answered
+    warm, from their remembered neighbour lists (measured: all 600 of both)."""
+    tool = MeshTool.from_file(stl / "punch.stl", (0.0, 0.0, T / 2))
+    rng = np.random.default_rng(7)
+    x = rng.uniform([-5.0, -45.0, -3.0], [45.0, 45.0, 20.0], (600, 3))
+    tool.gap(x, 0.4, -1.0)
+    step = rng.normal(size=x.shape)
+    y = x + move * step / np.linalg.norm(step, axis=1)[:, None]
+    dg, dn, dH = _same_answers(tool, y)
+    assert dg < 1e-10 and dn < 1e-10 and dH < 1e-10
+    assert tool.counts["warm"] >= warm * len(x) and tool.counts["searched"] + tool.counts["warm"] == 2 * len(x)
+
+
+def test_a_moved_point_whose_nearest_patch_jumps_is_found(stl):
+    """Points moved 0.5 mm across the seam between the punch's flat face and its nose, and
+    points moved through a slab 0.2 mm thick (its nearest face jumps from the top to the
+    bottom): the same answers as a fresh tool's."""
+    tool = MeshTool.from_file(stl / "punch.stl", (0.0, 0.0, T / 2))
+    edge = SCENE.tools.punch_half_width - SCENE.tools.punch_profile_radius
+    x = np.c_[np.full(50, edge - 0.25), np.linspace(-20.0, 20.0, 50), np.full(50, -0.6)]
+    tool.gap(x, 0.4, -1.0)
+    dg, dn, dH = _same_answers(tool, x + [0.5, 0.0, 0.0])
+    assert dg < 1e-10 and dn < 1e-10 and dH < 1e-10
+    from scipy.spatial import ConvexHull
+
+    corners = np.array([[a, b, c] for a in (-5.0, 5.0) for b in (-5.0, 5.0) for c in (-0.1, 0.1)])
+    faces = ConvexHull(corners).simplices
+    normal = np.cross(corners[faces[:, 1]] - corners[faces[:, 0]], corners[faces[:, 2]] - corners[faces[:, 0]])
+    faces = np.where((np.einsum("ij,ij->i", normal, corners[faces].mean(axis=1)) < 0)[:, None], faces[:, ::-1], faces)
+    slab = MeshTool.from_triangles(corners, faces)
+    x = np.c_[RNG.uniform(-3.0, 3.0, (40, 2)), np.full(40, 0.15)]
+    g, n = slab.gap(x)
+    assert np.allclose(g, 0.05) and np.allclose(n, [0.0, 0.0, 1.0])
+    for z, gap, nz in ((-0.15, 0.05, -1.0), (-0.02, -0.08, -1.0)):
+        y = x * [1.0, 1.0, 0.0] + [0.0, 0.0, z]
+        dg, dn, dH = _same_answers(slab, y, 0.0, 0.0)
+        assert dg < 1e-10 and dn < 1e-10 and dH < 1e-10
+        g, n = slab.gap(y)
+        assert np.allclose(g, gap) and np.allclose(n[:, 2], nz)
+        x = y
+    assert slab.counts["warm"] > 0

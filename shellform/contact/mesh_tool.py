@@ -78,9 +78,33 @@ edge, where the two patches' normals fans leave a gap, or beside a crease), d = 
 the sign of (y - c) . n_c, n = (y - c) / d, and H the Hessian of the distance to the curve:
 (I - n n^T - x' x'^T / (|x'|^2 - (y - c) . x'')) / d; at a vertex (I - n n^T) / d.
 
-The last call's points are remembered with their answers: a point given again (in the tool's
-frame: the same x and dz) takes its answer without a search (the contact set asks gap about three
-times and shape once per iterate at the same points).
+Neighbour lists. The search keeps for each point y the triangles whose samples lie within
+U + m + reach of it (U the least upper bound above, m = BALL_MARGIN times the sampling's
+spacing, reach the farthest any patch point lies from its triangle's nearest sample: the
+patches not kept lie farther than R = U + m) and whose lower bound (flat distance less b_T)
+lies within R: y's list, each triangle with a lower bound L_T of the distance to its patch,
+its distance itself where it was a candidate. Every patch outside the list lies farther than R.
+
+The last call's points are remembered with their answers, lists, L_T and R. A point given again
+(in the tool's frame: the same x and dz) takes its answer without a search (the contact set asks
+gap about three times and shape once per iterate at the same points). A moved point y' = y +
+delta e, y its nearest remembered point (|e| = 1, closest point c there), starts warm. The
+distance to any set is 1-Lipschitz: the patches outside the list lie farther than R - delta,
+each listed patch farther than L_T - delta; c lies on the surface, so y' lies within U' =
+|y' - c| of it. Where U' <= R - delta - TIE (of the tool's size), the nearest patch is in the
+list and its lower bound is at most U': the candidates are the listed patches with L_T - delta
+<= U'. For those other than y's own patch two more bounds: a patch lies within the sphere of
+its flat triangle's centroid and radius (farthest corner plus b_T), so seen from y its points
+x lie in a cone of half-angle a = asin(radius / |centroid - y|) around the centroid's
+direction; then |x - y'| >= w . (x - y') = |x - y| - delta w . e >= L_T - delta cos(max(0, p -
+a)), w the unit direction of x - y and p the angle between e and the cone's axis (a point
+moved across its far neighbours' directions hardly nears them); and the flat distance less b_T.
+The candidates still within U' are projected as in the search (y's own patch by Newton from
+y's (u, v)), the nearest taken. Every patch left out lies provably farther than U' >= the distance found, so the
+answer is the search's (the same candidates' projections; ties at equal distances go to the
+lesser patch). The list goes on with the candidates' new distances and the others' L_T -
+delta, R - delta; where R - delta < U' + TIE (a point moved about m in all since its search)
+the point is searched afresh. `counts` counts the points answered each way.
 
 Reading a file: STL (binary, or ASCII), or a gmsh .msh in its ASCII format (2.2 or 4.1: its
 3-node triangles; the corners of 6-node ones), parsed here without gmsh, so no script (a FILE.opt
@@ -93,6 +117,7 @@ boundary curve). Lengths are in the file's units, mm.
 """
 
 import re
+from itertools import chain
 from pathlib import Path
 
 import numpy as np
@@ -109,6 +134,8 @@ PLANE_ANGLE = 150.0  # degrees: coplanar facets spanning this much at a vertex m
 PARALLEL = 1e-12  # 1 - (n_a . n_b)^2 below this: Nagata's c = 0 (parallel or opposite normals)
 NEWTON_ITERATIONS = 30  # the most Newton iterations of a projection
 NEAREST_SAMPLES = 4  # samples whose triangles give each point's first upper bound
+BALL_MARGIN = 1.0  # the search's ball reaches this times the sampling's spacing beyond the candidates'
+TIE = 1e-9  # times the tool's size: a warm start's point is this much nearer than every other patch
 NORMALS = ("outward", "inward")
 
 
@@ -470,6 +497,41 @@ def _flat_closest(y, p0, p1, p2):
     return best_u, best_v, dist
 
 
+_EDGE_START = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])  # (u, v) at each edge's start
+_EDGE_DIRECTION = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])  # d(u, v)/ds along each edge
+
+
+class _Remembered:
+    """A call's points y (tool frame) and their answers: closest points c, signed distances d,
+    normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge) and
+    distances; each point's neighbour list, `length` patches `near` with lower bounds `bound`
+    of their distances (the points' lists one after another), every patch outside the list
+    farther than `rest`."""
+
+    def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, length, near, bound):
+        from scipy.spatial import cKDTree
+
+        self.y, self.tree = y, cKDTree(y)
+        self.c, self.d, self.n, self.H, self.t, self.u, self.v, self.kind = c, d, n, H, t, u, v, kind
+        self.dist, self.rest, self.length, self.near, self.bound = dist, rest, length, near, bound
+        self.start = np.cumsum(length) - length
+
+
+def _firsts(p, dist, t):
+    """Of pairs (point p, patch t) at distances dist: each point's nearest (the lesser patch of
+    equals), in the order of the points."""
+    order = np.lexsort((t, dist, p))
+    head = np.ones(order.size, dtype=bool)
+    head[1:] = p[order][1:] != p[order][:-1]
+    return order[head]
+
+
+def _ranges(start, length):
+    """The concatenated index ranges start[i] .. start[i] + length[i] - 1."""
+    total = int(length.sum())
+    return np.repeat(start - np.cumsum(length) + length, length) + np.arange(total)
+
+
 class MeshTool:
     """A rigid tool: quadratic triangular patches (T, 6, 3), X(u, v) = a_0 + a_1 u + a_2 v + a_3 u^2
     + a_4 v^2 + a_5 u v on u, v >= 0, u + v <= 1 (nagata_patches of a mesh; flat facets have
@@ -494,6 +556,10 @@ class MeshTool:
         self.bulge = np.minimum(sizes.max(axis=1) / 3.0, sizes.sum(axis=1) / 4.0) * (1 + 1e-9)
         lo, hi = self.corners.reshape(-1, 3).min(axis=0), self.corners.reshape(-1, 3).max(axis=0)
         self.size = float(np.linalg.norm(hi - lo))
+        # each patch within a sphere: its flat triangle's centroid, the farthest corner plus the bulge
+        self.centre = self.corners.mean(axis=1)
+        self.radius = (np.linalg.norm(self.corners - self.centre[:, None], axis=2).max(axis=1) + self.bulge) \
+            * (1 + 1e-9)
         # samples on each flat triangle: a barycentric grid of m intervals, m = longest edge / spacing
         edges = np.linalg.norm(self.corners[:, [1, 2, 0]] - self.corners, axis=2)
         spacing = float(np.median(edges))
@@ -513,8 +579,9 @@ class MeshTool:
         self._samples = cKDTree(np.vstack(points))
         self._sample_owner = np.concatenate(owner)
         self._reach = float((reach + self.bulge).max()) * (1 + 1e-9) + 1e-12 * self.size
-        self._last = None  # the last call's points (tool frame) and their answers
-        self.counts = {"repeated": 0, "searched": 0}
+        self._margin = BALL_MARGIN * spacing
+        self._last = None  # the last call's points (tool frame) and their answers (_Remembered)
+        self.counts = {"repeated": 0, "warm": 0, "searched": 0}  # points answered each way, all calls
 
     def flat_top_boundary(self) -> list[np.ndarray]:
         """The boundary loops, in the model's frame ((m, 3) points at the mesh's vertices), of the
@@ -572,71 +639,166 @@ class MeshTool:
         return c + self.translation + np.array([0.0, 0.0, dz]), d.copy(), n.copy()
 
     def _answers(self, x, dz):
-        """Closest points c (tool frame), signed distances, normals and H; points given again
-        (the same point in the tool's frame as in the last call) take their last answers."""
+        """Closest points c (tool frame), signed distances, normals and H (module docstring:
+        points given again take their last answers, moved points start warm from their
+        remembered neighbours' bounds, the rest are searched)."""
         y = x - self.translation - np.array([0.0, 0.0, dz])
         npts = len(y)
-        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
-        todo = np.ones(npts, dtype=bool)
         last = self._last
         if last is not None and npts:
-            delta, ref = last[0].query(y)
-            same = np.flatnonzero(delta == 0.0)
-            r = ref[same]
-            c[same], d[same], n[same], H[same] = last[1][r], last[2][r], last[3][r], last[4][r]
-            todo[same] = False
-            self.counts["repeated"] += same.size
-            if same.size == npts:
-                return c, d, n, H
-        rest = np.flatnonzero(todo)
-        self.counts["searched"] += rest.size
-        if rest.size:
-            c[rest], d[rest], n[rest], H[rest] = self._search(y[rest])
+            delta, ref = last.tree.query(y)
+            same = delta == 0.0
+            if same.all():  # every point given again: the remembered points stay
+                self.counts["repeated"] += npts
+                return last.c[ref], last.d[ref], last.n[ref], last.H[ref]
+        else:
+            delta, ref, same = np.zeros(npts), np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
+        t, kind = np.zeros(npts, dtype=np.int64), np.full(npts, -1)
+        u, v, dist, rest = np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts)
+        # each point's neighbour list: a range of the pool of (patch, lower bound) pairs
+        start, length = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=np.int64)
+        near, bound = [np.zeros(0, dtype=np.int64)], [np.zeros(0)]
+        todo = ~same
+        if last is not None and npts:
+            near.append(last.near)
+            bound.append(last.bound)
+            rows = np.flatnonzero(same)
+            r = ref[rows]
+            t[rows], u[rows], v[rows], kind[rows], dist[rows] = last.t[r], last.u[r], last.v[r], last.kind[r], \
+                last.dist[r]
+            rest[rows], start[rows], length[rows] = last.rest[r], last.start[r], last.length[r]
+            self.counts["repeated"] += rows.size
+            moved = np.flatnonzero(todo)
+            if moved.size:
+                r = ref[moved]
+                found, answers, pairs = self._warm(y[moved], last, r, delta[moved])
+                rows = moved[found]
+                t[rows], u[rows], v[rows], kind[rows], dist[rows], rest[rows] = answers
+                offset = len(last.near)
+                near.append(pairs[0])
+                bound.append(pairs[1])
+                start[rows], length[rows] = pairs[2] + offset, pairs[3]
+                todo[rows] = False
+                self.counts["warm"] += rows.size
+        searched = np.flatnonzero(todo)
+        self.counts["searched"] += searched.size
+        if searched.size:
+            answers, pairs = self._search(y[searched])
+            t[searched], u[searched], v[searched], kind[searched], dist[searched], rest[searched] = answers
+            offset = sum(len(a) for a in near)
+            near.append(pairs[0])
+            bound.append(pairs[1])
+            start[searched], length[searched] = pairs[2] + offset, pairs[3]
+        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
+        rows = np.flatnonzero(same)
+        if rows.size:
+            r = ref[rows]
+            c[rows], d[rows], n[rows], H[rows] = last.c[r], last.d[r], last.n[r], last.H[r]
+        new = np.flatnonzero(~same)
+        if new.size:
+            c[new], d[new], n[new], H[new] = self._signed(y[new], t[new], u[new], v[new], kind[new])
         if npts:
-            from scipy.spatial import cKDTree
-
-            self._last = (cKDTree(y), c, d, n, H)
+            at = _ranges(start, length)
+            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, dist, rest, length, np.concatenate(near)[at],
+                                     np.concatenate(bound)[at])
         return c, d, n, H
 
-    def _search(self, y):
-        """Closest points, signed distances, normals and H of points y (tool frame)."""
+    def _warm(self, y, last, ref, delta):
+        """Points y moved by delta from the remembered points ref (_Remembered last): their
+        closest points from the remembered neighbour lists (module docstring). Returns which
+        were found; their patches t, (u, v), kind, distances and bounds beyond their lists; and
+        their lists (patches, lower bounds, start and length of each found point's)."""
         npts = len(y)
-        # a first upper bound of each point's distance: the triangles of its nearest samples
+        rest = last.rest[ref] - delta  # the distance is 1-Lipschitz
+        upper = np.linalg.norm(y - last.c[ref], axis=1)  # the remembered closest point lies on the surface
+        found = upper <= rest - TIE * self.size  # no patch outside the list may be nearer
+        length = last.length[ref]
+        at = _ranges(last.start[ref], length)
+        p = np.repeat(np.arange(npts), length)
+        t = last.near[at]
+        lower = last.bound[at] - delta[p]
+        limit = upper * (1 + 1e-12) + 1e-12 * self.size
+        cand = np.flatnonzero(found[p] & (lower <= limit[p]))
+        pc, tc = p[cand], t[cand]
+        own = tc == last.t[ref[pc]]  # the remembered patch: Newton from the remembered (u, v)
+        other = np.flatnonzero(~own)
+        if other.size:  # the cone from the remembered point to each patch's sphere
+            i, k = pc[other], tc[other]
+            w = self.centre[k] - last.y[ref[i]]
+            step = y[i] - last.y[ref[i]]
+            far = np.linalg.norm(w, axis=1)
+            sin_a = np.minimum(self.radius[k] / far, 1.0)
+            cos_p = np.clip(np.einsum("ij,ij->i", w, step) / (far * delta[i]), -1.0, 1.0)
+            cos_a = np.sqrt(1.0 - sin_a * sin_a)
+            toward = np.where((cos_p >= cos_a) | (far <= self.radius[k]), 1.0,
+                              cos_p * cos_a + np.sqrt(1.0 - cos_p * cos_p) * sin_a)
+            lower[cand[other]] = np.maximum(lower[cand[other]], last.bound[at[cand[other]]] - delta[i] * toward)
+            closer = own | (lower[cand] <= limit[pc])
+            cand, pc, tc, own = cand[closer], pc[closer], tc[closer], own[closer]
+        u, v = last.u[ref[pc]], last.v[ref[pc]]
+        other = np.flatnonzero(~own)
+        if other.size:  # the others' flat triangles' distances less the bulges
+            P = self.corners[tc[other]]
+            u[other], v[other], flat = _flat_closest(y[pc[other]], P[:, 0], P[:, 1], P[:, 2])
+            lower[cand[other]] = np.maximum(lower[cand[other]], flat - self.bulge[tc[other]])
+            closer = own | (lower[cand] <= limit[pc])
+            cand, pc, tc, u, v = cand[closer], pc[closer], tc[closer], u[closer], v[closer]
+        u, v, dc, kc = self._exact(y[pc], tc, u, v)
+        lower[cand] = dc
+        # the nearest: the first of equals by patch
+        head = _firsts(pc, dc, tc)
+        keep = found[p]
+        length = length[found]
+        answers = (tc[head], u[head], v[head], kc[head], dc[head], rest[found])
+        return found, answers, (t[keep], lower[keep], np.cumsum(length) - length, length)
+
+    def _search(self, y):
+        """The closest points of points y (tool frame), as _warm gives them, and their lists: every
+        triangle with a sample within upper + margin + reach of a point, upper the least of its
+        nearest samples' triangles' upper bounds (flat distance plus bulge), is in its list
+        with the lower bound flat distance less bulge, where that lies within upper + margin
+        (every other patch lies beyond it); the candidates, lower bound <= upper, projected,
+        their distances their bounds."""
+        npts, T = len(y), len(self.patches)
         k = min(NEAREST_SAMPLES, self._samples.n)
         _, near = self._samples.query(y, k=k)
-        near = self._sample_owner[np.asarray(near).reshape(npts, k)]
-        P = self.corners[near.ravel()]
+        near = self._sample_owner[np.asarray(near).reshape(npts, k)].ravel()
+        P = self.corners[near]
         _, _, flat = _flat_closest(np.repeat(y, k, axis=0), P[:, 0], P[:, 1], P[:, 2])
-        upper = (flat + self.bulge[near.ravel()]).reshape(npts, k).min(axis=1)
-        # candidates: every triangle with a sample within upper + reach, and lower bound <= upper
-        lists = self._samples.query_ball_point(y, upper + self._reach)
-        lengths = np.fromiter((len(s) for s in lists), dtype=np.int64, count=npts)
-        samples = np.fromiter((i for s in lists for i in s), dtype=np.int64, count=int(lengths.sum()))
-        pair = np.unique(np.repeat(np.arange(npts), lengths) * len(self.patches) + self._sample_owner[samples])
-        p, t = pair // len(self.patches), pair % len(self.patches)
+        upper = (flat + self.bulge[near]).reshape(npts, k).min(axis=1)
+        rest = upper + self._margin
+        lists = self._samples.query_ball_point(y, rest + self._reach, return_sorted=True)
+        lengths = np.fromiter(map(len, lists), dtype=np.int64, count=npts)
+        samples = np.fromiter(chain.from_iterable(lists), dtype=np.int64, count=int(lengths.sum()))
+        # a point's samples come sorted, a triangle's samples are consecutive: one pair per run
+        pair = np.repeat(np.arange(npts) * T, lengths) + self._sample_owner[samples]
+        pair = pair[np.r_[True, pair[1:] != pair[:-1]]]
+        p, t = pair // T, pair % T
         P = self.corners[t]
         u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
-        keep = flat - self.bulge[t] <= upper[p] * (1 + 1e-12) + 1e-12 * self.size
-        p, t, u, v = p[keep], t[keep], u[keep], v[keep]
-        # Newton on each candidate patch; the edges where its minimiser leaves the triangle
-        u, v, inside = self._project(y[p], t, u, v)
+        lower = flat - self.bulge[t]
+        keep = lower <= rest[p]
+        p, t, u, v, lower = p[keep], t[keep], u[keep], v[keep], lower[keep]
+        cand = np.flatnonzero(lower <= upper[p] * (1 + 1e-12) + 1e-12 * self.size)
+        pc, tc = p[cand], t[cand]
+        u, v, dc, kc = self._exact(y[pc], tc, u[cand], v[cand])
+        lower[cand] = dc
+        best = _firsts(pc, dc, tc)  # every point has a candidate: the triangle that gave upper
+        length = np.bincount(p, minlength=npts)
+        return (tc[best], u[best], v[best], kc[best], dc[best], rest), (t, lower, np.cumsum(length) - length, length)
+
+    def _exact(self, y, t, u, v):
+        """The nearest points of points y on patches t: Newton from (u, v); the edge curves
+        where the minimiser leaves the triangle. Their (u, v), distances and kind (-1 inside,
+        0, 1, 2 the edge)."""
+        u, v, inside = self._project(y, t, u, v)
         X, _, _ = _evaluate(self.patches[t], u, v)
-        dist = np.where(inside, np.linalg.norm(y[p] - X, axis=1), np.inf)
-        kind = np.full(len(p), -1)  # -1 inside; 0, 1, 2 the edge
+        dist = np.where(inside, np.linalg.norm(y - X, axis=1), np.inf)
+        kind = np.full(len(t), -1)
         out = np.flatnonzero(~inside)
         if out.size:
-            for e in range(3):
-                ue, ve = self._project_edge(y[p[out]], t[out], e)
-                Xe, _, _ = _evaluate(self.patches[t[out]], ue, ve)
-                de = np.linalg.norm(y[p[out]] - Xe, axis=1)
-                better = de < dist[out]
-                rows = out[better]
-                dist[rows], u[rows], v[rows], kind[rows] = de[better], ue[better], ve[better], e
-        order = np.lexsort((dist, p))
-        firsts = order[np.r_[True, p[order][1:] != p[order][:-1]]]
-        best = np.empty(npts, dtype=np.int64)
-        best[p[firsts]] = firsts
-        return self._signed(y, t[best], u[best], v[best], kind[best])
+            u[out], v[out], dist[out], kind[out] = self._project_edges(y[out], t[out])
+        return u, v, dist, kind
 
     def _project(self, y, t, u, v):
         """Newton on patches t from (u, v): the minimisers of |X - y|^2 and whether each lies
@@ -675,29 +837,46 @@ class MeshTool:
         inside = converged & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
         return np.where(inside, np.clip(u, 0, 1), u), np.where(inside, np.clip(v, 0, 1), v), inside
 
-    def _project_edge(self, y, t, e):
-        """The nearest points on edge e (0: u-axis, 1: u + v = 1, 2: v-axis) of patches t: their
-        (u, v), by Newton in the edge's parameter, clamped to [0, 1]."""
-        A = self.patches[t]
-        (u0, v0), (du, dv) = ((0.0, 0.0), (1.0, 0.0)) if e == 0 else (((1.0, 0.0), (-1.0, 1.0)) if e == 1 else
-                                                                      ((0.0, 0.0), (0.0, 1.0)))
+    def _project_edges(self, y, t):
+        """The nearest points on the three edge curves (0: u-axis, 1: u + v = 1, 2: v-axis) of
+        patches t, all at once: Newton in each edge's parameter from the flat edge's closest
+        point, clamped to [0, 1]. Returns the nearest edge's (u, v), distance and edge (the first
+        of equals)."""
+        m = len(t)
+        A = np.tile(self.patches[t], (3, 1, 1))
+        Y = np.tile(y, (3, 1))
+        e = np.repeat(np.arange(3), m)
+        u0, v0 = _EDGE_START[e, 0], _EDGE_START[e, 1]
+        du, dv = _EDGE_DIRECTION[e, 0], _EDGE_DIRECTION[e, 1]
         P = self.corners[t]
-        a, b = P[:, {0: 0, 1: 1, 2: 0}[e]], P[:, {0: 1, 1: 2, 2: 2}[e]]
-        s = np.clip(np.einsum("ij,ij->i", y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
-        second = 2.0 * A[:, 3] * du * du + 2.0 * A[:, 4] * dv * dv + 2.0 * A[:, 5] * du * dv  # x''
+        a = np.concatenate([P[:, 0], P[:, 1], P[:, 0]])
+        b = np.concatenate([P[:, 1], P[:, 2], P[:, 2]])
+        s = np.clip(np.einsum("ij,ij->i", Y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
+        # the edge's curve x(s) = Q0 + Q1 s + Q2 s^2, less y
+        Q0 = A[:, 0] + A[:, 1] * u0[:, None] + A[:, 2] * v0[:, None] + A[:, 3] * (u0 * u0)[:, None] \
+            + A[:, 4] * (v0 * v0)[:, None] + A[:, 5] * (u0 * v0)[:, None] - Y
+        Q1 = (A[:, 1] + 2.0 * A[:, 3] * u0[:, None] + A[:, 5] * v0[:, None]) * du[:, None] \
+            + (A[:, 2] + 2.0 * A[:, 4] * v0[:, None] + A[:, 5] * u0[:, None]) * dv[:, None]
+        Q2 = A[:, 3] * (du * du)[:, None] + A[:, 4] * (dv * dv)[:, None] + A[:, 5] * (du * dv)[:, None]
+        # (x - y) . x' = c0 + c1 s + c2 s^2 + c3 s^3 and its derivative
+        c0, c1 = np.einsum("ij,ij->i", Q0, Q1), np.einsum("ij,ij->i", Q1, Q1) + 2.0 * np.einsum("ij,ij->i", Q0, Q2)
+        c2, c3 = 3.0 * np.einsum("ij,ij->i", Q1, Q2), 2.0 * np.einsum("ij,ij->i", Q2, Q2)
+        ff0 = np.einsum("ij,ij->i", Q1, Q1)
         for _ in range(NEWTON_ITERATIONS):
-            X, Xu, Xv = _evaluate(A, u0 + du * s, v0 + dv * s)
-            r = X - y
-            first = Xu * du + Xv * dv
-            g = np.einsum("ij,ij->i", first, r)
-            h = np.einsum("ij,ij->i", first, first) + np.einsum("ij,ij->i", second, r)
-            h = np.where(h > 0, h, np.einsum("ij,ij->i", first, first))
-            new = np.clip(s - g / h, 0.0, 1.0)
+            g = c0 + s * (c1 + s * (c2 + s * c3))
+            h = c1 + s * (2.0 * c2 + 3.0 * c3 * s)
+            ff = ff0 + s * (4.0 * c2 / 3.0 + 2.0 * c3 * s)  # |x'|^2
+            new = np.clip(s - g / np.where(h > 0, h, ff), 0.0, 1.0)
             done = np.abs(new - s).max() < 1e-13
             s = new
             if done:
                 break
-        return u0 + du * s, v0 + dv * s
+        u, v = u0 + du * s, v0 + dv * s
+        X, _, _ = _evaluate(A, u, v)
+        dist = np.linalg.norm(Y - X, axis=1).reshape(3, m)
+        edge = np.argmin(dist, axis=0)
+        pick = edge * m + np.arange(m)
+        return u[pick], v[pick], dist[edge, np.arange(m)], edge
 
     def _signed(self, y, t, u, v, kind):
         """Closest points, signed distances, normals and H at the closest points (u, v) of
