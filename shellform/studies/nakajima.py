@@ -62,8 +62,9 @@ def scene_of(width: float, n: int, folder: Path) -> scene.Scene:
     the limits."""
     base = scene.load(SCENE)
     radius = float(re.search(r"(?m)^R = ([0-9.]+);", SPECIMEN.read_text()).group(1))
+    specimen_name = f"waist {width:g} mm" if width < 2 * radius else "whole disc"
     changes = {"mesh.n": n, "output.vtx": False, "output.vtu": False,
-               "title": base.title.replace("waist 60 mm", f"waist {width:g} mm" if width < 2 * radius else "whole disc")}
+               "title": f"Nakajima test, {specimen_name}: " + base.title.split(": ", 1)[-1]}
     if width >= 2 * radius:
         changes.update({"geometry.shape": "circle", "geometry.file": "", "geometry.radius": radius,
                         "geometry.region": "quarter", "supports": {"left": "symmetry", "bottom": "symmetry"}})
