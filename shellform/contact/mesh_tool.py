@@ -634,8 +634,8 @@ def _nearer(dist, t, best, best_t):
 
 
 @njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
-def _warm_pass(y, delta, ref, last_y, last_c, last_t, last_u, last_v, last_rest, start, length, near, bound,
-               patches, corners, centre, radius, bulge, size):
+def _warm_pass(y, delta, ref, last_y, last_c, last_t, last_u, last_v, last_kind, last_dist, last_rest, start,
+               length, near, bound, patches, corners, centre, radius, bulge, size):
     """Points y moved by delta from the remembered points ref: their closest points from the
     remembered lists (module docstring; last_* the remembered points' y, closest points, patches,
     (u, v) and R, their lists `length` pairs (near, bound) from `start`; size the tool's).
@@ -655,6 +655,15 @@ def _warm_pass(y, delta, ref, last_y, last_c, last_t, last_u, last_v, last_rest,
     for i in range(n):
         r, moved = ref[i], delta[i]
         rest = last_rest[r] - moved  # the distance is 1-Lipschitz
+        if moved == 0.0:  # given again: its answer and list
+            found[i] = True
+            t_out[i], u_out[i], v_out[i], kind_out[i], dist_out[i], rest_out[i] = last_t[r], last_u[r], last_v[r], \
+                last_kind[r], last_dist[r], rest
+            near_out[at:at + length[r]] = near[start[r]:start[r] + length[r]]
+            bound_out[at:at + length[r]] = bound[start[r]:start[r] + length[r]]
+            start_out[i], length_out[i] = at, length[r]
+            at += length[r]
+            continue
         upper = _distance(y[i], last_c[r])  # the remembered closest point lies on the surface
         if not upper <= rest - TIE * size:  # a patch outside the list may be nearer: searched
             continue
@@ -789,22 +798,27 @@ class _Remembered:
     """A call's points y (tool frame) and their answers: closest points c, signed distances d,
     normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge) and
     distances; each point's neighbour list, `length` patches `near` with lower bounds `bound`
-    of their distances (the points' lists one after another), every patch outside the list
-    farther than `rest`."""
+    of their distances from `start`, every patch outside the list farther than `rest`."""
 
-    def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, length, near, bound):
-        from scipy.spatial import cKDTree
-
-        self.y, self.tree = y, cKDTree(y)
+    def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, start, length, near, bound):
+        self.y = y
         self.c, self.d, self.n, self.H, self.t, self.u, self.v, self.kind = c, d, n, H, t, u, v, kind
-        self.dist, self.rest, self.length, self.near, self.bound = dist, rest, length, near, bound
-        self.start = np.cumsum(length) - length
+        self.dist, self.rest, self.start, self.length, self.near, self.bound = dist, rest, start, length, near, bound
 
+    def references(self, y, margin):
+        """Each point of y's remembered point and its distance from it: the point of the same
+        index where y has as many points as the remembered ones and each lies within margin
+        of its own (a contact set's nodes, moved by an iterate), else the nearest (a k-d tree)."""
+        if len(y) == len(self.y):
+            step = y - self.y
+            delta = np.sqrt(np.einsum("ij,ij->i", step, step))
+            if delta.max() <= margin:
+                return delta, np.arange(len(y))
+        if not hasattr(self, "tree"):
+            from scipy.spatial import cKDTree
 
-def _ranges(start, length):
-    """The concatenated index ranges start[i] .. start[i] + length[i] - 1."""
-    total = int(length.sum())
-    return np.repeat(start - np.cumsum(length) + length, length) + np.arange(total)
+            self.tree = cKDTree(self.y)
+        return self.tree.query(y)
 
 
 class MeshTool:
@@ -920,74 +934,47 @@ class MeshTool:
         y = x - self.translation - np.array([0.0, 0.0, dz])
         npts = len(y)
         last = self._last
-        if last is not None and npts:
-            delta, ref = last.tree.query(y)
+        if last is None or not npts:
+            (t, u, v, kind, dist, rest), (near, bound, start, length) = self._search(y)
+            searched = np.arange(npts)
+            same = np.zeros(npts, dtype=bool)
+        else:
+            if np.array_equal(y, last.y):  # every point given again: the remembered points stay
+                self.counts["repeated"] += npts
+                return last.c, last.d, last.n, last.H
+            delta, ref = last.references(y, self._margin)
             same = delta == 0.0
-            if same.all():  # every point given again: the remembered points stay
+            if same.all():  # given again, some of them (the points in contact): the remembered points stay
                 self.counts["repeated"] += npts
                 return last.c[ref], last.d[ref], last.n[ref], last.H[ref]
-        else:
-            delta, ref, same = np.zeros(npts), np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
-        t, kind = np.zeros(npts, dtype=np.int64), np.full(npts, -1)
-        u, v, dist, rest = np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts)
-        # each point's neighbour list: a range of the pool of (patch, lower bound) pairs
-        start, length = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=np.int64)
-        near, bound = [np.zeros(0, dtype=np.int64)], [np.zeros(0)]
-        todo = ~same
-        if last is not None and npts:
-            near.append(last.near)
-            bound.append(last.bound)
+            found, t, u, v, kind, dist, rest, near, bound, start, length = self._warm(y, last, ref, delta)
+            searched = np.flatnonzero(~found)
+            self.counts["repeated"] += int(same.sum())
+            self.counts["warm"] += npts - int(same.sum()) - searched.size
+            if searched.size:
+                answers, lists = self._search(y[searched])
+                t[searched], u[searched], v[searched], kind[searched], dist[searched], rest[searched] = answers
+                start[searched], length[searched] = lists[2] + len(near), lists[3]
+                near, bound = np.concatenate([near, lists[0]]), np.concatenate([bound, lists[1]])
+        self.counts["searched"] += searched.size
+        c, d, n, H = self._signed(y, t, u, v, kind)
+        if same.any():
             rows = np.flatnonzero(same)
             r = ref[rows]
-            t[rows], u[rows], v[rows], kind[rows], dist[rows] = last.t[r], last.u[r], last.v[r], last.kind[r], \
-                last.dist[r]
-            rest[rows], start[rows], length[rows] = last.rest[r], last.start[r], last.length[r]
-            self.counts["repeated"] += rows.size
-            moved = np.flatnonzero(todo)
-            if moved.size:
-                r = ref[moved]
-                found, answers, pairs = self._warm(y[moved], last, r, delta[moved])
-                rows = moved[found]
-                t[rows], u[rows], v[rows], kind[rows], dist[rows], rest[rows] = answers
-                offset = len(last.near)
-                near.append(pairs[0])
-                bound.append(pairs[1])
-                start[rows], length[rows] = pairs[2] + offset, pairs[3]
-                todo[rows] = False
-                self.counts["warm"] += rows.size
-        searched = np.flatnonzero(todo)
-        self.counts["searched"] += searched.size
-        if searched.size:
-            answers, pairs = self._search(y[searched])
-            t[searched], u[searched], v[searched], kind[searched], dist[searched], rest[searched] = answers
-            offset = sum(len(a) for a in near)
-            near.append(pairs[0])
-            bound.append(pairs[1])
-            start[searched], length[searched] = pairs[2] + offset, pairs[3]
-        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
-        rows = np.flatnonzero(same)
-        if rows.size:
-            r = ref[rows]
             c[rows], d[rows], n[rows], H[rows] = last.c[r], last.d[r], last.n[r], last.H[r]
-        new = np.flatnonzero(~same)
-        if new.size:
-            c[new], d[new], n[new], H[new] = self._signed(y[new], t[new], u[new], v[new], kind[new])
         if npts:
-            at = _ranges(start, length)
-            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, dist, rest, length, np.concatenate(near)[at],
-                                     np.concatenate(bound)[at])
+            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, dist, rest, start, length, near, bound)
         return c, d, n, H
 
     def _warm(self, y, last, ref, delta):
-        """Points y moved by delta from the remembered points ref (_Remembered last): their
-        closest points from the remembered neighbour lists (module docstring). Returns which
-        were found; their patches t, (u, v), kind, distances and bounds beyond their lists; and
-        their lists (patches, lower bounds, start and length of each found point's)."""
-        out = _warm_pass(y, delta, ref, last.y, last.c, last.t, last.u, last.v, last.rest, last.start, last.length,
-                         last.near, last.bound, self.patches, self.corners, self.centre, self.radius, self.bulge,
-                         self.size)
-        found = out[0]
-        return found, tuple(a[found] for a in out[1:7]), (out[7], out[8], out[9][found], out[10][found])
+        """Points y moved by delta from the remembered points ref (_Remembered last), or given
+        again (delta 0: their remembered answers and lists): their closest points from the
+        remembered neighbour lists (module docstring). Returns which were found; their patches
+        t, (u, v), kinds, distances and bounds beyond their lists; their lists (patches, lower
+        bounds; each found point's start and length)."""
+        return _warm_pass(y, delta, ref, last.y, last.c, last.t, last.u, last.v, last.kind, last.dist, last.rest,
+                          last.start, last.length, last.near, last.bound, self.patches, self.corners, self.centre,
+                          self.radius, self.bulge, self.size)
 
     def _search(self, y):
         """The closest points of points y (tool frame), as _warm gives them, and their lists: every
