@@ -88,7 +88,9 @@ its distance itself where it was a candidate. Every patch outside the list lies 
 The last call's points are remembered with their answers, lists, L_T and R. A point given again
 (in the tool's frame: the same x and dz) takes its answer without a search (the contact set asks
 gap about three times and shape once per iterate at the same points). A moved point y' = y +
-delta e, y its nearest remembered point (|e| = 1, closest point c there), starts warm. The
+delta e starts warm, y its remembered point (|e| = 1, closest point c there): the point of the
+same index where the call has as many points as the last and each moved less than m (a contact
+set's nodes, moved by an iterate: no k-d tree to build and query), else the nearest. The
 distance to any set is 1-Lipschitz: the patches outside the list lie farther than R - delta,
 each listed patch farther than L_T - delta; c lies on the surface, so y' lies within U' =
 |y' - c| of it. Where U' <= R - delta - TIE (of the tool's size), the nearest patch is in the
@@ -105,6 +107,14 @@ answer is the search's (the same candidates' projections; ties at equal distance
 lesser patch). The list goes on with the candidates' new distances and the others' L_T -
 delta, R - delta; where R - delta < U' + TIE (a point moved about m in all since its search)
 the point is searched afresh. `counts` counts the points answered each way.
+
+Compiled. The projections (Newton on a patch, the edge curves), the flat triangles' distances,
+the warm start's and the search's bounds over each point's list and the signed answers are
+loops compiled by numba, one call of each a tool call (numpy's cost per operation, some 500
+array operations a call of 60 points, was most of a call's time: docs/tools.md). The k-d trees'
+queries, a search's pairs and the patches' H (surface_geometry.distance_hessian) stay numpy's
+and scipy's. The first use in a process compiles them (about 9 s CPU) unless shellform's numba
+cache holds them (shellform._jit; loaded from it, 0.2 s).
 
 Reading a file: STL (binary, or ASCII), or a gmsh .msh in its ASCII format (2.2 or 4.1: its
 3-node triangles; the corners of 6-node ones), parsed here without gmsh, so no script (a FILE.opt
@@ -638,9 +648,10 @@ def _warm_pass(y, delta, ref, last_y, last_c, last_t, last_u, last_v, last_kind,
                length, near, bound, patches, corners, centre, radius, bulge, size):
     """Points y moved by delta from the remembered points ref: their closest points from the
     remembered lists (module docstring; last_* the remembered points' y, closest points, patches,
-    (u, v) and R, their lists `length` pairs (near, bound) from `start`; size the tool's).
-    Returns which were found; their patches, (u, v), kinds, distances and R - delta (rows of
-    the found points); and the found points' lists: patches, lower bounds, start, length."""
+    (u, v), kinds, distances and R, their lists `length` pairs (near, bound) from `start`; size
+    the tool's); a point given again (delta 0) its remembered answer and list. Returns which
+    were found; their patches, (u, v), kinds, distances and R - delta; their lists: patches,
+    lower bounds (one pool), each found point's start and length in it."""
     n = len(y)
     found = np.zeros(n, dtype=np.bool_)
     t_out, kind_out = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
