@@ -88,7 +88,9 @@ its distance itself where it was a candidate. Every patch outside the list lies 
 The last call's points are remembered with their answers, lists, L_T and R. A point given again
 (in the tool's frame: the same x and dz) takes its answer without a search (the contact set asks
 gap about three times and shape once per iterate at the same points). A moved point y' = y +
-delta e, y its nearest remembered point (|e| = 1, closest point c there), starts warm. The
+delta e starts warm, y its remembered point (|e| = 1, closest point c there): the point of the
+same index where the call has as many points as the last and each moved less than m (a contact
+set's nodes, moved by an iterate: no k-d tree to build and query), else the nearest. The
 distance to any set is 1-Lipschitz: the patches outside the list lie farther than R - delta,
 each listed patch farther than L_T - delta; c lies on the surface, so y' lies within U' =
 |y' - c| of it. Where U' <= R - delta - TIE (of the tool's size), the nearest patch is in the
@@ -106,6 +108,14 @@ lesser patch). The list goes on with the candidates' new distances and the other
 delta, R - delta; where R - delta < U' + TIE (a point moved about m in all since its search)
 the point is searched afresh. `counts` counts the points answered each way.
 
+Compiled. The projections (Newton on a patch, the edge curves), the flat triangles' distances,
+the warm start's and the search's bounds over each point's list and the signed answers are
+loops compiled by numba, one call of each a tool call (numpy's cost per operation, some 500
+array operations a call of 60 points, was most of a call's time: docs/tools.md). The k-d trees'
+queries, a search's pairs and the patches' H (surface_geometry.distance_hessian) stay numpy's
+and scipy's. The first use in a process compiles them (about 9 s CPU) unless shellform's numba
+cache holds them (shellform._jit; loaded from it, 0.2 s).
+
 Reading a file: STL (binary, or ASCII), or a gmsh .msh in its ASCII format (2.2 or 4.1: its
 3-node triangles; the corners of 6-node ones), parsed here without gmsh, so no script (a FILE.opt
 beside it) runs. At most MAX_MESH_BYTES. Vertices nearer than MERGE_TOLERANCE of the model's
@@ -122,6 +132,7 @@ from pathlib import Path
 
 import numpy as np
 
+from shellform._jit import njit
 from shellform.contact.holder_edge import closed_loops
 from shellform.contact.surface_geometry import distance_hessian
 from shellform.errors import InputError
@@ -462,74 +473,363 @@ def nagata_patches(vertices, triangles, feature_angle: float = FEATURE_ANGLE):
         .reshape(T, 6, 3)
 
 
-# -- the patches' geometry -------------------------------------------------------------------
-def _evaluate(A, u, v):
-    """X, X_u, X_v of patches A (m, 6, 3) at (u, v)."""
-    u, v = u[:, None], v[:, None]
-    X = A[:, 0] + A[:, 1] * u + A[:, 2] * v + A[:, 3] * u * u + A[:, 4] * v * v + A[:, 5] * u * v
-    Xu = A[:, 1] + 2.0 * A[:, 3] * u + A[:, 5] * v
-    Xv = A[:, 2] + 2.0 * A[:, 4] * v + A[:, 5] * u
-    return X, Xu, Xv
+_EDGE_START = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])  # (u, v) at each edge's start
+_EDGE_DIRECTION = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])  # d(u, v)/ds along each edge
+_EDGE_CORNERS = np.array([[0, 1], [1, 2], [0, 2]])  # each edge's corners
 
 
-def _flat_closest(y, p0, p1, p2):
-    """The closest points' barycentric (u, v) on flat triangles p0 p1 p2 (m, 3) and the
-    distances to them."""
-    e1, e2 = p1 - p0, p2 - p0
-    w = y - p0
-    g11, g12, g22 = (np.einsum("ij,ij->i", a, b) for a, b in ((e1, e1), (e1, e2), (e2, e2)))
-    r1, r2 = np.einsum("ij,ij->i", w, e1), np.einsum("ij,ij->i", w, e2)
+# -- the closest points, compiled (numba: a call's few loops instead of hundreds of numpy
+# operations on a few hundred rows). A patch is A (6, 3), a_0 .. a_5; its flat triangle P (3, 3).
+
+
+@njit
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit
+def _at(A, u, v, X, Xu, Xv):
+    """X, X_u, X_v of patch A at (u, v), into X, Xu, Xv (3)."""
+    for k in range(3):
+        X[k] = A[0, k] + A[1, k] * u + A[2, k] * v + A[3, k] * u * u + A[4, k] * v * v + A[5, k] * u * v
+        Xu[k] = A[1, k] + 2.0 * A[3, k] * u + A[5, k] * v
+        Xv[k] = A[2, k] + 2.0 * A[4, k] * v + A[5, k] * u
+
+
+@njit
+def _distance(y, X):
+    return np.sqrt((y[0] - X[0]) ** 2 + (y[1] - X[1]) ** 2 + (y[2] - X[2]) ** 2)
+
+
+@njit
+def _sub(a, b):
+    return a[0] - b[0], a[1] - b[1], a[2] - b[2]
+
+
+@njit
+def _less(a, s, b):
+    """a - s b of three-vectors."""
+    return a[0] - s * b[0], a[1] - s * b[1], a[2] - s * b[2]
+
+
+@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+def _flat(y, P):
+    """The closest point's barycentric (u, v) on the flat triangle P and the distance to it:
+    the plane's foot point where it lies inside, else the nearest of the three edges' (clamped
+    to the edge; the first of equals)."""
+    e1, e2, w = _sub(P[1], P[0]), _sub(P[2], P[0]), _sub(y, P[0])
+    g11, g12, g22, r1, r2 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2), _dot(w, e1), _dot(w, e2)
     det = g11 * g22 - g12 * g12
     u = (g22 * r1 - g12 * r2) / det
     v = (g11 * r2 - g12 * r1) / det
-    inside = (u >= 0) & (v >= 0) & (u + v <= 1)
-    best_u, best_v = np.where(inside, u, 0.0), np.where(inside, v, 0.0)
-    dist = np.where(inside, np.linalg.norm(w - u[:, None] * e1 - v[:, None] * e2, axis=1), np.inf)
-    for (q0, q1, du, dv, u0, v0) in ((p0, p1, 1.0, 0.0, 0.0, 0.0), (p1, p2, -1.0, 1.0, 1.0, 0.0),
-                                     (p0, p2, 0.0, 1.0, 0.0, 0.0)):
-        s = q1 - q0
-        t = np.clip(np.einsum("ij,ij->i", y - q0, s) / np.einsum("ij,ij->i", s, s), 0.0, 1.0)
-        dd = np.linalg.norm(y - q0 - t[:, None] * s, axis=1)
-        better = ~inside & (dd < dist)
-        dist = np.where(better, dd, dist)
-        best_u = np.where(better, u0 + du * t, best_u)
-        best_v = np.where(better, v0 + dv * t, best_v)
+    if u >= 0.0 and v >= 0.0 and u + v <= 1.0:
+        r = _less(_less(w, u, e1), v, e2)
+        return u, v, np.sqrt(_dot(r, r))
+    best_u, best_v, dist = 0.0, 0.0, np.inf
+    for e in range(3):
+        q0 = P[_EDGE_CORNERS[e, 0]]
+        s = _sub(P[_EDGE_CORNERS[e, 1]], q0)
+        w = _sub(y, q0)
+        t = min(max(_dot(w, s) / _dot(s, s), 0.0), 1.0)
+        r = _less(w, t, s)
+        dd = np.sqrt(_dot(r, r))
+        if dd < dist:
+            dist, best_u, best_v = dd, _EDGE_START[e, 0] + _EDGE_DIRECTION[e, 0] * t, \
+                _EDGE_START[e, 1] + _EDGE_DIRECTION[e, 1] * t
     return best_u, best_v, dist
 
 
-_EDGE_START = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])  # (u, v) at each edge's start
-_EDGE_DIRECTION = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])  # d(u, v)/ds along each edge
+@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+def _newton(A, y, u, v, X, Xu, Xv):
+    """Newton on patch A from (u, v) for the minimiser of |X - y|^2 (the Hessian J^T J + (X - y)
+    . X_ij, or J^T J where that is not positive): (u, v) and whether it converged inside the
+    triangle (within 1e-10; then clamped onto it). A step that leaves u, v >= -1, u + v <= 2
+    stops it (the edges decide)."""
+    converged = False
+    for _ in range(NEWTON_ITERATIONS):
+        _at(A, u, v, X, Xu, Xv)
+        g0 = g1 = guu = guv = gvv = huu = hvv = huv = 0.0
+        for k in range(3):
+            r = X[k] - y[k]
+            g0 += Xu[k] * r
+            g1 += Xv[k] * r
+            guu += Xu[k] * Xu[k]
+            guv += Xu[k] * Xv[k]
+            gvv += Xv[k] * Xv[k]
+            huu += r * (2.0 * A[3, k])
+            hvv += r * (2.0 * A[4, k])
+            huv += r * A[5, k]
+        huu, hvv, huv = guu + huu, gvv + hvv, guv + huv
+        det = huu * hvv - huv * huv
+        if det <= 1e-12 * (guu * gvv) or huu <= 0.0:
+            huu, hvv, huv = guu, gvv, guv
+            det = huu * hvv - huv * huv
+        du = -(hvv * g0 - huv * g1) / det
+        dv = -(huu * g1 - huv * g0) / det
+        u += du
+        v += dv
+        if abs(du) + abs(dv) < 1e-13:
+            converged = True
+            break
+        if u < -1.0 or v < -1.0 or u + v > 2.0:
+            break
+    eps = 1e-10
+    if converged and u >= -eps and v >= -eps and u + v <= 1.0 + eps:
+        return min(max(u, 0.0), 1.0), min(max(v, 0.0), 1.0), True
+    return u, v, False
+
+
+@njit
+def _edge_curve(A, k, u0, v0, du, dv, y):
+    """Component k of the edge curve's x(s) - y = Q0 + Q1 s + Q2 s^2 from (u0, v0) along (du, dv)."""
+    return A[0, k] + A[1, k] * u0 + A[2, k] * v0 + A[3, k] * (u0 * u0) + A[4, k] * (v0 * v0) \
+        + A[5, k] * (u0 * v0) - y[k], \
+        (A[1, k] + 2.0 * A[3, k] * u0 + A[5, k] * v0) * du + (A[2, k] + 2.0 * A[4, k] * v0 + A[5, k] * u0) * dv, \
+        A[3, k] * (du * du) + A[4, k] * (dv * dv) + A[5, k] * (du * dv)
+
+
+@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+def _edge_curves(A, P, y, X, Xu, Xv):
+    """The nearest point on patch A's three edge curves (0: u-axis, 1: u + v = 1, 2: v-axis):
+    on each, Newton in its parameter s from the flat edge's closest point, clamped to [0, 1],
+    on the cubic (x(s) - y) . x'(s) (x(s) = Q0 + Q1 s + Q2 s^2; x'(s) . x'(s) its derivative
+    where that is not positive). Returns the nearest edge's (u, v), distance and edge (the
+    first of equals)."""
+    best_u, best_v, best, edge = 0.0, 0.0, np.inf, -1
+    for e in range(3):
+        u0, v0 = _EDGE_START[e, 0], _EDGE_START[e, 1]
+        du, dv = _EDGE_DIRECTION[e, 0], _EDGE_DIRECTION[e, 1]
+        a = P[_EDGE_CORNERS[e, 0]]
+        d = _sub(P[_EDGE_CORNERS[e, 1]], a)
+        s = min(max(_dot(_sub(y, a), d) / _dot(d, d), 0.0), 1.0)
+        qx, qy, qz = _edge_curve(A, 0, u0, v0, du, dv, y), _edge_curve(A, 1, u0, v0, du, dv, y), \
+            _edge_curve(A, 2, u0, v0, du, dv, y)
+        Q0, Q1, Q2 = (qx[0], qy[0], qz[0]), (qx[1], qy[1], qz[1]), (qx[2], qy[2], qz[2])
+        c0, c1 = _dot(Q0, Q1), _dot(Q1, Q1) + 2.0 * _dot(Q0, Q2)
+        c2, c3 = 3.0 * _dot(Q1, Q2), 2.0 * _dot(Q2, Q2)
+        ff0 = _dot(Q1, Q1)
+        for _ in range(NEWTON_ITERATIONS):
+            g = c0 + s * (c1 + s * (c2 + s * c3))
+            h = c1 + s * (2.0 * c2 + 3.0 * c3 * s)
+            ff = ff0 + s * (4.0 * c2 / 3.0 + 2.0 * c3 * s)  # |x'|^2
+            new = min(max(s - g / (h if h > 0 else ff), 0.0), 1.0)
+            done = abs(new - s) < 1e-13
+            s = new
+            if done:
+                break
+        u, v = u0 + du * s, v0 + dv * s
+        _at(A, u, v, X, Xu, Xv)
+        dist = _distance(y, X)
+        if dist < best:
+            best_u, best_v, best, edge = u, v, dist, e
+    return best_u, best_v, best, edge
+
+
+@njit
+def _exact(A, P, y, u, v, X, Xu, Xv):
+    """The nearest point of y on patch A (flat triangle P): Newton from (u, v); the edge curves
+    where the minimiser leaves the triangle. Its (u, v), distance and kind (-1 inside, 0, 1, 2
+    the edge)."""
+    u, v, inside = _newton(A, y, u, v, X, Xu, Xv)
+    if inside:
+        _at(A, u, v, X, Xu, Xv)
+        return u, v, _distance(y, X), -1
+    return _edge_curves(A, P, y, X, Xu, Xv)
+
+
+@njit
+def _nearer(dist, t, best, best_t):
+    """Whether patch t at dist is nearer than the best so far (ties: the lesser patch)."""
+    return dist < best or (dist == best and t < best_t)
+
+
+@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+def _warm_pass(y, delta, ref, last_y, last_c, last_t, last_u, last_v, last_kind, last_dist, last_rest, start,
+               length, near, bound, patches, corners, centre, radius, bulge, size):
+    """Points y moved by delta from the remembered points ref: their closest points from the
+    remembered lists (module docstring; last_* the remembered points' y, closest points, patches,
+    (u, v), kinds, distances and R, their lists `length` pairs (near, bound) from `start`; size
+    the tool's); a point given again (delta 0) its remembered answer and list. Returns which
+    were found; their patches, (u, v), kinds, distances and R - delta; their lists: patches,
+    lower bounds (one pool), each found point's start and length in it."""
+    n = len(y)
+    found = np.zeros(n, dtype=np.bool_)
+    t_out, kind_out = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    u_out, v_out, dist_out, rest_out = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    total = 0
+    for i in range(n):
+        total += length[ref[i]]
+    near_out, bound_out = np.empty(total, dtype=np.int64), np.empty(total)
+    start_out, length_out = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    X, Xu, Xv = np.empty(3), np.empty(3), np.empty(3)
+    at = 0
+    for i in range(n):
+        r, moved = ref[i], delta[i]
+        rest = last_rest[r] - moved  # the distance is 1-Lipschitz
+        if moved == 0.0:  # given again: its answer and list
+            found[i] = True
+            t_out[i], u_out[i], v_out[i], kind_out[i], dist_out[i], rest_out[i] = last_t[r], last_u[r], last_v[r], \
+                last_kind[r], last_dist[r], rest
+            near_out[at:at + length[r]] = near[start[r]:start[r] + length[r]]
+            bound_out[at:at + length[r]] = bound[start[r]:start[r] + length[r]]
+            start_out[i], length_out[i] = at, length[r]
+            at += length[r]
+            continue
+        upper = _distance(y[i], last_c[r])  # the remembered closest point lies on the surface
+        if not upper <= rest - TIE * size:  # a patch outside the list may be nearer: searched
+            continue
+        limit = upper * (1 + 1e-12) + 1e-12 * size
+        step = _sub(y[i], last_y[r])
+        best, best_t, best_u, best_v, best_kind = np.inf, -1, 0.0, 0.0, -1
+        for j in range(length[r]):
+            k = near[start[r] + j]
+            lower = bound[start[r] + j] - moved
+            if lower <= limit:
+                u, v = last_u[r], last_v[r]
+                if k != last_t[r]:  # the cone from the remembered point to the patch's sphere
+                    w = _sub(centre[k], last_y[r])
+                    far = np.sqrt(_dot(w, w))
+                    sin_a = min(radius[k] / far, 1.0)
+                    cos_p = min(max(_dot(w, step) / (far * moved), -1.0), 1.0)
+                    cos_a = np.sqrt(1.0 - sin_a * sin_a)
+                    toward = 1.0
+                    if not (cos_p >= cos_a or far <= radius[k]):
+                        toward = cos_p * cos_a + np.sqrt(1.0 - cos_p * cos_p) * sin_a
+                    lower = max(lower, bound[start[r] + j] - moved * toward)
+                    if lower <= limit:  # the flat triangle's distance less the bulge
+                        u, v, flat = _flat(y[i], corners[k])
+                        lower = max(lower, flat - bulge[k])
+                if lower <= limit:  # a candidate: projected
+                    u, v, lower, kind = _exact(patches[k], corners[k], y[i], u, v, X, Xu, Xv)
+                    if _nearer(lower, k, best, best_t):
+                        best, best_t, best_u, best_v, best_kind = lower, k, u, v, kind
+            near_out[at + j], bound_out[at + j] = k, lower
+        if best_t < 0:
+            continue
+        found[i] = True
+        t_out[i], u_out[i], v_out[i], kind_out[i], dist_out[i], rest_out[i] = best_t, best_u, best_v, best_kind, \
+            best, rest
+        start_out[i], length_out[i] = at, length[r]
+        at += length[r]
+    return found, t_out, u_out, v_out, kind_out, dist_out, rest_out, near_out[:at], bound_out[:at], start_out, \
+        length_out
+
+
+@njit
+def _upper_bounds(y, near, corners, bulge):
+    """Each point's least upper bound (flat distance plus bulge) over the patches `near` (points,
+    k)."""
+    n, k = near.shape
+    upper = np.full(n, np.inf)
+    for i in range(n):
+        for j in range(k):
+            t = near[i, j]
+            upper[i] = min(upper[i], _flat(y[i], corners[t])[2] + bulge[t])
+    return upper
+
+
+@njit
+def _search_pass(y, p, t, upper, rest, patches, corners, bulge, size):
+    """The search's pairs (point p, patch t; by point): each pair's lower bound the flat
+    distance less the bulge, kept where it lies within the point's rest; the candidates (lower
+    bound within upper) projected, their distances their bounds. Returns the points' closest
+    patches, (u, v), kinds and distances, and their lists (patches, lower bounds, start,
+    length)."""
+    n = len(y)
+    t_out, kind_out = np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    u_out, v_out, dist_out = np.zeros(n), np.zeros(n), np.full(n, np.inf)
+    near_out, bound_out = np.empty(len(p), dtype=np.int64), np.empty(len(p))
+    length = np.zeros(n, dtype=np.int64)
+    X, Xu, Xv = np.empty(3), np.empty(3), np.empty(3)
+    at = 0
+    for q in range(len(p)):
+        i, k = p[q], t[q]
+        u, v, flat = _flat(y[i], corners[k])
+        lower = flat - bulge[k]
+        if not lower <= rest[i]:
+            continue
+        if lower <= upper[i] * (1 + 1e-12) + 1e-12 * size:
+            u, v, lower, kind = _exact(patches[k], corners[k], y[i], u, v, X, Xu, Xv)
+            if _nearer(lower, k, dist_out[i], t_out[i]):
+                t_out[i], u_out[i], v_out[i], kind_out[i], dist_out[i] = k, u, v, kind, lower
+        near_out[at], bound_out[at] = k, lower
+        length[i] += 1
+        at += 1
+    return t_out, u_out, v_out, kind_out, dist_out, near_out[:at], bound_out[:at], np.cumsum(length) - length, length
+
+
+@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+def _signed_pass(y, t, u, v, kind, patches, sign, tiny, c, d, n, H, J, S):
+    """Closest points c, signed distances d, normals n at the closest points (u, v) of patches t;
+    H on the edge curves (kind 0, 1, 2: the curve's, (I - n n^T - x' x'^T / (|x'|^2 - (y - c)
+    . x'')) / d; at a vertex (I - n n^T) / d; 0 within `tiny` of the curve), and J, S (X_u, X_v;
+    X_uu, X_vv, X_uv) for the patches' H of the points inside (kind -1)."""
+    Xu, Xv = np.empty(3), np.empty(3)
+    for i in range(len(y)):
+        A = patches[t[i]]
+        _at(A, u[i], v[i], c[i], Xu, Xv)
+        for k in range(3):
+            J[i, 0, k], J[i, 1, k] = Xu[k], Xv[k]
+            S[i, 0, k], S[i, 1, k], S[i, 2, k] = 2.0 * A[3, k], 2.0 * A[4, k], A[5, k]
+        nc = (Xu[1] * Xv[2] - Xu[2] * Xv[1], Xu[2] * Xv[0] - Xu[0] * Xv[2], Xu[0] * Xv[1] - Xu[1] * Xv[0])
+        norm = max(np.sqrt(_dot(nc, nc)), 1e-300)
+        nc = (sign * nc[0] / norm, sign * nc[1] / norm, sign * nc[2] / norm)
+        r = _sub(y[i], c[i])
+        dist = np.sqrt(_dot(r, r))
+        d[i] = _dot(r, nc)
+        for k in range(3):
+            n[i, k] = nc[k]
+        if kind[i] < 0:
+            continue
+        s = -1.0 if d[i] < 0.0 else 1.0
+        far = dist > tiny
+        d[i] = s * dist
+        if far:
+            for k in range(3):
+                n[i, k] = s * r[k] / dist
+        du, dv = _EDGE_DIRECTION[kind[i], 0], _EDGE_DIRECTION[kind[i], 1]
+        first = (Xu[0] * du + Xv[0] * dv, Xu[1] * du + Xv[1] * dv, Xu[2] * du + Xv[2] * dv)
+        w0, w1, w2 = du * du, dv * dv, 2 * du * dv
+        second = (w0 * S[i, 0, 0] + w1 * S[i, 1, 0] + w2 * S[i, 2, 0], w0 * S[i, 0, 1] + w1 * S[i, 1, 1]
+                  + w2 * S[i, 2, 1], w0 * S[i, 0, 2] + w1 * S[i, 1, 2] + w2 * S[i, 2, 2])
+        position = u[i] if kind[i] == 0 else v[i]
+        vertex = position <= 0.0 or position >= 1.0
+        ff = _dot(first, first)
+        stiff = max(ff - _dot(r, second), 1e-12 * ff)
+        scale = d[i] if far else np.inf
+        for a in range(3):
+            for b in range(3):
+                P = (1.0 if a == b else 0.0) - n[i, a] * n[i, b]
+                if not vertex:
+                    P = P - first[a] * first[b] / stiff
+                H[i, a, b] = P / scale
 
 
 class _Remembered:
     """A call's points y (tool frame) and their answers: closest points c, signed distances d,
     normals n, H; the closest points' patches t, (u, v), kind (-1 inside, 0, 1, 2 the edge) and
     distances; each point's neighbour list, `length` patches `near` with lower bounds `bound`
-    of their distances (the points' lists one after another), every patch outside the list
-    farther than `rest`."""
+    of their distances from `start`, every patch outside the list farther than `rest`."""
 
-    def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, length, near, bound):
-        from scipy.spatial import cKDTree
-
-        self.y, self.tree = y, cKDTree(y)
+    def __init__(self, y, c, d, n, H, t, u, v, kind, dist, rest, start, length, near, bound):
+        self.y = y
         self.c, self.d, self.n, self.H, self.t, self.u, self.v, self.kind = c, d, n, H, t, u, v, kind
-        self.dist, self.rest, self.length, self.near, self.bound = dist, rest, length, near, bound
-        self.start = np.cumsum(length) - length
+        self.dist, self.rest, self.start, self.length, self.near, self.bound = dist, rest, start, length, near, bound
 
+    def references(self, y, margin):
+        """Each point of y's remembered point and its distance from it: the point of the same
+        index where y has as many points as the remembered ones and each lies within margin
+        of its own (a contact set's nodes, moved by an iterate), else the nearest (a k-d tree)."""
+        if len(y) == len(self.y):
+            step = y - self.y
+            delta = np.sqrt(np.einsum("ij,ij->i", step, step))
+            if delta.max() <= margin:
+                return delta, np.arange(len(y))
+        if not hasattr(self, "tree"):
+            from scipy.spatial import cKDTree
 
-def _firsts(p, dist, t):
-    """Of pairs (point p, patch t) at distances dist: each point's nearest (the lesser patch of
-    equals), in the order of the points."""
-    order = np.lexsort((t, dist, p))
-    head = np.ones(order.size, dtype=bool)
-    head[1:] = p[order][1:] != p[order][:-1]
-    return order[head]
-
-
-def _ranges(start, length):
-    """The concatenated index ranges start[i] .. start[i] + length[i] - 1."""
-    total = int(length.sum())
-    return np.repeat(start - np.cumsum(length) + length, length) + np.arange(total)
+            self.tree = cKDTree(self.y)
+        return self.tree.query(y)
 
 
 class MeshTool:
@@ -645,112 +945,47 @@ class MeshTool:
         y = x - self.translation - np.array([0.0, 0.0, dz])
         npts = len(y)
         last = self._last
-        if last is not None and npts:
-            delta, ref = last.tree.query(y)
+        if last is None or not npts:
+            (t, u, v, kind, dist, rest), (near, bound, start, length) = self._search(y)
+            searched = np.arange(npts)
+            same = np.zeros(npts, dtype=bool)
+        else:
+            if np.array_equal(y, last.y):  # every point given again: the remembered points stay
+                self.counts["repeated"] += npts
+                return last.c, last.d, last.n, last.H
+            delta, ref = last.references(y, self._margin)
             same = delta == 0.0
-            if same.all():  # every point given again: the remembered points stay
+            if same.all():  # given again, some of them (the points in contact): the remembered points stay
                 self.counts["repeated"] += npts
                 return last.c[ref], last.d[ref], last.n[ref], last.H[ref]
-        else:
-            delta, ref, same = np.zeros(npts), np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=bool)
-        t, kind = np.zeros(npts, dtype=np.int64), np.full(npts, -1)
-        u, v, dist, rest = np.zeros(npts), np.zeros(npts), np.zeros(npts), np.zeros(npts)
-        # each point's neighbour list: a range of the pool of (patch, lower bound) pairs
-        start, length = np.zeros(npts, dtype=np.int64), np.zeros(npts, dtype=np.int64)
-        near, bound = [np.zeros(0, dtype=np.int64)], [np.zeros(0)]
-        todo = ~same
-        if last is not None and npts:
-            near.append(last.near)
-            bound.append(last.bound)
+            found, t, u, v, kind, dist, rest, near, bound, start, length = self._warm(y, last, ref, delta)
+            searched = np.flatnonzero(~found)
+            self.counts["repeated"] += int(same.sum())
+            self.counts["warm"] += npts - int(same.sum()) - searched.size
+            if searched.size:
+                answers, lists = self._search(y[searched])
+                t[searched], u[searched], v[searched], kind[searched], dist[searched], rest[searched] = answers
+                start[searched], length[searched] = lists[2] + len(near), lists[3]
+                near, bound = np.concatenate([near, lists[0]]), np.concatenate([bound, lists[1]])
+        self.counts["searched"] += searched.size
+        c, d, n, H = self._signed(y, t, u, v, kind)
+        if same.any():
             rows = np.flatnonzero(same)
             r = ref[rows]
-            t[rows], u[rows], v[rows], kind[rows], dist[rows] = last.t[r], last.u[r], last.v[r], last.kind[r], \
-                last.dist[r]
-            rest[rows], start[rows], length[rows] = last.rest[r], last.start[r], last.length[r]
-            self.counts["repeated"] += rows.size
-            moved = np.flatnonzero(todo)
-            if moved.size:
-                r = ref[moved]
-                found, answers, pairs = self._warm(y[moved], last, r, delta[moved])
-                rows = moved[found]
-                t[rows], u[rows], v[rows], kind[rows], dist[rows], rest[rows] = answers
-                offset = len(last.near)
-                near.append(pairs[0])
-                bound.append(pairs[1])
-                start[rows], length[rows] = pairs[2] + offset, pairs[3]
-                todo[rows] = False
-                self.counts["warm"] += rows.size
-        searched = np.flatnonzero(todo)
-        self.counts["searched"] += searched.size
-        if searched.size:
-            answers, pairs = self._search(y[searched])
-            t[searched], u[searched], v[searched], kind[searched], dist[searched], rest[searched] = answers
-            offset = sum(len(a) for a in near)
-            near.append(pairs[0])
-            bound.append(pairs[1])
-            start[searched], length[searched] = pairs[2] + offset, pairs[3]
-        c, d, n, H = np.zeros((npts, 3)), np.zeros(npts), np.zeros((npts, 3)), np.zeros((npts, 3, 3))
-        rows = np.flatnonzero(same)
-        if rows.size:
-            r = ref[rows]
             c[rows], d[rows], n[rows], H[rows] = last.c[r], last.d[r], last.n[r], last.H[r]
-        new = np.flatnonzero(~same)
-        if new.size:
-            c[new], d[new], n[new], H[new] = self._signed(y[new], t[new], u[new], v[new], kind[new])
         if npts:
-            at = _ranges(start, length)
-            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, dist, rest, length, np.concatenate(near)[at],
-                                     np.concatenate(bound)[at])
+            self._last = _Remembered(y, c, d, n, H, t, u, v, kind, dist, rest, start, length, near, bound)
         return c, d, n, H
 
     def _warm(self, y, last, ref, delta):
-        """Points y moved by delta from the remembered points ref (_Remembered last): their
-        closest points from the remembered neighbour lists (module docstring). Returns which
-        were found; their patches t, (u, v), kind, distances and bounds beyond their lists; and
-        their lists (patches, lower bounds, start and length of each found point's)."""
-        npts = len(y)
-        rest = last.rest[ref] - delta  # the distance is 1-Lipschitz
-        upper = np.linalg.norm(y - last.c[ref], axis=1)  # the remembered closest point lies on the surface
-        found = upper <= rest - TIE * self.size  # no patch outside the list may be nearer
-        length = last.length[ref]
-        at = _ranges(last.start[ref], length)
-        p = np.repeat(np.arange(npts), length)
-        t = last.near[at]
-        lower = last.bound[at] - delta[p]
-        limit = upper * (1 + 1e-12) + 1e-12 * self.size
-        cand = np.flatnonzero(found[p] & (lower <= limit[p]))
-        pc, tc = p[cand], t[cand]
-        own = tc == last.t[ref[pc]]  # the remembered patch: Newton from the remembered (u, v)
-        other = np.flatnonzero(~own)
-        if other.size:  # the cone from the remembered point to each patch's sphere
-            i, k = pc[other], tc[other]
-            w = self.centre[k] - last.y[ref[i]]
-            step = y[i] - last.y[ref[i]]
-            far = np.linalg.norm(w, axis=1)
-            sin_a = np.minimum(self.radius[k] / far, 1.0)
-            cos_p = np.clip(np.einsum("ij,ij->i", w, step) / (far * delta[i]), -1.0, 1.0)
-            cos_a = np.sqrt(1.0 - sin_a * sin_a)
-            toward = np.where((cos_p >= cos_a) | (far <= self.radius[k]), 1.0,
-                              cos_p * cos_a + np.sqrt(1.0 - cos_p * cos_p) * sin_a)
-            lower[cand[other]] = np.maximum(lower[cand[other]], last.bound[at[cand[other]]] - delta[i] * toward)
-            closer = own | (lower[cand] <= limit[pc])
-            cand, pc, tc, own = cand[closer], pc[closer], tc[closer], own[closer]
-        u, v = last.u[ref[pc]], last.v[ref[pc]]
-        other = np.flatnonzero(~own)
-        if other.size:  # the others' flat triangles' distances less the bulges
-            P = self.corners[tc[other]]
-            u[other], v[other], flat = _flat_closest(y[pc[other]], P[:, 0], P[:, 1], P[:, 2])
-            lower[cand[other]] = np.maximum(lower[cand[other]], flat - self.bulge[tc[other]])
-            closer = own | (lower[cand] <= limit[pc])
-            cand, pc, tc, u, v = cand[closer], pc[closer], tc[closer], u[closer], v[closer]
-        u, v, dc, kc = self._exact(y[pc], tc, u, v)
-        lower[cand] = dc
-        # the nearest: the first of equals by patch
-        head = _firsts(pc, dc, tc)
-        keep = found[p]
-        length = length[found]
-        answers = (tc[head], u[head], v[head], kc[head], dc[head], rest[found])
-        return found, answers, (t[keep], lower[keep], np.cumsum(length) - length, length)
+        """Points y moved by delta from the remembered points ref (_Remembered last), or given
+        again (delta 0: their remembered answers and lists): their closest points from the
+        remembered neighbour lists (module docstring). Returns which were found; their patches
+        t, (u, v), kinds, distances and bounds beyond their lists; their lists (patches, lower
+        bounds; each found point's start and length)."""
+        return _warm_pass(y, delta, ref, last.y, last.c, last.t, last.u, last.v, last.kind, last.dist, last.rest,
+                          last.start, last.length, last.near, last.bound, self.patches, self.corners, self.centre,
+                          self.radius, self.bulge, self.size)
 
     def _search(self, y):
         """The closest points of points y (tool frame), as _warm gives them, and their lists: every
@@ -762,10 +997,7 @@ class MeshTool:
         npts, T = len(y), len(self.patches)
         k = min(NEAREST_SAMPLES, self._samples.n)
         _, near = self._samples.query(y, k=k)
-        near = self._sample_owner[np.asarray(near).reshape(npts, k)].ravel()
-        P = self.corners[near]
-        _, _, flat = _flat_closest(np.repeat(y, k, axis=0), P[:, 0], P[:, 1], P[:, 2])
-        upper = (flat + self.bulge[near]).reshape(npts, k).min(axis=1)
+        upper = _upper_bounds(y, self._sample_owner[np.asarray(near).reshape(npts, k)], self.corners, self.bulge)
         rest = upper + self._margin
         lists = self._samples.query_ball_point(y, rest + self._reach, return_sorted=True)
         lengths = np.fromiter(map(len, lists), dtype=np.int64, count=npts)
@@ -773,143 +1005,19 @@ class MeshTool:
         # a point's samples come sorted, a triangle's samples are consecutive: one pair per run
         pair = np.repeat(np.arange(npts) * T, lengths) + self._sample_owner[samples]
         pair = pair[np.r_[True, pair[1:] != pair[:-1]]]
-        p, t = pair // T, pair % T
-        P = self.corners[t]
-        u, v, flat = _flat_closest(y[p], P[:, 0], P[:, 1], P[:, 2])
-        lower = flat - self.bulge[t]
-        keep = lower <= rest[p]
-        p, t, u, v, lower = p[keep], t[keep], u[keep], v[keep], lower[keep]
-        cand = np.flatnonzero(lower <= upper[p] * (1 + 1e-12) + 1e-12 * self.size)
-        pc, tc = p[cand], t[cand]
-        u, v, dc, kc = self._exact(y[pc], tc, u[cand], v[cand])
-        lower[cand] = dc
-        best = _firsts(pc, dc, tc)  # every point has a candidate: the triangle that gave upper
-        length = np.bincount(p, minlength=npts)
-        return (tc[best], u[best], v[best], kc[best], dc[best], rest), (t, lower, np.cumsum(length) - length, length)
-
-    def _exact(self, y, t, u, v):
-        """The nearest points of points y on patches t: Newton from (u, v); the edge curves
-        where the minimiser leaves the triangle. Their (u, v), distances and kind (-1 inside,
-        0, 1, 2 the edge)."""
-        u, v, inside = self._project(y, t, u, v)
-        X, _, _ = _evaluate(self.patches[t], u, v)
-        dist = np.where(inside, np.linalg.norm(y - X, axis=1), np.inf)
-        kind = np.full(len(t), -1)
-        out = np.flatnonzero(~inside)
-        if out.size:
-            u[out], v[out], dist[out], kind[out] = self._project_edges(y[out], t[out])
-        return u, v, dist, kind
-
-    def _project(self, y, t, u, v):
-        """Newton on patches t from (u, v): the minimisers of |X - y|^2 and whether each lies
-        inside its triangle (converged there)."""
-        A = self.patches[t]
-        S = np.stack([2.0 * A[:, 3], 2.0 * A[:, 4], A[:, 5]], axis=1)
-        u, v = u.copy(), v.copy()
-        active = np.ones(len(t), dtype=bool)
-        converged = np.zeros(len(t), dtype=bool)
-        tol = 1e-13
-        for _ in range(NEWTON_ITERATIONS):
-            i = np.flatnonzero(active)
-            if i.size == 0:
-                break
-            X, Xu, Xv = _evaluate(A[i], u[i], v[i])
-            r = X - y[i]
-            g = np.stack([np.einsum("ij,ij->i", Xu, r), np.einsum("ij,ij->i", Xv, r)], axis=1)
-            guu, guv, gvv = (np.einsum("ij,ij->i", a, b) for a, b in ((Xu, Xu), (Xu, Xv), (Xv, Xv)))
-            huu = guu + np.einsum("ij,ij->i", r, S[i, 0])
-            hvv = gvv + np.einsum("ij,ij->i", r, S[i, 1])
-            huv = guv + np.einsum("ij,ij->i", r, S[i, 2])
-            det = huu * hvv - huv * huv
-            indefinite = (det <= 1e-12 * (guu * gvv)) | (huu <= 0)
-            huu, hvv = np.where(indefinite, guu, huu), np.where(indefinite, gvv, hvv)
-            huv = np.where(indefinite, guv, huv)
-            det = huu * hvv - huv * huv
-            du = -(hvv * g[:, 0] - huv * g[:, 1]) / det
-            dv = -(huu * g[:, 1] - huv * g[:, 0]) / det
-            u[i] += du
-            v[i] += dv
-            small = np.abs(du) + np.abs(dv) < tol
-            far = (u[i] < -1.0) | (v[i] < -1.0) | (u[i] + v[i] > 2.0)  # left it: its edges decide
-            converged[i[small]] = True
-            active[i[small | far]] = False
-        eps = 1e-10
-        inside = converged & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
-        return np.where(inside, np.clip(u, 0, 1), u), np.where(inside, np.clip(v, 0, 1), v), inside
-
-    def _project_edges(self, y, t):
-        """The nearest points on the three edge curves (0: u-axis, 1: u + v = 1, 2: v-axis) of
-        patches t, all at once: Newton in each edge's parameter from the flat edge's closest
-        point, clamped to [0, 1]. Returns the nearest edge's (u, v), distance and edge (the first
-        of equals)."""
-        m = len(t)
-        A = np.tile(self.patches[t], (3, 1, 1))
-        Y = np.tile(y, (3, 1))
-        e = np.repeat(np.arange(3), m)
-        u0, v0 = _EDGE_START[e, 0], _EDGE_START[e, 1]
-        du, dv = _EDGE_DIRECTION[e, 0], _EDGE_DIRECTION[e, 1]
-        P = self.corners[t]
-        a = np.concatenate([P[:, 0], P[:, 1], P[:, 0]])
-        b = np.concatenate([P[:, 1], P[:, 2], P[:, 2]])
-        s = np.clip(np.einsum("ij,ij->i", Y - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0.0, 1.0)
-        # the edge's curve x(s) = Q0 + Q1 s + Q2 s^2, less y
-        Q0 = A[:, 0] + A[:, 1] * u0[:, None] + A[:, 2] * v0[:, None] + A[:, 3] * (u0 * u0)[:, None] \
-            + A[:, 4] * (v0 * v0)[:, None] + A[:, 5] * (u0 * v0)[:, None] - Y
-        Q1 = (A[:, 1] + 2.0 * A[:, 3] * u0[:, None] + A[:, 5] * v0[:, None]) * du[:, None] \
-            + (A[:, 2] + 2.0 * A[:, 4] * v0[:, None] + A[:, 5] * u0[:, None]) * dv[:, None]
-        Q2 = A[:, 3] * (du * du)[:, None] + A[:, 4] * (dv * dv)[:, None] + A[:, 5] * (du * dv)[:, None]
-        # (x - y) . x' = c0 + c1 s + c2 s^2 + c3 s^3 and its derivative
-        c0, c1 = np.einsum("ij,ij->i", Q0, Q1), np.einsum("ij,ij->i", Q1, Q1) + 2.0 * np.einsum("ij,ij->i", Q0, Q2)
-        c2, c3 = 3.0 * np.einsum("ij,ij->i", Q1, Q2), 2.0 * np.einsum("ij,ij->i", Q2, Q2)
-        ff0 = np.einsum("ij,ij->i", Q1, Q1)
-        for _ in range(NEWTON_ITERATIONS):
-            g = c0 + s * (c1 + s * (c2 + s * c3))
-            h = c1 + s * (2.0 * c2 + 3.0 * c3 * s)
-            ff = ff0 + s * (4.0 * c2 / 3.0 + 2.0 * c3 * s)  # |x'|^2
-            new = np.clip(s - g / np.where(h > 0, h, ff), 0.0, 1.0)
-            done = np.abs(new - s).max() < 1e-13
-            s = new
-            if done:
-                break
-        u, v = u0 + du * s, v0 + dv * s
-        X, _, _ = _evaluate(A, u, v)
-        dist = np.linalg.norm(Y - X, axis=1).reshape(3, m)
-        edge = np.argmin(dist, axis=0)
-        pick = edge * m + np.arange(m)
-        return u[pick], v[pick], dist[edge, np.arange(m)], edge
+        t, u, v, kind, dist, near, bound, start, length = _search_pass(y, pair // T, pair % T, upper, rest,
+                                                                        self.patches, self.corners, self.bulge,
+                                                                        self.size)
+        return (t, u, v, kind, dist, rest), (near, bound, start, length)
 
     def _signed(self, y, t, u, v, kind):
         """Closest points, signed distances, normals and H at the closest points (u, v) of
         patches t: inside (kind -1) the patch's; on an edge (kind 0, 1, 2) the curve's."""
-        A = self.patches[t]
-        X, Xu, Xv = _evaluate(A, u, v)
-        S = np.stack([2.0 * A[:, 3], 2.0 * A[:, 4], A[:, 5]], axis=1)
-        nc = np.cross(Xu, Xv)
-        nc = self.sign * nc / np.maximum(np.linalg.norm(nc, axis=1), 1e-300)[:, None]
-        r = y - X
-        dist = np.linalg.norm(r, axis=1)
-        d, n, H = np.einsum("ij,ij->i", r, nc), nc.copy(), np.zeros((len(y), 3, 3))
+        m = len(y)
+        c, d, n, H = np.zeros((m, 3)), np.zeros(m), np.zeros((m, 3)), np.zeros((m, 3, 3))
+        J, S = np.zeros((m, 2, 3)), np.zeros((m, 3, 3))
+        _signed_pass(y, t, u, v, kind, self.patches, self.sign, 1e-12 * self.size, c, d, n, H, J, S)
         inside = kind < 0
         if inside.any():
-            H[inside] = distance_hessian(np.stack([Xu, Xv], axis=1)[inside], S[inside], n[inside], d[inside])
-        edge = np.flatnonzero(~inside)
-        if edge.size:
-            s = np.where(d[edge] < 0.0, -1.0, 1.0)
-            far = dist[edge] > 1e-12 * self.size
-            d[edge] = s * dist[edge]
-            n[edge] = np.where(far[:, None], s[:, None] * r[edge] / np.where(far, dist[edge], 1.0)[:, None], nc[edge])
-            direction = np.array([[1.0, 0.0], [-1.0, 1.0], [0.0, 1.0]])[kind[edge]]
-            first = Xu[edge] * direction[:, :1] + Xv[edge] * direction[:, 1:]
-            second = np.einsum("pk,pki->pi", np.stack([direction[:, 0] ** 2, direction[:, 1] ** 2,
-                                                       2 * direction[:, 0] * direction[:, 1]], axis=1), S[edge])
-            position = np.where(kind[edge] == 1, v[edge], np.where(kind[edge] == 0, u[edge], v[edge]))
-            vertex = (position <= 0.0) | (position >= 1.0)
-            stiff = np.einsum("ij,ij->i", first, first) - np.einsum("ij,ij->i", r[edge], second)
-            stiff = np.maximum(stiff, 1e-12 * np.einsum("ij,ij->i", first, first))
-            m = n[edge]
-            P = np.eye(3) - m[:, :, None] * m[:, None, :]
-            along = first[:, :, None] * first[:, None, :] / stiff[:, None, None]
-            P = P - np.where(vertex[:, None, None], 0.0, along)
-            dd = np.where(far, d[edge], np.inf)
-            H[edge] = P / dd[:, None, None]
-        return X, d, n, H
+            H[inside] = distance_hessian(J[inside], S[inside], n[inside], d[inside])
+        return c, d, n, H
