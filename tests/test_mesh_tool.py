@@ -307,3 +307,28 @@ def test_a_moved_point_whose_nearest_patch_jumps_is_found(stl):
         assert np.allclose(g, gap) and np.allclose(n[:, 2], nz)
         x = y
     assert slab.counts["warm"] > 0
+
+
+def test_a_tool_meshed_without_the_blanks_symmetry_is_named():
+    """The demo's STL tools are triangulated without the quarter's mirror symmetry: their
+    distances at mirror points of the blank differ by micrometres, and a ToolSymmetryWarning
+    names each file; the STEP tools are symmetric to OCC's round-off and pass silently."""
+    import warnings
+
+    from mpi4py import MPI
+
+    from shellform.contact.cad_tools import ToolSymmetryWarning, check_mirrors
+    from shellform.mesh import blank
+
+    planes = np.eye(3)[:2]  # x = 0 and y = 0
+    for name, asymmetric in (("numisheet93_aluminium_stl.toml", True), ("numisheet93_aluminium_cad.toml", False)):
+        s = scene.load(ROOT / "demos" / name).changed({"mesh.n": 8})
+        x = blank(MPI.COMM_WORLD, s).mesh.geometry.x
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            worst = check_mirrors(cad_cup_tools(s.tools, T), x, planes, MPI.COMM_WORLD)
+        named = {str(w.message).split(":")[0] for w in caught if issubclass(w.category, ToolSymmetryWarning)}
+        if asymmetric:
+            assert min(worst.values()) > 1e-4 and named == {"tools.punch_file", "tools.die_file"}
+        else:
+            assert max(worst.values()) < 1e-9 and not named

@@ -65,6 +65,46 @@ def _tool(path):
     return MeshTool if Path(path).suffix.lower() in MESH_SUFFIXES else SurfaceTool
 
 
+class ToolSymmetryWarning(UserWarning):
+    """A tool is not mirror-symmetric about a symmetry line of the modelled blank."""
+
+
+MIRROR_TOLERANCE = 1e-9  # the largest difference of the distances (per mm of the tool's size) at mirror points
+
+
+def check_mirrors(tools: dict, x, planes, comm) -> dict:
+    """Whether the punch and the die are symmetric about the blank's mirror planes through the
+    z axis (planes: their unit normals, (1, 0, 0) for x = 0): at the blank's nodes x and their
+    mirror images M x, a symmetric tool's distances are equal, d(M x) = d(x). (Its normals are
+    mirror images too, except where two faces are equally near, whose normal either face may
+    give: the distances are compared.) Where they differ by more than MIRROR_TOLERANCE of the
+    tools' extent (a surface mesh triangulated without that symmetry, a tool off the centre), a
+    ToolSymmetryWarning names the tool's file: the symmetry lines then carry a force of the
+    order of the normals' difference times the tool's force. Returns the largest difference
+    (mm) per tool, all ranks."""
+    import warnings
+
+    from mpi4py import MPI
+
+    x = np.asarray(x, dtype=float).reshape(-1, 3)
+    worst = {}
+    for name in ("punch", "die"):
+        tool, largest = tools[name], 0.0
+        for m in planes:
+            M = np.eye(3) - 2.0 * np.outer(m, m)
+            g, gm = tool.gap(x, 0.0, 0.0)[0], tool.gap(x @ M, 0.0, 0.0)[0]
+            both = np.isfinite(g) & np.isfinite(gm)
+            largest = max(largest, float(np.abs(gm[both] - g[both]).max(initial=0.0)))
+        worst[name] = comm.allreduce(largest, op=MPI.MAX)
+        size = comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
+        if worst[name] > MIRROR_TOLERANCE * max(size, 1.0):
+            warnings.warn(ToolSymmetryWarning(
+                f"tools.{name}_file: the {name} is not mirror-symmetric about the blank's symmetry lines: its "
+                f"distances at mirror points differ by up to {worst[name]:.2g} mm. The modelled part's symmetry lines "
+                "then carry a force; model the whole blank, or give a surface meshed with the symmetry"), stacklevel=2)
+    return worst
+
+
 def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
     """The CAD tools around the blank at the start (x: its nodes, half: their half thicknesses,
     every rank its own): InputError naming the field where

@@ -15,10 +15,10 @@ from shellform import supports as named_supports
 from shellform.assembly.sheet_element import BS
 from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
-from shellform.contact.cad_tools import cad_cup_tools, check_start
+from shellform.contact.cad_tools import cad_cup_tools, check_mirrors, check_start
 from shellform.contact.pinch_edge import edge_load
 from shellform.contact.tools import square_cup_tools
-from shellform.mesh import blank
+from shellform.mesh import blank, outline
 from shellform.nonlinear.model import SheetModel
 from shellform.nonlinear.problem import scene_controls
 from shellform.scene import Scene
@@ -45,6 +45,8 @@ class DrawingProblem:
         tools = (cad_cup_tools if t.shape == "cad" else square_cup_tools)(t, s.material.thickness)
         if t.shape == "cad":
             check_start(tools, rect.mesh.geometry.x, s.material.thickness / 2, comm, 1e-2 * s.material.thickness)
+            planes = [{"left": (1.0, 0.0, 0.0), "bottom": (0.0, 1.0, 0.0)}[g] for g in outline.symmetry_lines(s.geometry)]
+            check_mirrors(tools, rect.mesh.geometry.x, np.array(planes), comm)
         symmetry = s.symmetry_copies
         controls = scene_controls(s)
         mu = t.friction if "friction" in s.effects else 0.0
