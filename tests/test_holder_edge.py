@@ -84,9 +84,11 @@ def test_the_numisheet_dies_flat_top_opening_is_its_rounded_square(name):
     """The NUMISHEET'93 die (STEP and STL): its flat top's inner loop is the rounded square
     (37 + 8, 12 + 8) where the holder begins: within 4e-4 mm (STEP, the sampling's sagitta) and
     0.03 mm (STL, 24 triangles a turn)."""
-    from shellform.contact.cad_tools import _tool
+    from shellform.contact.mesh_tool import MeshTool
+    from shellform.contact.surface_tool import SurfaceTool
 
-    die = _tool(name).from_file(ROOT / "demos" / "meshes" / "numisheet93" / name)
+    kind = MeshTool if name.endswith(".stl") else SurfaceTool
+    die = kind.from_file(ROOT / "demos" / "meshes" / "numisheet93" / name)
     loops = die.flat_top_boundary()
     assert len(loops) == 2
     inner = OutlineEdge(min(loops, key=lambda p: np.ptp(p[:, 0]))[:, :2])

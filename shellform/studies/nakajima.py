@@ -84,7 +84,8 @@ def row(width: float, n: int, d: Path) -> tuple[dict, list[dict]]:
     x0, y0 = s["strain_path"]["initial_xy_mm"]
     r = {"width_mm": width, "n": n, "cells": s["cells"],
          "limit_stroke_mm": limit["stroke_mm"] if limit else s["stroke_mm"], "reached": limit is not None,
-         "where": "dome" if np.hypot(x0, y0) < DIE_RADIUS else "flange", "x0_mm": x0, "y0_mm": y0, "major": end["major"], "minor": end["minor"],
+         "where": "dome" if np.hypot(x0, y0) < DIE_RADIUS else "flange", "x0_mm": x0, "y0_mm": y0,
+         "major": end["major"], "minor": end["minor"],
          "strain_ratio": end["minor"] / end["major"], "peak_thinning": s["min_thickness_strain"],
          "punch_force_kN": max(float(c["punch_force_kN"]) for c in curve),
          "increments": s["increments"], "newton_iterations": s["newton_iterations"], "cutbacks": s["cutbacks"],
@@ -125,9 +126,9 @@ def tables(out: Path, widths, n: int) -> list[dict]:
 
 
 def markdown(rows: list[dict]) -> str:
-    head = ("| waist W mm | cells | limit dome height mm | where | critical element (initial x, y) | major, minor at the "
-            "limit | minor / major | peak thinning | peak force kN | increments, iterations, cut-backs | worst balance "
-            "| wall s |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    head = ("| waist W mm | cells | limit dome height mm | where | critical element (initial x, y) "
+            "| major, minor at the limit | minor / major | peak thinning | peak force kN "
+            "| increments, iterations, cut-backs | worst balance | wall s |\n" + "|---" * 12 + "|\n")
     return head + "".join(
         f"| {'disc' if r['width_mm'] >= 180 else format(r['width_mm'], 'g')} | {r['cells']} | "
         f"{r['limit_stroke_mm']:.2f}{'' if r['reached'] else ' (not reached)'} | {r['where']} | "
