@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from shellform.contact.holder_edge import OutlineEdge, RoundedSquareEdge
+from shellform.contact.holder_edge import OutlineEdge, RoundedSquareEdge, signed_area
 from shellform.contact.mesh_tool import MESH_SUFFIXES, MeshTool
 from shellform.contact.placement import UP, Placed, rotation
 from shellform.contact.surface_tool import SurfaceTool
@@ -52,11 +52,10 @@ def die_opening(die: Placed) -> OutlineEdge:
     except ValueError as exc:
         raise InputError("tools.die_file", f"the holder covers the die's flat top: {exc}") from None
     plans = [(loop @ die.R.T + die.translation)[:, :2] for loop in loops]
-    area = [abs(0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])) for p in plans]
     if len(plans) != 2:
         raise InputError("tools.die_file", f"the die's flat top has {len(plans) - 1} openings: the holder's inner "
                          "edge is taken from a top with one opening (or give holder_half_width)")
-    return OutlineEdge(plans[int(np.argmin(area))])
+    return OutlineEdge(min(plans, key=lambda p: abs(signed_area(p))))
 
 
 def _tool(path):
@@ -87,16 +86,16 @@ def check_mirrors(tools: dict, x, planes, comm) -> dict:
     from mpi4py import MPI
 
     x = np.asarray(x, dtype=float).reshape(-1, 3)
+    size = comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
     worst = {}
     for name in ("punch", "die"):
         tool, largest = tools[name], 0.0
+        g = tool.gap(x, 0.0, 0.0)[0]
         for m in planes:
-            M = np.eye(3) - 2.0 * np.outer(m, m)
-            g, gm = tool.gap(x, 0.0, 0.0)[0], tool.gap(x @ M, 0.0, 0.0)[0]
+            gm = tool.gap(x @ (np.eye(3) - 2.0 * np.outer(m, m)), 0.0, 0.0)[0]
             both = np.isfinite(g) & np.isfinite(gm)
             largest = max(largest, float(np.abs(gm[both] - g[both]).max(initial=0.0)))
         worst[name] = comm.allreduce(largest, op=MPI.MAX)
-        size = comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
         if worst[name] > MIRROR_TOLERANCE * max(size, 1.0):
             warnings.warn(ToolSymmetryWarning(
                 f"tools.{name}_file: the {name} is not mirror-symmetric about the blank's symmetry lines: its "

@@ -25,6 +25,12 @@ from scipy.spatial import cKDTree
 from shellform.contact.tools import rounded_square_hessian, rounded_square_sdf
 
 
+def signed_area(points) -> float:
+    """The area a closed polyline (m, 2) encloses, > 0 counter-clockwise (the shoelace formula)."""
+    p = np.asarray(points, dtype=float)
+    return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+
+
 class RoundedSquareEdge:
     """The rounded square |x|, |y| <= half_width with plan corner radius corner_radius."""
 
@@ -61,8 +67,7 @@ class OutlineEdge:
         p = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(p) < 3:
             raise ValueError("holder edge: an outline needs at least three points")
-        area = 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
-        if area < 0:
+        if signed_area(p) < 0:
             p = p[::-1].copy()
         self.points = p
         self.ends = np.roll(p, -1, axis=0)

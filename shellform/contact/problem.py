@@ -45,7 +45,7 @@ class DrawingProblem:
         tools = (cad_cup_tools if t.shape == "cad" else square_cup_tools)(t, s.material.thickness)
         if t.shape == "cad":
             check_start(tools, rect.mesh.geometry.x, s.material.thickness / 2, comm, 1e-2 * s.material.thickness)
-            planes = [{"left": (1.0, 0.0, 0.0), "bottom": (0.0, 1.0, 0.0)}[g] for g in outline.symmetry_lines(s.geometry)]
+            planes = [outline.MIRROR_NORMALS[g] for g in outline.symmetry_lines(s.geometry)]
             check_mirrors(tools, rect.mesh.geometry.x, np.array(planes), comm)
         symmetry = s.symmetry_copies
         controls = scene_controls(s)

@@ -46,6 +46,10 @@ def group_names(g) -> tuple[str, ...]:
     return _read_file(g.file, gmsh_file.check(g.file))[0]
 
 
+# the mirror lines a quarter or half region is named by, x = 0 and y = 0: their planes' unit normals
+MIRROR_NORMALS = {"left": (1.0, 0.0, 0.0), "bottom": (0.0, 1.0, 0.0)}
+
+
 def symmetry_lines(g) -> tuple[str, ...]:
     """The groups of a [geometry] section on the mirror lines of a region that is part of the
     blank: x = 0 and y = 0 of a quarter (left, bottom), y = 0 of a half (bottom). None for a

@@ -32,15 +32,16 @@ from shellform.results.tables import write_json
 MANIFEST = "run.json"
 # what shellform's runs write into --out (shellform/run.py's routes: results/shell.py, nonlinear/run.py, contact/run.py)
 OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "force_stroke.csv",
-           "force_stroke.png", "thickness_*.csv", "fld.csv", "fld.png", "strain_path.csv", "rim.csv", "rim.png", "cup.png", "cup_margin.png",
+           "force_stroke.png", "thickness_*.csv", "fld.csv", "fld.png", "strain_path.csv", "rim.csv", "rim.png",
+           "cup.png", "cup_margin.png",
            "springback.csv", "springback.png", "deformed.png", "cup.bp", "cup_cells.bp",
            "cup.pvd", "punch.pvd", "die.pvd", "blank_holder.pvd", "vtu", "nodal.bp", "cells.bp", "checkpoint.npz",
            "checkpoint.previous.npz", ".checkpoint.npz.new", "last_converged.rank*.npz")
 # what may change when a run is resumed ("how to continue"; `shellform run --resume`)
 CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force", "effects.friction",
             "process.initial_step", "process.min_step", "process.max_step", "process.max_iterations",
-            "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit", "output.vtx",
-            "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
+            "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
+            "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
 
 
 def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:

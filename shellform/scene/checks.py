@@ -170,7 +170,8 @@ def _validate_material(s: Scene) -> None:
     if s.process.stop_at_forming_limit:
         require(s.tools is not None and plastic, "process.stop_at_forming_limit",
                 "ends a tool scene's stroke at the forming-limit curve: it needs the effects contact and plasticity")
-    if plastic and (mat.forming_limit_curve or (s.tools is not None and (s.output.fld or s.process.stop_at_forming_limit))):
+    limits_view = s.tools is not None and (s.output.fld or s.process.stop_at_forming_limit)
+    if plastic and (mat.forming_limit_curve or limits_view):
         from shellform.results import fld
 
         fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n

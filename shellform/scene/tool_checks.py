@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from shellform.mesh.outline import MIRROR_NORMALS
 from shellform.scene.rules import keys_of_effects, require
 from shellform.scene.schema import CAD_TOOL_KEYS, SIDES, SPREADS, TOOL_NORMALS, TOOL_SHAPES, Scene, ToolsSpec
 
@@ -124,16 +125,16 @@ def _validate_analytic_tools(s: Scene, t) -> float:
 
 def _validate_punch_travel(s: Scene, t) -> None:
     """A punch travelling aslant keeps the blank's mirror symmetry only within the mirror planes:
-    along x = 0 (the `left` edge) no x component, along y = 0 (`bottom`) no y component, along any
-    other symmetry line none in the plane."""
-    d = t.punch_direction
+    along x = 0 (the `left` edge) no x component, along y = 0 (`bottom`) no y component
+    (outline.MIRROR_NORMALS), along any other symmetry line none in the plane."""
+    d = np.asarray(t.punch_direction, dtype=float)
     for group, support in s.supports.items():
         if support != "symmetry":
             continue
-        across = {"left": (0,), "bottom": (1,)}.get(group, (0, 1))
-        require(all(d[i] == 0 for i in across), "tools.punch_direction",
-                f"{d} leaves the mirror plane of the symmetry line {group!r}: a punch travelling aslant needs "
-                "the blank modelled without that symmetry")
+        across = np.array([MIRROR_NORMALS[group]] if group in MIRROR_NORMALS else list(MIRROR_NORMALS.values()))
+        require(not np.any(across @ d), "tools.punch_direction",
+                f"{t.punch_direction} leaves the mirror plane of the symmetry line {group!r}: a punch travelling "
+                "aslant needs the blank modelled without that symmetry")
 
 
 def _validate_cad_tools(t) -> float:
@@ -142,7 +143,8 @@ def _validate_cad_tools(t) -> float:
     holder_half_width."""
     for name in ("punch_file", "die_file"):
         v = getattr(t, name)
-        require(bool(v), f"tools.{name}", "shape = 'cad' needs the tool's STEP, IGES or BREP file (or .stl, .msh surface mesh)")
+        require(bool(v), f"tools.{name}",
+                "shape = 'cad' needs the tool's STEP, IGES or BREP file (or .stl, .msh surface mesh)")
         require(Path(v).is_file(), f"tools.{name}", f"no such file: {v}")
     for name, what in (("punch_translation", "[x, y, z] (mm)"), ("die_translation", "[x, y, z] (mm)"),
                        ("punch_rotation", "angles about x, y, z (degrees)"),
