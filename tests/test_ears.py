@@ -62,7 +62,7 @@ def test_round_cup_writes_its_rim(tmp_path):
     assert np.array_equal(p.rim(), at_radius)
     theta = np.degrees(np.arctan2(X[at_radius, 1], X[at_radius, 0]))
     assert np.allclose(rows[:, 0], np.sort(theta), atol=1e-5)  # the CSV's 6 digits
-    assert rows[0, 0] == 0.0 and rows[-1, 0] == pytest.approx(90.0, abs=1e-9)
+    assert rows[0, 0] == pytest.approx(0.0, abs=1e-9) and rows[-1, 0] == pytest.approx(90.0, abs=1e-9)
     assert np.all(np.diff(rows[:, 0]) > 0)
 
     for last in (summary["draw_in_mm"][-1], summary["reports"][-1]["draw_in_mm"]):

@@ -49,8 +49,9 @@ def test_an_open_holder_stays_a_rigid_face_that_carries_its_force():
 
     def check(d):
         assert not d.holder.closed
-        assert abs(p.holder_force() - F) <= 1e-5 * F
-        # the tools balance to Newton's tolerance (rtol of the residual's scale, per quarter)
+        # its force and the tools' balance to Newton's tolerance (rtol of the residual's scale, per
+        # quarter; an iterate may converge on a round-off correction, module docstring of newton.py)
+        assert abs(p.holder_force() - F) <= 4 * d.controls.rtol * d.scale
         assert p.force_balance() * p.punch_force() <= 4 * d.controls.rtol * d.scale
         assert p.max_penetration() <= tol  # the open face included
         assert -tol < p.holder_lift() <= h.edge_law.riding_lift(F / edge) and p.in_contact()["holder"] > 0
