@@ -61,11 +61,8 @@ args = parser.parse_args([] if "ipykernel" in sys.modules else None)  # in a not
 
 ROOT = Path(__file__).resolve().parents[1] if "__file__" in globals() else Path.cwd()  # a notebook: the clone
 paper = scene.load(ROOT / "demos" / "square_cup.toml")
-k = paper.tools.stroke / args.stroke  # the load factor is the stroke's fraction: the same steps in mm
 s = paper.changed({"mesh.n": args.n, "tools.stroke": args.stroke, "process.springback": False,
-                   "output.vtx": False, "output.png": False,
-                   **{f"process.{key}": min(k * getattr(paper.process, key), 1.0)
-                      for key in ("initial_step", "min_step", "max_step")}})
+                   "output.vtx": False, "output.png": False})  # the scene's steps are mm of travel: the same
 
 # ## The sheet's strains, in UFL
 #

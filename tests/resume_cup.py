@@ -13,8 +13,8 @@ ROOT = Path(__file__).resolve().parents[1]
 def cup():
     """The paper's cup on 6 x 6, 1 mm of stroke in steps of 0.05 to 0.1 mm, a report at 0.5 mm."""
     return scene.load(ROOT / "demos" / "square_cup.toml").changed({
-        "mesh.n": 6, "tools.stroke": 1.0, "process.report": [0.5], "process.initial_step": 0.05,
-        "process.max_step": 0.1, "output.vtx": False, "output.png": False, "output.fld": False,
+        "mesh.n": 6, "tools.stroke": 1.0, "process.report": [0.5], "process.initial_step_mm": 0.05,
+        "process.max_step_mm": 0.1, "output.vtx": False, "output.png": False, "output.fld": False,
         "process.springback": False})
 
 

@@ -142,12 +142,12 @@ def test_hard_cup_cases_draw(case):
     back by the driver where they fail; a die shoulder of 2 mm, a quarter of a cell. Each reaches
     3 mm with the tools in balance, the flange pinched and no penetration."""
     s = square_cup()
-    big = 10 * s.process.max_step
+    big = 10 * s.process.max_step_mm
     changes = {"mu 0.3": ("tools", "friction", 0.3), "die radius 2 mm": ("tools", "die_profile_radius", 2.0),
-               "10x increment": ("process", "max_step", big)}[case]
+               "10x increment": ("process", "max_step_mm", big)}[case]
     setattr(getattr(s, changes[0]), changes[1], changes[2])
     if case == "10x increment":
-        s.process.initial_step = big
+        s.process.initial_step_mm = big
     p = DrawingProblem.from_scene(s, verbose=False)
     p.driver.run(3.0 / s.tools.stroke)
     assert p.stroke == pytest.approx(3.0)
@@ -156,6 +156,24 @@ def test_hard_cup_cases_draw(case):
     assert p.punch_force() > 0
     if case == "10x increment":  # it took the big steps (cut back where it had to)
         assert len(p.driver.history) <= 2 + sum(h.cutbacks for h in p.driver.history)
+
+
+def test_a_shorter_stroke_takes_fewer_increments_of_the_same_travel():
+    """A tool scene's steps are mm of the punch's travel (process.*_step_mm): the cup drawn 0.6
+    and 1.8 mm with the same steps takes the same first increments, in mm, and three times the
+    stroke takes about three times the increments (the first ones grow from initial_step_mm)."""
+    travel = {}
+    for stroke in (0.6, 1.8):
+        s = square_cup(n=4, stroke=stroke, changes={"process.initial_step_mm": 0.05, "process.max_step_mm": 0.15})
+        p = DrawingProblem.from_scene(s, verbose=False)
+        p.driver.run(1.0)
+        assert p.stroke == pytest.approx(stroke) and sum(h.cutbacks for h in p.driver.history) == 0
+        travel[stroke] = [h.dlam * stroke for h in p.driver.history]
+    short, long = travel[0.6], travel[1.8]
+    assert short[0] == pytest.approx(0.05, rel=1e-12) and max(long) == pytest.approx(0.15, rel=1e-12)
+    assert np.allclose(long[: len(short) - 1], short[:-1], rtol=1e-12)  # the short one's last is what is left
+    assert sum(short) == pytest.approx(0.6) and sum(long) == pytest.approx(1.8)
+    assert 2.0 * len(short) < len(long) <= 3 * len(short)
 
 
 def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
@@ -179,7 +197,7 @@ def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
 
     monkeypatch.setattr(SemiInverseDriver, "settle", breaks_down)
     s = square_cup()
-    s.process.initial_step = s.process.max_step = 0.25 / 30.0
+    s.process.initial_step_mm = s.process.max_step_mm = 0.25
     summary = contact_run.run(s, tmp_path)
     assert "forced by the test" in summary["stopped"]
     rows = list(csv.DictReader(open(tmp_path / "force_stroke.csv")))
@@ -256,7 +274,7 @@ def test_an_elastic_sheet_springs_back_flat():
     s = square_cup(n=6, stroke=1.0, friction=0.0, changes={
         "effects": ["bending", "membrane", "geometric_nonlinearity", "contact"], "material.hardening": "none",
         "material.r": 1.0, "material.K": 0.0, "material.eps0": 0.0, "material.n": 0.0,
-        "process.initial_step": 0.1, "process.max_step": 0.25})
+        "process.initial_step_mm": 0.1, "process.max_step_mm": 0.25})
     p = DrawingProblem.from_scene(s, verbose=False)
     p.driver.run(1.0)
     drawn = p.driver.q.x.array.reshape(-1, 9)
@@ -275,7 +293,7 @@ def test_drawn_cup_springback_outputs(tmp_path):
     from shellform.contact import run as contact_run
 
     s = square_cup(n=6, stroke=3.0)
-    s.process.initial_step, s.process.max_step = 0.02, 0.05
+    s.process.initial_step_mm, s.process.max_step_mm = 0.06, 0.15
     s.process.springback = True
     s.output.vtx = s.output.png = s.output.fld = False
     summary = contact_run.run(s, tmp_path)
@@ -436,7 +454,7 @@ def test_passes_that_only_move_the_contact_front_are_not_counted():
     for max_passes in (12, 2):
         p = DrawingProblem.from_scene(s, verbose=False)
         p.driver.controls.max_passes = max_passes
-        p.driver.run(s.process.initial_step)
+        p.driver.run(p.driver.controls.initial_step)
         h = p.driver.history
         assert len(h) == 1 and h[0].cutbacks == 0
         states.append((h[0].contact["passes"], p.driver.q.x.array.copy(), p.punch_force()))
@@ -452,7 +470,7 @@ def test_the_trace_names_every_node_that_switches(capsys):
     s = scene.load(ROOT / "demos" / "numisheet93_aluminium.toml")
     s.mesh.n = 16
     p = DrawingProblem.from_scene(s, verbose=False, trace=True)
-    p.driver.run(s.process.initial_step)
+    p.driver.run(p.driver.controls.initial_step)
     lines = capsys.readouterr().out.splitlines()
     switches = [ln for ln in lines if " joins tool " in ln or " leaves tool " in ln]
     h = p.driver.history[0].contact

@@ -56,7 +56,7 @@ def _cup(beads=None, **changes):
 
     s = scene.load(ROOT / "demos" / "square_cup.toml")
     more = {"effects": list(s.effects) + ["drawbeads"], "tools.drawbead": beads} if beads else {}
-    return s.changed({"mesh.n": 6, "tools.stroke": 3.0, "process.initial_step": 0.05, "process.max_step": 0.1,
+    return s.changed({"mesh.n": 6, "tools.stroke": 3.0, "process.initial_step_mm": 0.15, "process.max_step_mm": 0.3,
                       "process.report": [], "process.springback": False, "output.vtx": False, "output.png": False,
                       "output.fld": False, **more, **changes})
 

@@ -99,8 +99,8 @@ def test_friction_raises_the_punch_force():
     out = {}
     for mu in (0.0, 0.2):
         effects = [e for e in scene.load(ROOT / "demos" / "square_cup.toml").effects if e != "friction" or mu > 0]
-        s = square_cup(n=6, friction=mu, changes={"effects": effects, "process.initial_step": 0.02,
-                                            "process.max_step": 0.05})
+        s = square_cup(n=6, friction=mu, changes={"effects": effects, "process.initial_step_mm": 0.6,
+                                            "process.max_step_mm": 1.5})
         p = DrawingProblem.from_scene(s, verbose=False)
         p.driver.run(3.0 / s.tools.stroke)
         X, x, _ = p.nodal_values()

@@ -122,7 +122,7 @@ def test_the_cross_cup_draws_with_the_holder_on_the_dies_flat_top(tmp_path):
     from shellform.contact import run as contact_run
 
     s = scene.load(ROOT / "demos" / "cross_cup.toml").changed({
-        "mesh.n": 8, "tools.stroke": 5.0, "process.initial_step": 0.02, "process.max_step": 0.05,
+        "mesh.n": 8, "tools.stroke": 5.0, "process.initial_step_mm": 0.1, "process.max_step_mm": 0.25,
         "process.report": [], "output.vtx": False, "output.vtu": False, "output.png": False, "output.fld": False})
     summary = contact_run.run(s, tmp_path / "cross")
     worst = summary["over_the_stroke"]

@@ -215,9 +215,23 @@ def cup(effects=CONTACT, tools=None, geometry=None, supports=None, thickness=0.8
     (cup(supports={"right": "clamped"}), "supports.right"),
     (cup(supports={"top": "simply_supported"}), "supports.top"),
     (cup(geometry={"region": "full"}), "supports.left"),  # every side of a full blank is outer
+    # a tool scene steps the punch's travel in mm, a sheet scene its load factor
+    ({**cup(), "process": {"max_step": 0.01}}, "process.max_step"),
+    ({"process": {"max_step_mm": 0.2}}, "process.max_step_mm"),
+    ({**cup(), "process": {"min_step_mm": 0.5, "initial_step_mm": 0.1}}, "process.min_step_mm"),
+    ({**cup(), "process": {"initial_step_mm": 0.5, "max_step_mm": 0.25}}, "process.initial_step_mm"),
+    ({**cup(), "process": {"min_step_mm": 0.0}}, "process.min_step_mm"),
+    ({**cup(), "process": {"max_step_mm": float("inf")}}, "process.max_step_mm"),
 ])
 def test_tools_errors_name_the_field(data, field):
     assert_names_field(data, field)
+
+
+def test_a_tool_scene_gives_its_steps_in_mm():
+    with pytest.raises(InputError, match=r"steps the punch's travel in mm: give process.max_step_mm"):
+        scene.from_dict({**cup(), "process": {"max_step": 0.01}})
+    with pytest.raises(InputError, match=r"is a key of tool scenes .* process.initial_step$"):
+        scene.from_dict({"process": {"initial_step_mm": 0.1}})
 
 
 def test_tools_error_messages():

@@ -102,7 +102,7 @@ def small_cup(every: float = 60.0) -> str:
     0.5 mm, no pictures (the cup of tests/resume_cup.py), as a scene file's text."""
     text = (Path(__file__).resolve().parents[1] / "demos" / "square_cup.toml").read_text()
     for old, new in (("[mesh]\nn = 16", "[mesh]\nn = 6"), ("stroke = 30.0", "stroke = 1.0"),
-                     ("initial_step = 0.002", "initial_step = 0.05"), ("max_step = 0.008", "max_step = 0.1"),
+                     ("initial_step_mm = 0.06", "initial_step_mm = 0.05"), ("max_step_mm = 0.24", "max_step_mm = 0.1"),
                      ("springback = true", "springback = false")):
         assert old in text
         text = text.replace(old, new)
@@ -183,11 +183,11 @@ def test_a_resume_with_other_steps_starts_them_afresh(tmp_path):
     code, err, lines, out = interrupted_run(tmp_path / "cut", small_cup(), signal.SIGINT, after=7)
     assert code == 130, err
     before = json.loads((out / "summary.json").read_text())["increments"]
-    other = small_cup().replace("initial_step = 0.05", "initial_step = 0.01")
+    other = small_cup().replace("initial_step_mm = 0.05", "initial_step_mm = 0.01")
     (tmp_path / "cut" / "scene.toml").write_text(other)
     resumed = run_cli(tmp_path / "cut" / "scene.toml", "--out", out, "--resume")
     assert resumed.returncode == 0, resumed.stderr
     again = json.loads((out / "summary.json").read_text())
     history = json.loads((out / "history.json").read_text())
-    assert "process.initial_step" in again["resumed"]["changed"]
+    assert "process.initial_step_mm" in again["resumed"]["changed"]
     assert history[before]["dlam"] == pytest.approx(0.01, rel=1e-12) and again["stroke_mm"] == pytest.approx(1.0)

@@ -56,7 +56,7 @@ def specimens(tmp_path_factory):
     out = tmp_path_factory.mktemp("nakajima")
     runs = {}
     for width in (20, 180):
-        s = nakajima.scene_of(width, 8, out).changed({"output.png": False, "process.max_step": 0.01})
+        s = nakajima.scene_of(width, 8, out).changed({"output.png": False, "process.max_step_mm": 0.6})
         summary = contact_run.run(s, out / f"W{width}")
         with open(out / f"W{width}" / "strain_path.csv") as f:
             path = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]

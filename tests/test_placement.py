@@ -62,7 +62,7 @@ def _cad_cup(**changes):
     from shellform import scene
 
     s = scene.load(ROOT / "demos" / "numisheet93_aluminium_cad.toml")
-    return s.changed({"mesh.n": 8, "tools.stroke": 2.0, "process.initial_step": 0.05, "process.max_step": 0.1,
+    return s.changed({"mesh.n": 8, "tools.stroke": 2.0, "process.initial_step_mm": 0.1, "process.max_step_mm": 0.2,
                       "process.report": [], "output.vtx": False,
                       "output.vtu": False, "output.png": False, "output.fld": False, **changes})
 

@@ -31,7 +31,7 @@ def small_cup():
     """The paper's cup on 4 x 4, 0.2 mm of stroke in two steps."""
     s = scene.load(DEMOS / "square_cup.toml")
     s.mesh.n, s.tools.stroke, s.process.report = 4, 0.2, [0.5]
-    s.process.initial_step = s.process.max_step = 0.5
+    s.process.initial_step_mm = s.process.max_step_mm = 0.1
     s.output.vtx = s.output.png = s.output.fld = s.process.springback = False
     return s
 
@@ -44,17 +44,21 @@ def test_route_by_scene():
 
 def test_process_sets_the_controls_of_both_nonlinear_routes():
     """The scene's [process] values reach the driver's controls on the sheet's route and the
-    tools' route, through one function."""
+    tools' route, through one function; a tool scene's steps, in mm of the punch's travel,
+    become load-factor steps of the stroke (0.2 mm here)."""
     values = {"initial_step": 0.03, "min_step": 0.001, "max_step": 0.07, "max_iterations": 9, "rtol": 1e-7}
     expected = Controls(**values)
     sheet, tools = small_levy(), small_cup()
+    for k, v in values.items():
+        setattr(sheet.process, k, v)
+        setattr(tools.process, f"{k}_mm" if k.endswith("_step") else k, v * tools.tools.stroke if
+                k.endswith("_step") else v)
     for s in (sheet, tools):
-        for k, v in values.items():
-            setattr(s.process, k, v)
-        assert scene_controls(s) == expected
+        got = scene_controls(s)
+        assert {k: getattr(got, k) for k in values} == pytest.approx(values, rel=1e-14)
     assert SheetProblem.from_scene(sheet, verbose=False).driver.controls == expected
     drawing = DrawingProblem.from_scene(tools, verbose=False).driver.controls  # its own easy_iterations
-    assert {k: getattr(drawing, k) for k in values} == values
+    assert {k: getattr(drawing, k) for k in values} == pytest.approx(values, rel=1e-14)
 
 
 @pytest.mark.timeout(120)

@@ -19,7 +19,8 @@ CUP = ROOT / "demos" / "square_cup.toml"
     ({"tools.friction": 0.0}, "tools.friction"),  # the effect 'friction' needs friction > 0
     ({"tools.friction": -0.1}, "tools.friction"),
     ({"effects": ["bending", "membrane", "geometric_nonlinearity", "contact", "friction"]}, "material.hardening"),
-    ({"process.max_step": 1.5}, "process.max_step"),
+    ({"process.max_step_mm": -1.0}, "process.max_step_mm"),
+    ({"process.max_step": 0.1}, "process.max_step"),  # a tool scene steps in mm
     ({"bogus": 1}, "bogus"),
 ])
 def test_a_bad_change_names_its_field(changes, field):

@@ -71,8 +71,8 @@ def test_tool_surfaces_lie_on_the_tools():
 def small_cup():
     """The paper's cup on 4 x 4, drawn 3 mm in 4 increments, reported at 1.5 and 3 mm."""
     return scene.load(ROOT / "demos" / "square_cup.toml").changed({
-        "mesh.n": 4, "tools.stroke": 3.0, "process.report": [0.5], "process.initial_step": 0.25,
-        "process.max_step": 0.25, "output.vtx": False, "output.png": False, "process.springback": False})
+        "mesh.n": 4, "tools.stroke": 3.0, "process.report": [0.5], "process.initial_step_mm": 0.75,
+        "process.max_step_mm": 0.75, "output.vtx": False, "output.png": False, "process.springback": False})
 
 
 def test_the_cup_series_opens_in_pyvista_as_the_drawn_cup(tmp_path):

@@ -491,7 +491,7 @@ def test_the_dome_cup_stretches_the_sheet_over_the_hemispherical_punch(tmp_path)
 
     scene_file = ROOT / "demos" / "dome_cup.toml"
     args = ["run", str(scene_file), "-o", str(tmp_path), "--set", "mesh.n=8", "--set", "tools.stroke=4.0",
-            "--set", "process.initial_step=0.02", "--set", "process.max_step=0.05", "--set", "process.report=[]"]
+            "--set", "process.initial_step_mm=0.08", "--set", "process.max_step_mm=0.2", "--set", "process.report=[]"]
     assert cli.main(args) == 0
     s = json.loads((tmp_path / "summary.json").read_text())
     assert s["stopped"] is None and s["cutbacks"] == 0

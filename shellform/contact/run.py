@@ -75,7 +75,8 @@ from shellform.scene import Scene
 
 
 # a resume that changes one of these starts its steps afresh (not as the checkpoint had them)
-STEPPING = {"process.initial_step", "process.min_step", "process.max_step", "process.max_iterations", "process.rtol"}
+STEPPING = {"process.initial_step_mm", "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
+            "process.rtol"}
 # worst values over all increments, in summary.json: the balances and the pinch
 CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
 

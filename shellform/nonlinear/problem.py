@@ -32,10 +32,17 @@ from shellform.nonlinear.model import SheetModel
 def scene_controls(s) -> Controls:
     """The Newton driver's controls from a scene's [process]: the load-factor steps (initial,
     min, max), the iterations per increment and the residual tolerance; the rest at their
-    defaults. The one place a scene sets them, for the nonlinear sheet (SheetProblem.from_scene)
-    and the tools (contact.problem.DrawingProblem.from_scene)."""
+    defaults. A tool scene's load factor is the share of tools.stroke the punch has travelled,
+    and its steps are given in mm of that travel: dlambda = step_mm / stroke. The one place a
+    scene sets them, for the nonlinear sheet (SheetProblem.from_scene) and the tools
+    (contact.problem.DrawingProblem.from_scene)."""
     pr = s.process
-    return Controls(initial_step=pr.initial_step, min_step=pr.min_step, max_step=pr.max_step,
+    if s.tools is not None:
+        stroke = s.tools.stroke
+        steps = (pr.initial_step_mm / stroke, pr.min_step_mm / stroke, pr.max_step_mm / stroke)
+    else:
+        steps = (pr.initial_step, pr.min_step, pr.max_step)
+    return Controls(initial_step=steps[0], min_step=steps[1], max_step=steps[2],
                     max_iterations=pr.max_iterations, rtol=pr.rtol)
 
 

@@ -39,7 +39,8 @@ OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "fo
            "checkpoint.previous.npz", ".checkpoint.npz.new", "last_converged.rank*.npz")
 # what may change when a run is resumed ("how to continue"; `shellform run --resume`)
 CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force", "effects.friction",
-            "process.initial_step", "process.min_step", "process.max_step", "process.max_iterations",
+            "process.initial_step", "process.min_step", "process.max_step", "process.initial_step_mm",
+            "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
             "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
             "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
 

@@ -16,8 +16,8 @@ from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
-                                    DIAGONALS, HARDENING, MAY_BE_INFINITE, YIELD_FUNCTIONS, YIELD_PARAMETERS,
-                                    MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES,
+                                    DIAGONALS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE, STROKE_STEP_KEYS,
+                                    YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES,
                                     SUPPORTS, Scene, bounds)
 
 
@@ -270,14 +270,13 @@ def _validate_process(s: Scene) -> None:
     low = 2 if "plasticity" in s.effects else 1
     require(pr.thickness_points >= low, "process.thickness_points",
             f"must be >= {low}{' with plasticity' if low == 2 else ''}, got {pr.thickness_points}")
-    for name in ("min_step", "initial_step", "max_step"):
-        v = getattr(pr, name)
+    first, least, most = STROKE_STEP_KEYS if s.tools is not None else LOAD_STEP_KEYS
+    steps = {name: getattr(pr, name) for name in (least, first, most)}
+    for name, v in steps.items():
         require(math.isfinite(v) and v > 0, f"process.{name}", f"must be > 0, got {v}")
-    require(pr.min_step <= pr.initial_step, "process.min_step",
-            f"must be <= initial_step ({pr.initial_step}), got {pr.min_step}")
-    require(pr.initial_step <= pr.max_step, "process.initial_step",
-            f"must be <= max_step ({pr.max_step}), got {pr.initial_step}")
-    require(pr.max_step <= 1, "process.max_step", f"must be <= 1, got {pr.max_step}")
+    require(steps[least] <= steps[first], f"process.{least}", f"must be <= {first} ({steps[first]}), got {steps[least]}")
+    require(steps[first] <= steps[most], f"process.{first}", f"must be <= {most} ({steps[most]}), got {steps[first]}")
+    require(s.tools is not None or steps[most] <= 1, f"process.{most}", f"must be <= 1, got {steps[most]}")
     require(pr.max_iterations >= 1, "process.max_iterations", f"must be >= 1, got {pr.max_iterations}")
     require(math.isfinite(pr.rtol) and pr.rtol > 0, "process.rtol", f"must be > 0, got {pr.rtol}")
     require(len(pr.path) > 0, "process.path", "must list at least one load factor, e.g. [1.0]")

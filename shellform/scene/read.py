@@ -11,8 +11,8 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, SQUARE_TOOL_KEYS, Drawbead, EdgeMoment, Probe,
-                                    Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
+from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, LOAD_STEP_KEYS, SQUARE_TOOL_KEYS,
+                                    STROKE_STEP_KEYS, Drawbead, EdgeMoment, Probe, Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
                                     Surface, ToolsSpec)
 
 _SECTIONS = {
@@ -117,6 +117,14 @@ def from_dict(data: dict) -> Scene:
             if key in tools:
                 raise InputError(f"tools.{key}", "is a key of analytic tools: shape = 'cad' takes punch_file, die_file "
                                  "and their placements" if tools.get("shape") == "cad" else "is a key of shape = 'cad'")
+    process = data.get("process")
+    if isinstance(process, dict):
+        for key in LOAD_STEP_KEYS if "tools" in data else STROKE_STEP_KEYS:
+            if key in process:
+                raise InputError(f"process.{key}", f"a tool scene steps the punch's travel in mm: give process.{key}_mm "
+                                 "(the load-factor step times tools.stroke)" if "tools" in data else
+                                 "is a key of tool scenes (the punch's travel in mm): a sheet scene steps its load "
+                                 f"factor with process.{key.removesuffix('_mm')}")
     if "loads" in data:
         loads = dict(data["loads"]) if isinstance(data["loads"], dict) else data["loads"]
         if not isinstance(loads, dict):
@@ -177,6 +185,8 @@ def to_dict(s: Scene) -> dict:
     if s.tools is not None:  # the keys of the other kind of tools are not the scene's
         for key in ANALYTIC_TOOL_KEYS if s.tools.shape == "cad" else CAD_TOOL_KEYS:
             data["tools"].pop(key, None)
+    for key in LOAD_STEP_KEYS if s.tools is not None else STROKE_STEP_KEYS:  # the other kind of scene's steps
+        del data["process"][key]
     return data
 
 

@@ -18,13 +18,16 @@ from shellform import effects as registry
 from shellform.material import SheetMaterial, criteria
 from shellform.mesh import outline
 
-__all__ = ["TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS",
+__all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS", "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS",
            "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS", "ANISOTROPY_LISTS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
            "Drawbead", "ToolsSpec", "Probe", "Output", "Scene", "bounds"]
 
+# [process]: a sheet scene steps its load factor, a tool scene the punch's travel in mm
+LOAD_STEP_KEYS = ("initial_step", "min_step", "max_step")
+STROKE_STEP_KEYS = ("initial_step_mm", "min_step_mm", "max_step_mm")
 TOOL_SHAPES = ("square", "round", "cad")
 SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
 # the analytic tools' keys, which shape = "cad" does not take (its punch and die are files)
@@ -156,12 +159,18 @@ class Solver:
 
 @dataclass
 class Process:
-    """Load stepping of the nonlinear sheet (shellform.nonlinear.driver); ignored by linear scenes."""
+    """Load stepping of the nonlinear sheet (shellform.nonlinear.driver); ignored by linear scenes.
+    A sheet scene steps its load factor (initial_step, min_step, max_step), a tool scene the
+    punch's travel in mm (initial_step_mm, min_step_mm, max_step_mm), so that its increments do
+    not depend on the stroke: each kind of scene takes only its own keys."""
 
     thickness_points: int = 5  # Gauss points through the thickness (>= 2 with plasticity)
-    initial_step: float = 0.1  # first load-factor increment
+    initial_step: float = 0.1  # sheet scenes: first load-factor increment
     min_step: float = 1e-4  # 0 < min_step <= initial_step <= max_step <= 1
     max_step: float = 0.25
+    initial_step_mm: float = 0.06  # tool scenes: first increment of the punch's travel, mm
+    min_step_mm: float = 4e-4  # 0 < min_step_mm <= initial_step_mm <= max_step_mm
+    max_step_mm: float = 0.24
     max_iterations: int = 12  # Newton iterations per increment (>= 1)
     rtol: float = 1e-9  # residual tolerance (> 0)
     path: list[float] = field(default_factory=lambda: [1.0])  # load factors to step through, in order

@@ -27,7 +27,7 @@ def table(out: Path, runs, finest: str, reports: tuple[str, ...], measures=MEASU
     qs = quantities(reports, measures)
     rows = []
     for name, s in runs:
-        r = {**row(name, s, out), "max_step_mm": s.process.max_step * s.tools.stroke}
+        r = {**row(name, s, out), "max_step_mm": s.process.max_step_mm}
         r["peak_force"] = r["peak_punch_force_kN"]
         summary = json.loads((folder(out, name) / "summary.json").read_text())
         for at in summary["reports"]:

@@ -64,9 +64,7 @@ def scene_for(n: int, stroke: float | None = None, rtol: float | None = None):
         changes["process.rtol"] = rtol
     if stroke is not None and stroke != s.tools.stroke:
         scale = s.tools.stroke / stroke
-        changes.update({"process.max_step": s.process.max_step * scale,
-                        "process.initial_step": s.process.initial_step * scale,
-                        "process.report": [f * scale for f in s.process.report if f * scale <= 1.0],
+        changes.update({"process.report": [f * scale for f in s.process.report if f * scale <= 1.0],
                         "tools.stroke": stroke})
     return s.changed(changes)
 

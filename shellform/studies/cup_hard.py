@@ -65,14 +65,14 @@ def row(name: str, s: scene.Scene, out: Path) -> dict:
 
 def cases(n: int = 16) -> dict:
     """The hard variants of the paper's cup scene on an n x n quarter mesh."""
-    big = 10 * scene.load(ROOT / "demos" / "square_cup.toml").process.max_step
+    big = 10 * scene.load(ROOT / "demos" / "square_cup.toml").process.max_step_mm
     variant_n = lambda **changes: variant(n, **changes)  # noqa: E731
     return {
         "mu 0.3": variant_n(tools__friction=0.3),
         "t 0.5 mm": variant_n(material__thickness=0.5),
         "die radius 2 mm": variant_n(tools__die_profile_radius=2.0),
         "BHF 4t, die radius 20 mm": variant_n(tools__blank_holder_force=39200.0, tools__die_profile_radius=20.0),
-        "10x increment": variant_n(process__initial_step=big, process__max_step=big),
+        "10x increment": variant_n(process__initial_step_mm=big, process__max_step_mm=big),
     }
 
 

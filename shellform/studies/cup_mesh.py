@@ -26,8 +26,8 @@ def runs(levels=LEVELS) -> list:
     """(name, scene) of the study's runs."""
     demo = variant(16)
     return [(f"n {n}", variant(n)) for n in levels] + [
-        ("n 16, half step", variant(16, process__max_step=demo.process.max_step / 2,
-                                    process__initial_step=demo.process.initial_step / 2))]
+        ("n 16, half step", variant(16, process__max_step_mm=demo.process.max_step_mm / 2,
+                                    process__initial_step_mm=demo.process.initial_step_mm / 2))]
 
 
 def run(out: Path, levels=LEVELS) -> list[dict]:

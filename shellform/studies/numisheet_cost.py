@@ -31,12 +31,11 @@ def runs(levels=LEVELS, steps=STEPS, stroke=None) -> list:
     for k in steps[::-1]:
         for n in levels:
             s = variant(n, SCENE)
-            max_step, initial_step = s.process.max_step * k, s.process.initial_step * k
-            changes = {}
-            if stroke is not None:  # the same increments in mm
-                max_step, initial_step = max_step * (s.tools.stroke / stroke), initial_step * (s.tools.stroke / stroke)
+            changes = {"process.max_step_mm": s.process.max_step_mm * k,
+                       "process.initial_step_mm": s.process.initial_step_mm * k}
+            if stroke is not None:
                 changes["tools.stroke"] = stroke
-            s = s.changed({"process.max_step": max_step, "process.initial_step": initial_step, **changes})
+            s = s.changed(changes)
             out.append((f"n {n}" + (f", {k}x step" if k != 1 else ""), s))
     return out
 
