@@ -41,7 +41,7 @@ OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "fo
 CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force", "effects.friction",
             "process.initial_step", "process.min_step", "process.max_step", "process.max_iterations",
             "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
-            "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
+            "process.stop_at_neck", "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
 
 
 def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:
