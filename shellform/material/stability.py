@@ -38,9 +38,10 @@ A + G turns singular exactly at Considere's force maximum d tau / d eps = tau (S
 rigid-plastic: eps = n - eps0; the power law eps/eps_y = (sigma/sigma_y)^N: eps = 1/N). In
 shear the block of (dF12, dF21) stays positive definite in tension (its determinant is the
 shear tangent times lambda^2 N1 > 0), so there the full tangent dP/dF and its spin-free part
-lose definiteness together. In the compressed flange of a cup, -tau d eps^2 adds to the
-stiffness, and no compressed point is reported. In equibiaxial tension of a von Mises sheet
-it is Swift's diffuse neck: the equivalent strain 2n (each in-plane strain n).
+lose definiteness together. With principal stretches along fixed axes the same steps give, in
+the logarithmic strain and the Kirchhoff stress, w2 = t0 (d eps : d tau - tau : d eps^2): a
+compressive principal stress adds to the stiffness (the compressed flange of a cup is not
+reported), a tensile one takes from it.
 """
 
 import math
@@ -53,7 +54,7 @@ from shellform import _jit as jit
 ROOT2 = math.sqrt(2.0)
 # the Voigt strains' tensors: dE = sum_a v_a X_a for v = (dE11, dE22, 2 dE12)
 _VOIGT = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]], [[0.0, 0.5], [0.5, 0.0]]])
-_MANDEL = np.array([1.0, 1.0, 1.0 / ROOT2])  # v = T m, m = (dE11, dE22, sqrt 2 dE12)
+_MANDEL = np.array([1.0, 1.0, ROOT2])  # v = T m, m = (dE11, dE22, sqrt 2 dE12)
 
 
 @jit.njit
@@ -75,7 +76,7 @@ def smallest_eigenvalue(a00, a01, a02, a11, a12, a22):
 @jit.njit
 def membrane_stiffness(E, N, A, M):
     """M (3 x 3) = T (A + G) T, the tangent of the nominal membrane force on spin-free rates in
-    Mandel's components (T = diag(1, 1, 1/sqrt 2)), from the membrane strain E = (E11, E22, 2 E12),
+    Mandel's components m (v = T m, T = diag(1, 1, sqrt 2): v^T (A + G) v = m^T M m), from the membrane strain E = (E11, E22, 2 E12),
     its resultant N = (N11, N22, N12) and tangent A (3 x 3, Voigt); G_ab = sym tr(N X_a C^-1 X_b)
     over the Voigt strains' tensors X_a (module docstring). Returns False where C = I + 2E is not
     positive definite."""
