@@ -98,6 +98,22 @@ def test_the_watch_interpolates_the_onset_and_keeps_it():
     assert watch.onset == first
 
 
+def test_a_resumed_watch_keeps_an_earlier_onset():
+    """A resumed run at 12 mm keeps the onset found at 10 mm (from the summary before), and
+    ignores one past its state (a run resumed from before it finds it again)."""
+    earlier = {"stroke_mm": 10.0, "increment_stroke_mm": 10.5, "initial_xy_mm": [1.0, 2.0],
+               "thickness_strain": -0.2, "stability": -1.0}
+    watch = NeckWatch(MPI.COMM_SELF)
+    watch.carry(earlier, 12.0)
+    assert watch.onset == earlier
+    assert watch.reached(13.0, np.array([5.0]), np.array([-0.1]), np.array([[0.0, 0.0]]))
+    assert watch.onset == earlier
+    later = NeckWatch(MPI.COMM_SELF)
+    later.carry(earlier, 9.0)
+    later.carry(None, 9.0)
+    assert later.onset is None
+
+
 @pytest.mark.parametrize("homogeneous", [True, False], ids=["homogeneous", "free"])
 @pytest.mark.parametrize("material", ["swift", "power"])
 def test_a_strip_pulled_past_considere_necks_at_the_force_maximum(material, homogeneous):
