@@ -78,8 +78,8 @@ def membrane_stiffness(E, N, A, M):
     """M (3 x 3) = T (A + G) T, the tangent of the nominal membrane force on spin-free rates in
     Mandel's components m (v = T m, T = diag(1, 1, sqrt 2): v^T (A + G) v = m^T M m), from the
     membrane strain E = (E11, E22, 2 E12), its resultant N = (N11, N22, N12) and tangent A (3 x 3,
-    Voigt); G_ab = sym tr(N X_a C^-1 X_b) over the Voigt strains' tensors X_a (module docstring). Returns False where C = I + 2E is not
-    positive definite."""
+    Voigt); G_ab = sym tr(N X_a C^-1 X_b) over the Voigt strains' tensors X_a (module docstring).
+    Returns False where C = I + 2E is not positive definite."""
     c00, c11, c01 = 1.0 + 2.0 * E[0], 1.0 + 2.0 * E[1], E[2]
     det = c00 * c11 - c01 * c01
     if not (c00 > 0.0 and det > 0.0):
