@@ -52,9 +52,6 @@ import numpy as np
 from shellform import _jit as jit
 
 ROOT2 = math.sqrt(2.0)
-# the Voigt strains' tensors: dE = sum_a v_a X_a for v = (dE11, dE22, 2 dE12)
-_VOIGT = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]], [[0.0, 0.5], [0.5, 0.0]]])
-_MANDEL = np.array([1.0, 1.0, ROOT2])  # v = T m, m = (dE11, dE22, sqrt 2 dE12)
 
 
 @jit.njit
@@ -78,26 +75,26 @@ def membrane_stiffness(E, N, A, M):
     """M (3 x 3) = T (A + G) T, the tangent of the nominal membrane force on spin-free rates in
     Mandel's components m (v = T m, T = diag(1, 1, sqrt 2): v^T (A + G) v = m^T M m), from the
     membrane strain E = (E11, E22, 2 E12), its resultant N = (N11, N22, N12) and tangent A (3 x 3,
-    Voigt); G_ab = sym tr(N X_a C^-1 X_b) over the Voigt strains' tensors X_a (module docstring).
-    Returns False where C = I + 2E is not positive definite."""
+    Voigt). With dE = [[a, c], [c, b]] and B = C^-1, tr(N dE B dE) is the quadratic form in
+    (a, b, c) of
+
+        H_aa = N11 B11,  H_bb = N22 B22,  H_cc = N11 B22 + N22 B11 + 2 N12 B12,
+        H_ab = N12 B12,  H_ac = N11 B12 + N12 B11,  H_bc = N22 B12 + N12 B22,
+
+    and m = (a, b, sqrt 2 c). Returns False where C = I + 2E is not positive definite."""
     c00, c11, c01 = 1.0 + 2.0 * E[0], 1.0 + 2.0 * E[1], E[2]
     det = c00 * c11 - c01 * c01
     if not (c00 > 0.0 and det > 0.0):
         return False
-    B = np.empty((2, 2))  # C^-1
-    B[0, 0], B[1, 1], B[0, 1], B[1, 0] = c11 / det, c00 / det, -c01 / det, -c01 / det
-    n = np.empty((2, 2))
-    n[0, 0], n[1, 1], n[0, 1], n[1, 0] = N[0], N[1], N[2], N[2]
-    for a in range(3):
-        for b in range(a, 3):
-            g = 0.0
-            for i in range(2):
-                for j in range(2):
-                    for k in range(2):
-                        for m in range(2):
-                            g += n[i, j] * (_VOIGT[a, j, k] * B[k, m] * _VOIGT[b, m, i]
-                                            + _VOIGT[b, j, k] * B[k, m] * _VOIGT[a, m, i])
-            M[a, b] = M[b, a] = _MANDEL[a] * _MANDEL[b] * (0.5 * (A[a, b] + A[b, a]) + 0.5 * g)
+    b11, b22, b12 = c11 / det, c00 / det, -c01 / det  # C^-1
+    n11, n22, n12 = N[0], N[1], N[2]
+    r = 1.0 / ROOT2
+    M[0, 0] = A[0, 0] + n11 * b11
+    M[1, 1] = A[1, 1] + n22 * b22
+    M[2, 2] = 2.0 * A[2, 2] + 0.5 * (n11 * b22 + n22 * b11 + 2.0 * n12 * b12)
+    M[0, 1] = M[1, 0] = 0.5 * (A[0, 1] + A[1, 0]) + n12 * b12
+    M[0, 2] = M[2, 0] = ROOT2 * 0.5 * (A[0, 2] + A[2, 0]) + r * (n11 * b12 + n12 * b11)
+    M[1, 2] = M[2, 1] = ROOT2 * 0.5 * (A[1, 2] + A[2, 1]) + r * (n22 * b12 + n12 * b22)
     return True
 
 
@@ -109,7 +106,7 @@ def membrane_stability(strain, resultants, tangents, thickness, out):
     6, 6) of the sections (shellform.nonlinear.model.SheetModel); NaN where a point's C is not
     positive definite."""
     for c in numba.prange(strain.shape[0]):
-        M = np.empty((3, 3))
+        M = np.empty((3, 3))  # scratch, once per cell
         least = math.inf
         for g in range(strain.shape[1]):
             if not membrane_stiffness(strain[c, g, :3], resultants[c, g, :3], tangents[c, g, :3, :3], M):
