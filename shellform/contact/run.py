@@ -41,6 +41,11 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              the stroke ends at the increment where the smallest margin reaches
                              0; summary.json "forming_limit_reached": the stroke interpolated to
                              margin 0 and the increment's (results/fld.py)
+    (summary.json "neck")    where the sheet starts to neck (results/neck.py): the stroke where
+                             a cell's membrane stability reaches 0 (interpolated within the
+                             increment), the cell's initial x y and thickness strain there; null
+                             without a neck. With [process] stop_at_neck the stroke ends at that
+                             increment; without, the run goes on and only reports it
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
                              after the tools withdraw (contact/springback.py; the picture: after
                              minus before); summary.json: wall angle, flange edge, re-yield,
@@ -67,7 +72,7 @@ from shellform.errors import InputError
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
-from shellform.results import cup, fld, run_folder
+from shellform.results import cup, fld, neck, run_folder
 from shellform.results.log import Progress
 from shellform.results.summary import DrawingSummary
 from shellform.results.tables import write_csv, write_json
@@ -83,6 +88,10 @@ CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_u
 
 class FormingLimitReached(Exception):
     """The stroke ends: an element's margin to the forming-limit curve reached 0."""
+
+
+class NeckReached(Exception):
+    """The stroke ends: the sheet starts to neck ([process] stop_at_neck)."""
 
 
 def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list, dict]:
@@ -121,6 +130,14 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     return curve, reports, info
 
 
+def _previous_neck(outdir: Path) -> dict | None:
+    """The neck that the resumed run's summary.json reports (None without one or without it)."""
+    try:
+        return json.loads((outdir / "summary.json").read_text()).get("neck")
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
 def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> DrawingSummary:
     """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
     continue from the last converged state in outdir (written at every report, at the end and
@@ -146,6 +163,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         (curve_of_limits, _), _ = fld.curves(s.material)
         paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
         watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
+    necks = neck.NeckWatch(comm) if p.model.plastic else None
+    if necks is not None and resumed:
+        necks.carry(_previous_neck(outdir), p.stroke)
+    centres = p.model.cell_centres()
 
     def on_increment(d):
         h = d.history[-1]
@@ -163,12 +184,20 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         every = s.output.checkpoint_every  # the last converged increment on disk at least this often
         if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
             checkpoint_now()
+        necked = False
+        if necks is not None:
+            before = necks.onset
+            necked = necks.reached(p.stroke, p.model.membrane_stability(), p.model.thickness_strain(), centres)
+            if necked and before is None and not s.process.stop_at_neck:
+                p.driver.progress.note(f"shellform: the sheet starts to neck: {neck.words(necks.onset)}")
         if paths is not None or watch is not None:
             f = p.model.cell_fields()
             if paths is not None:
                 paths.record(p.stroke, f["major_strain"], f["minor_strain"])
             if watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"]):
                 raise FormingLimitReached
+        if necked and s.process.stop_at_neck:
+            raise NeckReached
 
     def write_curve():
         write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
@@ -204,6 +233,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         p.driver.progress.note(f"shellform: the forming-limit curve is reached at {watch.limit['stroke_mm']:.4g} mm")
         report()
         checkpoint_now()
+    except NeckReached:  # the stroke ends where the sheet starts to neck
+        p.driver.progress.note(f"shellform: the stroke ends: {neck.words(necks.onset)}")
+        report()
+        checkpoint_now()
     except ConvergenceFailure as err:
         stopped = str(err)
         p.driver.progress.note(f"shellform: stopped: {err}")
@@ -226,7 +259,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
     limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
     if paths is not None:
-        path = paths.critical(p.model.cell_coords.reshape(-1, 3, 3).mean(axis=1)[:, :2])
+        path = paths.critical(centres)
         if path:
             rows = [dict(zip(("stroke_mm", "major", "minor", "margin"), r))
                     for r in zip(path["stroke_mm"], path["major"], path["minor"], path["margin"])]
@@ -252,7 +285,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
         "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],
         **{k: v for k, v in reports[-1].items() if k not in ("stroke_mm", "draw_in_mm", "punch_force_kN")},
-        "reports": reports, **limits, "springback": sprung, **({"rim": rim} if rim else {}),
+        "reports": reports, **limits, "neck": necks.onset if necks is not None else None,
+        "springback": sprung, **({"rim": rim} if rim else {}),
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "element_evaluations": {"run": d.evaluations, "reused": d.reused, "tangents": d.tangents},

@@ -22,6 +22,7 @@ from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly import assumed_membrane
 from shellform.assembly.sheet_kernels import SheetKernels
 from shellform.material import hencky, plane_stress, section
+from shellform.material.stability import membrane_stability
 from shellform.material.update import section_update
 from shellform.nonlinear.assemble import CellArrayForms
 from shellform import _jit as jit
@@ -136,6 +137,7 @@ class SheetModel:
         self.taper = np.zeros((self.num_cells, self.nqp, 3))  # curvature carried without a moment (follow_taper)
         self.resultants = np.zeros((self.num_cells, self.nqp, 6))
         self.tangents = np.zeros((self.num_cells, self.nqp, 6, 6))
+        self.stability_n = np.full(self.num_cells, np.nan)  # of the committed state (membrane_stability)
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
         self.state_version = 0  # changes with the committed material state (Driver's reuse of an evaluation)
 
@@ -165,7 +167,11 @@ class SheetModel:
                                  self.resultants, self.tangents, tangent, self.forms.vectors, self.forms.matrices)
 
     def commit(self) -> None:
-        """Accept the trial material state (an increment converged)."""
+        """Accept the trial material state (an increment converged); the sections' membrane
+        stability at it (membrane_stability), from the converged iterate's strains, resultants
+        and tangents."""
+        numba.set_num_threads(self.threads)
+        membrane_stability(self.strain, self.resultants, self.tangents, self.thickness, self.stability_n)
         self.ep_n[...] = self.ep
         self.p_n[...] = self.p
         self.stretch_n[...] = self.stretch
@@ -211,6 +217,7 @@ class SheetModel:
         for key, target in pairs:
             target[...] = data[key]
         self.ep[...], self.p[...], self.stretch[...], self.lever[...] = self.ep_n, self.p_n, self.stretch_n, self.stretch_n
+        self.stability_n[...] = np.nan  # not known until an increment converges
         self.state_version += 1
 
     def converged_lever(self) -> None:
@@ -220,6 +227,18 @@ class SheetModel:
         self.state_version += 1
 
     # -- output fields ------------------------------------------------------------------------
+    def membrane_stability(self) -> np.ndarray:
+        """Per owned cell, at the last converged increment: the least over its quadrature points
+        of the smallest eigenvalue of the tangent of the nominal membrane force on spin-free rates,
+        per unit initial thickness (stress units; shellform.material.stability). At or below 0
+        the material point has lost its stability: a neck may start there (Considere's force
+        maximum in uniaxial tension). NaN before the first increment after a start or a restore."""
+        return self.stability_n
+
+    def cell_centres(self) -> np.ndarray:
+        """The owned cells' centroids in the initial (flat blank's) x, y: (cells, 2)."""
+        return self.cell_coords.reshape(-1, 3, 3).mean(axis=1)[:, :2]
+
     def cell_fields(self) -> dict[str, np.ndarray]:
         """Per owned cell, averaged over its quadrature points, at the last evaluated state:
         equivalent plastic strain (max over the layers), thickness strain of the section (mean

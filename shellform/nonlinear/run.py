@@ -13,6 +13,11 @@ Writes into the output folder:
                        last converged state (nonlinear/checkpoint.py;
                        `--resume` continues tool scenes only)
     run.json           the run: scene file and hash, title, code version, started
+
+summary.json "neck" (plasticity): where the sheet starts to neck (results/neck.py), the load factor
+where a cell's membrane stability reaches 0 (interpolated within the increment), the cell's
+initial x y and thickness strain there; null without a neck. With [process] stop_at_neck the
+load path ends at that increment (its state reported), as a finished run.
 """
 
 import time
@@ -28,7 +33,7 @@ from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
 from shellform.nonlinear.problem import SheetProblem
 from shellform.scene import Scene
-from shellform.results import fields, run_folder
+from shellform.results import fields, neck, run_folder
 from shellform.results.log import Progress
 from shellform.results.summary import SheetSummary
 from shellform.results.tables import write_csv, write_json
@@ -83,6 +88,10 @@ def extremes(p: SheetProblem) -> dict:
     return out
 
 
+class NeckReached(Exception):
+    """The load path ends: the sheet starts to neck ([process] stop_at_neck)."""
+
+
 def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSummary:
     """Step the scene's load path into outdir, which is this run's alone (run_folder.start);
     scene_path: the scene's file, for run.json."""
@@ -97,14 +106,32 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
     reports, stopped, signum = [], None, 0
     p.driver.progress = Progress("load factor", max(abs(x) for x in s.process.path))
     targets = sorted(set(s.process.report))
+    necks = neck.NeckWatch(comm, "load_factor", "initial_xy") if p.model.plastic else None
+    centres = p.model.cell_centres()
+
+    def on_increment(d):
+        if necks is None:
+            return
+        before = necks.onset
+        if necks.reached(d.lam, p.model.membrane_stability(), p.model.thickness_strain(), centres):
+            if s.process.stop_at_neck:
+                raise NeckReached
+            if before is None:
+                p.driver.progress.note(f"shellform: the sheet starts to neck: "
+                                       f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
+
     try:
         for target in s.process.path:
             # stop at every report point on the way to the target
             lo, hi = sorted((p.driver.lam, target))
             stops = [r for r in targets if lo < r < hi]
             for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
-                p.driver.run(r)
+                p.driver.run(r, on_increment=on_increment)
                 reports.append(_record(p, s))
+    except NeckReached:  # the load path ends where the sheet starts to neck
+        p.driver.progress.note(f"shellform: the load path ends: "
+                               f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
+        reports.append(_record(p, s))
     except (ConvergenceFailure, Interrupted) as err:
         stopped = str(err)
         if isinstance(err, Interrupted):
@@ -120,6 +147,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         "dofs": p.model.V.dofmap.index_map.size_global * 9, "reports": reports,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
+        "neck": necks.onset if necks is not None else None,
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
     }, outdir)
     rows = [{"increment": h.number, "load_factor": h.lam, "step": h.dlam, "iterations": h.iterations,

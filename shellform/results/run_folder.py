@@ -42,7 +42,7 @@ CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force
             "process.initial_step", "process.min_step", "process.max_step", "process.initial_step_mm",
             "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
             "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
-            "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
+            "process.stop_at_neck", "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
 
 
 def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:

@@ -4,7 +4,8 @@ Every route (shellform.run: the linear shell, the nonlinear sheet, the tools) re
 Summary: a dict holding exactly what summary.json holds, which also knows
 
     closing_line()   the one line `shellform run` prints on stdout at the end: the title, the
-                     cells, the route's result in a few numbers, the time, the output folder
+                     cells, the route's result in a few numbers (and where the sheet started to
+                     neck, summary.json "neck", if it did), the time, the output folder
     stop_line()      where the run stopped early (no convergence, a limit load, Ctrl-C,
                      SIGTERM), the line for stderr; None when it ran to its end
     exit_status()    0 when it ran to its end, 128 + the signal when a signal stopped it, 3
@@ -14,6 +15,8 @@ so that the command line prints and returns without asking which route ran.
 """
 
 from pathlib import Path
+
+from shellform.results import neck
 
 
 class Summary(dict):
@@ -44,22 +47,26 @@ class ShellSummary(Summary):
 
 
 class SheetSummary(Summary):
-    """The nonlinear sheet: the last reported load factor and w there."""
+    """The nonlinear sheet: the last reported load factor and w there, and the neck's onset."""
 
     def closing_line(self) -> str:
         last = self["reports"][-1] if self["reports"] else {}
+        necked = f", {neck.words(self['neck'], 'load_factor', 'initial_xy')}" if self.get("neck") else ""
         return (f"shellform: {self['title']}: {self['cells']} cells, {self['increments']} increments, "
-                f"load factor {last.get('load_factor')}, w = {last.get('w')}, {self['wall_time_s']:.2f} s; "
+                f"load factor {last.get('load_factor')}, w = {last.get('w')}{necked}, {self['wall_time_s']:.2f} s; "
                 f"results in {self.outdir}")
 
 
 class DrawingSummary(Summary):
-    """The tools: the stroke reached, the last draw-in, the peak thickness strain."""
+    """The tools: the stroke reached, the last draw-in, the peak thickness strain, the neck's
+    onset."""
 
     def closing_line(self) -> str:
         last = self["draw_in_mm"][-1] if self["draw_in_mm"] else {}
         draw_in = ", ".join(f"{k} {v:.3f}" for k, v in last.items() if k != "stroke_mm")
         force = self["punch_force_kN"][-1]["force"] if self.get("punch_force_kN") else float("nan")
+        necked = f", {neck.words(self['neck'])}" if self.get("neck") else ""
         return (f"shellform: {self['title']}: {self['cells']} cells, stroke {self['stroke_mm']:.2f} mm, "
                 f"draw-in (mm) {draw_in}, punch force {force:.2f} kN, largest thinning (thickness strain) "
-                f"{self['min_thickness_strain']:.4f}, {self['wall_time_s']['total']:.1f} s; results in {self.outdir}")
+                f"{self['min_thickness_strain']:.4f}{necked}, {self['wall_time_s']['total']:.1f} s; "
+                f"results in {self.outdir}")

@@ -170,6 +170,10 @@ def _validate_material(s: Scene) -> None:
     if s.process.stop_at_forming_limit:
         require(s.tools is not None and plastic, "process.stop_at_forming_limit",
                 "ends a tool scene's stroke at the forming-limit curve: it needs the effects contact and plasticity")
+    if s.process.stop_at_neck:
+        require(s.nonlinear and plastic, "process.stop_at_neck",
+                "ends a nonlinear scene's stroke or load path where the sheet starts to neck: it needs the effects "
+                "geometric_nonlinearity and plasticity")
     limits_view = s.tools is not None and (s.output.fld or s.process.stop_at_forming_limit)
     if plastic and (mat.forming_limit_curve or limits_view):
         from shellform.results import fld

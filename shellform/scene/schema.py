@@ -179,6 +179,9 @@ class Process:
     # tool scenes with plasticity: the stroke ends where an element's margin to the forming-limit
     # curve reaches 0 (results/fld.py, FormingLimitWatch): a Nakajima test's limit dome height
     stop_at_forming_limit: bool = False
+    # nonlinear scenes with plasticity: the stroke (or load path) ends where a cell's membrane
+    # stability reaches 0, the onset of a neck (results/neck.py, NeckWatch); reported either way
+    stop_at_neck: bool = False
 
 
 @dataclass

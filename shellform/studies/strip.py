@@ -9,7 +9,10 @@ Quarter strip 10 x 2 x 1 (symmetry on the left and bottom), pulled along x:
   logarithmic strain); the closed form is sigma_f(p) / lambda, p = ln lambda - tau / E.
 - free: only the end is pulled (u = a L, u_y = 0). The force peaks at Considere's strain, where
   d sigma / d eps = sigma (Swift: eps = n - eps0; power law eps/eps_y = (sigma/sigma_y)^N:
-  eps = 1/N); past it the strip necks.
+  eps = 1/N); past it the strip necks. With the elastic strain the force peaks a little later
+  (force_maximum_strain: 0.2532 for the mild steel, 0.25 for the power law, whose strain is the
+  total one). A NeckWatch given to `strip` finds the neck's onset there from the sections'
+  membrane stability (shellform.results.neck), held homogeneous or free.
 - equibiaxial: a quarter square 1 x 1 with u = a x, v = a y held everywhere. Hill 1979 gives
   tau = sigma_f(p) (2 (1 + r))^(1/m) / 2, p = (2 (1 + r))^(1/m) (ln lambda - (1 - nu) tau / E).
 
@@ -29,6 +32,7 @@ from shellform.material import Hill79Material, flow_stress
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.problem import SheetProblem
 from shellform.results.log import say
+from shellform.results.neck import NeckWatch
 from shellform.results.tables import write_csv
 
 LENGTH, WIDTH, T0 = 5.0, 1.0, 1.0  # the quarter strip
@@ -56,6 +60,17 @@ def considere_strain(mat) -> float:
     return 1.0 / mat.n
 
 
+def force_maximum_strain(mat) -> float:
+    """The true strain ln lambda at the maximum of the nominal stress tau(lambda) / lambda of
+    uniaxial_kirchhoff (its elastic part included): where d tau / d eps = tau."""
+    from scipy.optimize import minimize_scalar
+
+    e = considere_strain(mat)
+    found = minimize_scalar(lambda x: -uniaxial_kirchhoff(mat, np.exp(x)) / np.exp(x), bounds=(0.5 * e, 1.5 * e),
+                            method="bounded", options={"xatol": 1e-9})
+    return float(found.x)
+
+
 def uniaxial_kirchhoff(mat, lam: float) -> float:
     """tau with tau = sigma_f(ln lambda - tau / E) (Swift), or sigma(ln lambda) of the power
     law, whose strain is the total one."""
@@ -79,9 +94,11 @@ def equibiaxial_kirchhoff(mat, lam: float, elastic=True) -> float:
     return tau
 
 
-def strip(mat, stretch: float, homogeneous=True, finite=True, steps=10, n=1, comm=MPI.COMM_WORLD):
+def strip(mat, stretch: float, homogeneous=True, finite=True, steps=10, n=1, comm=MPI.COMM_WORLD, watch=None):
     """Pull the quarter strip to `stretch`; returns (problem, rows) with a row per increment:
-    stretch, nominal stress, thickness strain ln(t/t0), width strain ln(w/w0)."""
+    stretch, nominal stress, thickness strain ln(t/t0), width strain ln(w/w0) and the least
+    membrane stability of the cells (shellform.material.stability). watch: a NeckWatch
+    (shellform.results.neck) told the stretch and the cells' state after every increment."""
     a = stretch - 1.0
     if homogeneous:
         held = {("all", "u"): lambda x, y: a * x, ("all", "u_x"): a, ("all", "u_y"): 0.0}
@@ -97,9 +114,13 @@ def strip(mat, stretch: float, homogeneous=True, finite=True, steps=10, n=1, com
         f = p.model.cell_fields()
         e33 = comm.allreduce(float(f["thickness_strain"].sum()), op=MPI.SUM) / comm.allreduce(
             f["thickness_strain"].size, op=MPI.SUM)
+        stability = p.model.membrane_stability()
         rows.append({"stretch": 1.0 + d.lam * a, "nominal_stress": p.reaction("right", "u") / (WIDTH * T0),
                      "thickness_strain": e33,
-                     "width_strain": float(np.log(1.0 + p.value("v", LENGTH, WIDTH) / WIDTH))})
+                     "width_strain": float(np.log(1.0 + p.value("v", LENGTH, WIDTH) / WIDTH)),
+                     "stability": comm.allreduce(float(stability.min(initial=np.inf)), op=MPI.MIN)})
+        if watch is not None:
+            watch.reached(1.0 + d.lam * a, stability, f["thickness_strain"], p.model.cell_centres())
 
     p.driver.run(1.0, on_increment=record)
     return p, rows
@@ -132,14 +153,16 @@ def run(outdir: Path, stretch=1.5, steps=20) -> list[dict]:
                                       ("small strain (issue 3), homogeneous", True, False),
                                       ("finite strain, free end", False, True)):
         t0 = time.perf_counter()
-        _, path = strip(mat, stretch, homogeneous, finite, steps, n=1 if homogeneous else 4)
+        watch = NeckWatch(MPI.COMM_WORLD, "stretch", "initial_xy")
+        _, path = strip(mat, stretch, homogeneous, finite, steps, n=1 if homogeneous else 4, watch=watch)
         seconds = time.perf_counter() - t0
         for r in path:
             closed = uniaxial_kirchhoff(mat, r["stretch"]) / r["stretch"]
             rows.append({"model": name, **{k: r[k] for k in ("stretch", "nominal_stress", "thickness_strain")},
                          "closed_form": closed, "rel_error": r["nominal_stress"] / closed - 1,
                          "thickness_closed_form": -np.log(r["stretch"]) / 2, "seconds": seconds})
-        say(f"strip: {name}: {path[-1]['nominal_stress']:.1f} MPa at stretch {stretch} ({seconds:.1f} s)")
+        necked = f", neck from ln(stretch) {np.log(watch.onset['stretch']):.4f}" if watch.onset else ""
+        say(f"strip: {name}: {path[-1]['nominal_stress']:.1f} MPa at stretch {stretch}{necked} ({seconds:.1f} s)")
     write_csv(outdir / "strip.csv", rows, COLUMNS)
     _plot(outdir / "strip.png", rows, mat)
     return rows

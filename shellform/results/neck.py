@@ -1,0 +1,73 @@
+"""Where the sheet starts to neck: the watch over the sections' membrane stability.
+
+A neck is a material instability: the material point can no longer carry more nominal force
+for more stretch, and a local model then localises the strain into one row of cells. Its onset
+is where a cell's membrane stability (shellform.material.stability, SheetModel.membrane_stability:
+the smallest eigenvalue of the tangent of the nominal membrane force, per unit initial
+thickness) first reaches 0; in uniaxial tension that is Considere's force maximum.
+
+The watch is told the sheet's state after every converged increment (a run's on_increment;
+the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
+tool scene, the load factor of a sheet scene) interpolated linearly between the last increment
+whose least stability is positive and the first whose is not (the least over all cells of
+every rank at each: where the weakest cell changes between them, a lower bound of the onset),
+the initial x, y of the cell weakest at that first increment, and its thickness strain
+interpolated to the onset the same way. `reached` stays True from then on; a run with
+[process] stop_at_neck ends its stroke or load path there, one without goes on and only
+reports it (summary.json "neck", null without a neck).
+"""
+
+import numpy as np
+
+
+class NeckWatch:
+    """The onset of the neck along a run. at, place: the names of the load measure and of the
+    place in `onset` ("stroke_mm", "initial_xy_mm" for tool scenes; "load_factor", "initial_xy"
+    for sheet scenes)."""
+
+    def __init__(self, comm, at: str = "stroke_mm", place: str = "initial_xy_mm"):
+        self.comm, self.at, self.place = comm, at, place
+        self.last = None  # (load measure, least stability) of the last increment
+        self.thickness = None  # the local cells' thickness strains at the last increment
+        self.onset = None  # {at, "increment_" + at, place, "thickness_strain", "stability"}, or None
+
+    def carry(self, onset: dict | None, at: float) -> None:
+        """Keep the onset an earlier run found at or before `at` (a resumed run's state), so that
+        a resume reports where the neck started, not where the resumed run first sees it."""
+        if onset and self.onset is None and onset.get(self.at) is not None and onset[self.at] <= at:
+            self.onset = dict(onset)
+
+    def reached(self, at: float, stability, thickness_strain, centres) -> bool:
+        """After an increment at the load measure `at`: the local cells' stability, thickness
+        strain and initial centres (cells, 2). Whether the neck has started (now or before)."""
+        stability = np.asarray(stability, dtype=float)
+        local = float(np.nanmin(stability)) if np.any(np.isfinite(stability)) else np.inf
+        least, owner = min(self.comm.allgather((local, self.comm.rank)))
+        if least <= 0.0 and self.onset is None:
+            fraction = 1.0
+            if self.last is not None and self.last[1] > 0.0 and np.isfinite(self.last[1]):
+                a0, m0 = self.last
+                fraction = m0 / (m0 - least)
+                start = a0 + (at - a0) * fraction
+            else:
+                start = at
+            where = None
+            if self.comm.rank == owner:
+                i = int(np.nanargmin(stability))
+                t1 = float(thickness_strain[i])
+                t0 = float(self.thickness[i]) if self.thickness is not None else t1
+                where = ([float(c) for c in centres[i]], t0 + fraction * (t1 - t0))
+            xy, t = self.comm.bcast(where, root=owner)
+            self.onset = {self.at: float(start), f"increment_{self.at}": float(at), self.place: xy,
+                          "thickness_strain": float(t), "stability": float(least)}
+        self.last = (float(at), float(least))
+        self.thickness = np.array(thickness_strain, dtype=float, copy=True)
+        return self.onset is not None
+
+
+def words(onset: dict, at: str = "stroke_mm", place: str = "initial_xy_mm") -> str:
+    """A watch's onset in words, for a run's log and closing line: 'neck from stroke 23.8 mm at
+    initial (25, 12.5), thickness strain -0.1650' (a load factor without a unit)."""
+    x, y = onset[place]
+    where = f"stroke {onset[at]:.4g} mm" if at == "stroke_mm" else f"{at.replace('_', ' ')} {onset[at]:.4g}"
+    return f"neck from {where} at initial ({x:.4g}, {y:.4g}), thickness strain {onset['thickness_strain']:.4f}"

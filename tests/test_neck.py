@@ -1,0 +1,215 @@
+"""The neck's onset (issue 44): the sections' membrane stability (shellform.material.stability)
+reaches 0 at Considere's force maximum of a strip in tension, the watch (shellform.results.neck)
+interpolates where, and [process] stop_at_neck ends a tool scene's stroke there."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from shellform import scene
+from shellform.contact import run as contact_run
+from shellform.errors import InputError
+from shellform.material.stability import membrane_stiffness, smallest_eigenvalue
+from shellform.results.neck import NeckWatch
+from shellform.studies import strip
+
+DEMOS = Path(__file__).resolve().parents[1] / "demos"
+MATERIALS = {"swift": strip.mild_steel, "power": strip.power_law}
+
+
+def test_smallest_eigenvalue_in_closed_form():
+    """The trigonometric solution against LAPACK on random symmetric matrices, with a nearly
+    singular and a repeated case, to 1e-9 of the largest eigenvalue."""
+    rng = np.random.default_rng(44)
+    cases = [rng.normal(size=(3, 3)) * 10.0 ** rng.uniform(-2, 5) for _ in range(200)]
+    cases += [np.diag([2e5, 1e5, 1e-3]), np.diag([7.0, 7.0, 7.0]), np.diag([3.0, 5.0, 5.0])]
+    for a in cases:
+        a = a + a.T
+        exact = np.linalg.eigvalsh(a)
+        got = smallest_eigenvalue(a[0, 0], a[0, 1], a[0, 2], a[1, 1], a[1, 2], a[2, 2])
+        assert abs(got - exact[0]) <= 1e-9 * np.abs(exact).max()
+
+
+def test_uniaxial_stiffness_is_the_slope_of_the_nominal_force():
+    """A state of uniaxial stress N = (N1, 0, 0) at stretches (lambda, mu), with a diagonal
+    tangent A: on the spin-free rates the stiffness along dE11 is A11 + N1 / lambda^2 (its
+    geometric term), the shear's 2 (A22 + N1 / (4 mu^2)) in Mandel's components (dE12 = 1/2 in
+    the Voigt shear's tensor, sqrt 2 dE12 its Mandel component)."""
+    lam, mu, N1 = 1.3, 0.9, 250.0
+    E = np.array([(lam**2 - 1) / 2, (mu**2 - 1) / 2, 0.0])
+    A = np.diag([100.0, 2000.0, 800.0])
+    M = np.zeros((3, 3))
+    assert membrane_stiffness(E, np.array([N1, 0.0, 0.0]), A, M)
+    assert M[0, 0] == pytest.approx(100.0 + N1 / lam**2, rel=1e-14)
+    assert M[1, 1] == pytest.approx(2000.0, rel=1e-14)
+    assert M[2, 2] == pytest.approx(2.0 * (800.0 + N1 / (4 * mu**2)), rel=1e-14)
+    assert M[0, 1] == M[0, 2] == M[1, 2] == 0.0
+
+
+def test_the_stiffness_is_the_nominal_force_tangent_on_spin_free_rates():
+    """For a membrane N = A0 E + N0 (any symmetric A0, a prestress N0) at a sheared stretch F,
+    dF : dP on dF = F^-T dE equals m^T M m, P = F N the nominal force and dP its central
+    difference, for random dE (m: dE's Mandel components)."""
+    rng = np.random.default_rng(7)
+    A0 = rng.normal(size=(3, 3)) * 50.0
+    A0 = A0 + A0.T + np.diag([900.0, 700.0, 300.0])
+    N0 = np.array([120.0, -40.0, 30.0])
+    F = np.array([[1.25, 0.2], [-0.1, 0.85]])
+
+    def strain(F):
+        E = 0.5 * (F.T @ F - np.eye(2))
+        return np.array([E[0, 0], E[1, 1], 2.0 * E[0, 1]])
+
+    def nominal(F):
+        N = A0 @ strain(F) + N0
+        return F @ np.array([[N[0], N[2]], [N[2], N[1]]])
+
+    M = np.zeros((3, 3))
+    assert membrane_stiffness(strain(F), A0 @ strain(F) + N0, A0, M)
+    for _ in range(5):
+        m = rng.normal(size=3)
+        dE = np.array([[m[0], m[2] / np.sqrt(2)], [m[2] / np.sqrt(2), m[1]]])
+        dF = np.linalg.inv(F).T @ dE
+        h = 1e-6
+        dP = (nominal(F + h * dF) - nominal(F - h * dF)) / (2 * h)
+        assert np.sum(dF * dP) == pytest.approx(m @ M @ m, rel=1e-7)
+
+
+def test_the_watch_interpolates_the_onset_and_keeps_it():
+    """Least stabilities 30 and 10 at stretches 1.1 and 1.2, -10 at 1.3: the onset at 1.25, in
+    the cell weakest at 1.3, whose thickness strain -0.10 -> -0.14 is -0.12 there; the first
+    onset stays."""
+    watch = NeckWatch(MPI.COMM_SELF, "stretch", "initial_xy")
+    centres = np.array([[0.5, 0.5], [1.5, 0.5]])
+    assert not watch.reached(1.1, np.array([40.0, 30.0]), np.array([-0.04, -0.05]), centres)
+    assert not watch.reached(1.2, np.array([10.0, 20.0]), np.array([-0.10, -0.08]), centres)
+    assert watch.onset is None
+    assert watch.reached(1.3, np.array([-10.0, 5.0]), np.array([-0.14, -0.11]), centres)
+    assert watch.onset["stretch"] == pytest.approx(1.25, rel=1e-14)
+    assert watch.onset["increment_stretch"] == 1.3
+    assert watch.onset["initial_xy"] == [0.5, 0.5]
+    assert watch.onset["thickness_strain"] == pytest.approx(-0.12, rel=1e-13)
+    assert watch.onset["stability"] == -10.0
+    first = dict(watch.onset)
+    assert watch.reached(1.4, np.array([-20.0, -30.0]), np.array([-0.2, -0.2]), centres)
+    assert watch.onset == first
+
+
+def test_a_resumed_watch_keeps_an_earlier_onset():
+    """A resumed run at 12 mm keeps the onset found at 10 mm (from the summary before), and
+    ignores one past its state (a run resumed from before it finds it again)."""
+    earlier = {"stroke_mm": 10.0, "increment_stroke_mm": 10.5, "initial_xy_mm": [1.0, 2.0],
+               "thickness_strain": -0.2, "stability": -1.0}
+    watch = NeckWatch(MPI.COMM_SELF)
+    watch.carry(earlier, 12.0)
+    assert watch.onset == earlier
+    assert watch.reached(13.0, np.array([5.0]), np.array([-0.1]), np.array([[0.0, 0.0]]))
+    assert watch.onset == earlier
+    later = NeckWatch(MPI.COMM_SELF)
+    later.carry(earlier, 9.0)
+    later.carry(None, 9.0)
+    assert later.onset is None
+
+
+@pytest.mark.parametrize("homogeneous", [True, False], ids=["homogeneous", "free"])
+@pytest.mark.parametrize("material", ["swift", "power"])
+def test_a_strip_pulled_past_considere_necks_at_the_force_maximum(material, homogeneous):
+    """Pulled to a stretch of 1.35 in 20 increments (d eps = 0.0136 at the onset), held
+    homogeneous or only its end pulled: the neck starts at the closed-form force maximum of
+    tau(eps) / lambda (Swift 0.2532, its elastic part included; the power law 1/N = 0.25) within
+    0.05 d eps. Why that tolerance: the stability is smooth in the stretch (as d tau / d eps - tau),
+    and its linear interpolation between the increments misses its zero by at most
+    d eps^2 / 8 |m''| / |m'|, about 3e-4 = 0.024 d eps here (measured 3.2e-4 and 2.4e-4); the
+    rigid-plastic Considere strain n - eps0 = 0.2518 lies 1.4e-3 below the Swift maximum (the
+    elastic strain), still within one d eps. The thickness strain there is the uniaxial one,
+    -(eps - tau/E)/2 - nu tau/E, to 1e-4 (seen 1e-5)."""
+    mat = MATERIALS[material]()
+    steps, stretch = 20, 1.35
+    watch = NeckWatch(MPI.COMM_WORLD, "stretch", "initial_xy")
+    _, rows = strip.strip(mat, stretch, homogeneous=homogeneous, steps=steps, n=1 if homogeneous else 2, watch=watch)
+    onset = watch.onset
+    assert onset is not None
+    eps = float(np.log(onset["stretch"]))
+    d_eps = float(np.log(onset["increment_stretch"] / (onset["increment_stretch"] - (stretch - 1) / steps)))
+    assert d_eps == pytest.approx(0.0136, abs=1e-4)
+    assert abs(eps - strip.force_maximum_strain(mat)) < 0.05 * d_eps
+    assert abs(eps - strip.considere_strain(mat)) < d_eps
+    tau = strip.uniaxial_kirchhoff(mat, onset["stretch"])
+    assert onset["thickness_strain"] == pytest.approx(-(eps - tau / mat.E) / 2 - mat.nu * tau / mat.E, abs=1e-4)
+    stable, unstable = [r for r in rows if r["stability"] > 0], [r for r in rows if r["stability"] <= 0]
+    assert stable[-1]["stretch"] < onset["stretch"] <= onset["increment_stretch"] == unstable[0]["stretch"]
+
+
+@pytest.mark.parametrize("material", ["swift", "power"])
+def test_a_strip_pulled_short_of_considere_does_not_neck(material):
+    """Pulled to a stretch of 1.25 (eps 0.223, below 0.25) in 16 increments: no neck, the
+    stability falling at every increment and still positive at the last (19.4 MPa Swift, 36.0 the
+    power law)."""
+    mat = MATERIALS[material]()
+    watch = NeckWatch(MPI.COMM_WORLD, "stretch", "initial_xy")
+    _, rows = strip.strip(mat, 1.25, homogeneous=False, steps=16, n=2, watch=watch)
+    assert watch.onset is None
+    stability = [r["stability"] for r in rows]
+    assert np.all(np.diff(stability) < 0) and stability[-1] > 15.0
+
+
+def stretched_cup(stroke: float, stop: bool):
+    """The paper's cup on 4 x 4 with a holder force of 300 kN, which holds the flange: the punch
+    stretches the sheet over its corner until it necks (at about 19.4 mm), in steps of 1.5 mm."""
+    return scene.load(DEMOS / "square_cup.toml").changed({
+        "mesh.n": 4, "tools.stroke": stroke, "tools.blank_holder_force": 300000.0, "process.initial_step": 0.05,
+        "process.max_step": 0.05, "process.stop_at_neck": stop, "process.springback": False, "output.vtx": False,
+        "output.vtu": False, "output.png": False, "output.fld": False})
+
+
+@pytest.fixture(scope="module")
+def stretched(tmp_path_factory):
+    out = tmp_path_factory.mktemp("neck")
+    return {stop: contact_run.run(stretched_cup(30.0, stop), out / str(stop)) for stop in (True, False)}
+
+
+def test_stop_at_neck_ends_the_stroke_at_the_neck(stretched):
+    """With stop_at_neck the stroke ends, as a finished run, at the first increment whose least
+    stability is <= 0 (19.5 mm); the onset lies within that increment (19.41 mm), at the punch's
+    plan corner (initial (25, 31.25) mm), where the cell has thinned by 0.108 (its most strained
+    quadrature point, equivalent plastic strain 0.25, lost its stability first); summary.json
+    and the closing line say so."""
+    summary = stretched[True]
+    neck = summary["neck"]
+    assert summary["stopped"] is None and summary.exit_status() == 0
+    assert summary["stroke_mm"] == pytest.approx(neck["increment_stroke_mm"]) == pytest.approx(19.5)
+    assert 18.0 < neck["stroke_mm"] < 19.5
+    assert neck["stability"] <= 0.0
+    assert neck["initial_xy_mm"] == pytest.approx([25.0, 31.25])
+    assert -0.12 < neck["thickness_strain"] < -0.09
+    assert summary.closing_line().count(
+        f"neck from stroke {neck['stroke_mm']:.4g} mm at initial ({neck['initial_xy_mm'][0]:.4g}, "
+        f"{neck['initial_xy_mm'][1]:.4g}), thickness strain {neck['thickness_strain']:.4f}") == 1
+    saved = json.loads((summary.outdir / "summary.json").read_text())
+    assert saved["neck"] == neck
+
+
+def test_without_stop_at_neck_the_run_goes_on_and_reports_the_neck(stretched):
+    """The same onset, and the stroke drawn to its end (30 mm), thinning past it."""
+    on, off = stretched[True], stretched[False]
+    assert off["stroke_mm"] == pytest.approx(30.0)
+    assert off["neck"] == on["neck"]
+    assert off["min_thickness_strain"] < on["neck"]["thickness_strain"] - 0.05
+
+
+def test_no_neck_is_null(tmp_path):
+    """A plastic run that does not neck writes "neck": null (the cup above stopped at 15 mm)."""
+    summary = contact_run.run(stretched_cup(15.0, True), tmp_path)
+    assert summary["neck"] is None and summary["stroke_mm"] == pytest.approx(15.0)
+    assert '"neck": null' in (tmp_path / "summary.json").read_text()
+    assert "neck from" not in summary.closing_line()
+
+
+def test_stop_at_neck_needs_a_nonlinear_scene_with_plasticity():
+    """A linear plate's scene that asks to stop at the neck: an error naming the key."""
+    with pytest.raises(InputError) as err:
+        scene.load(DEMOS / "square_plate.toml").changed({"process.stop_at_neck": True})
+    assert err.value.field == "process.stop_at_neck"
