@@ -160,8 +160,8 @@ def stretched_cup(stroke: float, stop: bool):
     """The paper's cup on 4 x 4 with a holder force of 300 kN, which holds the flange: the punch
     stretches the sheet over its corner until it necks (at about 19.4 mm), in steps of 1.5 mm."""
     return scene.load(DEMOS / "square_cup.toml").changed({
-        "mesh.n": 4, "tools.stroke": stroke, "tools.blank_holder_force": 300000.0, "process.initial_step": 0.05,
-        "process.max_step": 0.05, "process.stop_at_neck": stop, "process.springback": False, "output.vtx": False,
+        "mesh.n": 4, "tools.stroke": stroke, "tools.blank_holder_force": 300000.0, "process.initial_step_mm": 1.5,
+        "process.max_step_mm": 1.5, "process.stop_at_neck": stop, "process.springback": False, "output.vtx": False,
         "output.vtu": False, "output.png": False, "output.fld": False})
 
 
