@@ -176,6 +176,31 @@ def test_a_shorter_stroke_takes_fewer_increments_of_the_same_travel():
     assert 2.0 * len(short) < len(long) <= 3 * len(short)
 
 
+def test_the_iterations_of_a_try_cut_back_are_counted(monkeypatch):
+    """An increment's iterations are its linear solves, those of a try that was cut back included:
+    the second increment's first try is refused (after its Newton ran), cut back and tried again;
+    the history's iterations add up to the solves made."""
+    s = square_cup(n=4, stroke=0.3, changes={"process.initial_step_mm": 0.1, "process.max_step_mm": 0.1})
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    real, tries = SemiInverseDriver.newton, []
+
+    def second_refused(self, lam, reversal=False):
+        ok, its, res, ev = real(self, lam, reversal)
+        tries.append(its)
+        if len(tries) == 2:
+            self.cause = "refused by the test"
+            return False, its, res, ev
+        return ok, its, res, ev
+
+    monkeypatch.setattr(SemiInverseDriver, "newton", second_refused)
+    d.run(1.0)
+    h = d.history
+    assert h[1].cutbacks == 1 and tries[1] > 0
+    assert h[1].iterations == tries[1] + tries[2]
+    assert sum(x.iterations for x in h) == sum(tries) == d.solves
+
+
 def test_a_stopped_run_reports_its_last_converged_state(tmp_path, monkeypatch):
     """A run whose Newton breaks down (here: forced past 0.5 mm, leaving a wild iterate behind)
     stops with its cause, and summary.json reports the last converged state: the stroke, punch

@@ -42,7 +42,7 @@ class Increment:
     number: int
     lam: float
     dlam: float
-    iterations: int
+    iterations: int  # Newton iterations (linear solves), those of the tries cut back included
     residuals: list[float]
     plastic_layers: int
     cutbacks: int
@@ -203,17 +203,18 @@ class Driver(Newton):
         while abs(target - self.lam) > 1e-14:
             dlam = min(dlam, abs(target - self.lam))
             x_n = self.q.x.array.copy()
-            cutbacks = 0
+            cutbacks = spent = 0  # the tries cut back, and their iterations
+            t0 = time.perf_counter()
             while True:
                 lam = self.lam + direction * dlam
                 self._predict(dlam, x_n, x_prev)
-                t0 = time.perf_counter()
                 ok, its, res, ev = self.newton(lam, reversal)
                 if not ok and self.swap_line_search:
                     ok, its, res, ev = self._other_line_search(lam, reversal, dlam, x_n, x_prev, its)
                 if ok:
                     break
                 self.q.x.array[:] = x_n
+                spent += its
                 self._stop_if_requested()
                 cutbacks += 1
                 dlam *= c.cut
@@ -233,13 +234,13 @@ class Driver(Newton):
             x_prev = x_n
             self.lam = lam
             self._dlam_prev = dlam
-            inc = Increment(len(self.history) + 1, lam, dlam, its, res, ev.plastic_layers, cutbacks,
+            inc = Increment(len(self.history) + 1, lam, dlam, spent + its, res, ev.plastic_layers, cutbacks,
                             {"wall_s": time.perf_counter() - t0}, self._increment_info(), self._norm(self.q.x.array - x_n))
             self.history.append(inc)
             if self.verbose:
                 self.progress.increment(
                     lam, inc.number, sum(h.iterations for h in self.history),
-                    f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {its}  "
+                    f"increment {inc.number:3d}  lambda {lam:.6g}  dlambda {dlam:.3g}  iterations {inc.iterations}  "
                     f"|R| {res[0]:.2e} -> {res[-1]:.2e}  plastic layers {ev.plastic_layers}")
             if its <= self.easy_iterations and cutbacks == 0:
                 dlam = min(dlam * c.growth, c.max_step)
