@@ -3,8 +3,23 @@ the tests share."""
 
 import shellform  # noqa: F401
 
+import json
+
 import numpy as np
 import pytest
+
+
+def _refuse(constant):
+    raise ValueError(f"{constant} is not JSON")
+
+
+@pytest.fixture(autouse=True)
+def strict_summaries(request):
+    """Every summary.json a test writes into its tmp_path is strict JSON: no NaN, no Infinity."""
+    folder = request.getfixturevalue("tmp_path") if "tmp_path" in request.fixturenames else None
+    yield
+    for path in folder.rglob("summary.json") if folder is not None else ():
+        json.loads(path.read_text(), parse_constant=_refuse)
 
 
 @pytest.fixture

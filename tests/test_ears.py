@@ -155,3 +155,12 @@ def test_numisheet_steel_with_three_r_values_draws_in_less_where_r_across_is_hig
     assert out["hill79"]["DX"] == pytest.approx(out["hill79"]["DY"], rel=1e-9)
     d = out["hill48"]
     assert d["DY"] - d["DX"] > 0.01 * d["DY"], out
+
+
+def test_the_rim_reaches_its_ends_to_round_off():
+    """A rim whose first node lies at 1e-14 degrees (its angle from tabulated coordinates) still
+    gives the draw-in at 0 degrees, its first node's; an angle the rim does not reach is nan."""
+    rows = np.array([[1e-14, 2.0, 0.0], [30.0, 3.0, 0.0], [60.0, 4.0, 0.0], [90.0 - 1e-13, 5.0, 0.0]])
+    d = cup.rim_draw_in(rows)
+    assert d == {"rim_0deg": 2.0, "rim_45deg": pytest.approx(3.5), "rim_90deg": 5.0}
+    assert np.isnan(cup.rim_draw_in(rows[1:])["rim_0deg"])

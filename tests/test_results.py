@@ -2,6 +2,9 @@
 
 import io
 
+import numpy as np
+import pytest
+
 from shellform.results.log import Progress
 
 
@@ -82,3 +85,17 @@ def test_the_force_axis_says_the_whole_cup():
     assert cup.force_label(4) == "punch force on the whole cup (kN)\n(the modelled quarter's x 4)"
     assert cup.force_label(2).endswith("(the modelled half's x 2)")
     assert cup.force_label(1) == "punch force on the whole cup (kN)"
+
+
+def test_json_has_no_nan_or_infinity(tmp_path):
+    """write_json writes strict JSON: a non-finite number (the draw-in at an angle the rim does not
+    reach) is null, numpy numbers and arrays plain ones."""
+    import json
+
+    from shellform.results.tables import write_json
+
+    write_json(tmp_path / "s.json", {"rim_0deg": float("nan"), "a": [np.inf, np.float64(2.5)], "n": np.int64(3),
+                                     "nested": {"b": -np.inf, "ok": True, "arr": np.array([1.0, np.nan])}})
+    text = (tmp_path / "s.json").read_text()
+    assert json.loads(text, parse_constant=lambda c: pytest.fail(c)) == {
+        "rim_0deg": None, "a": [None, 2.5], "n": 3, "nested": {"b": None, "ok": True, "arr": [1.0, None]}}

@@ -62,11 +62,14 @@ def rim(p) -> np.ndarray:
     return rows[np.argsort(rows[:, 0], kind="stable")]
 
 
-def rim_draw_in(rows: np.ndarray, angles=RIM_ANGLES) -> dict:
+def rim_draw_in(rows: np.ndarray, angles=RIM_ANGLES, tol: float = 1e-6) -> dict:
     """The rim's draw-in at the given angles (degrees), linear between its nodes along the
-    angle: {"rim_0deg": ..., ...} (nan at an angle the rim does not reach)."""
-    return {f"rim_{a:g}deg": float(np.interp(a, rows[:, 0], rows[:, 1], left=np.nan, right=np.nan))
-            for a in angles}
+    angle: {"rim_0deg": ..., ...}; nan at an angle the rim does not reach, beyond its first or
+    last node by more than tol degrees (a node on a symmetry line lies at 0 or 90 degrees to
+    round-off only: its angle is computed from tabulated coordinates)."""
+    lo, hi = rows[0, 0], rows[-1, 0]
+    return {f"rim_{a:g}deg": float(np.interp(min(max(a, lo), hi), rows[:, 0], rows[:, 1]))
+            if lo - tol <= a <= hi + tol else float("nan") for a in angles}
 
 
 def write_rim(outdir: Path, p, title: str) -> dict:

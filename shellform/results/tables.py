@@ -8,9 +8,11 @@ a kill or a full disk during the write leaves the previous file as it was (docs/
 import csv
 import io
 import json
+import math
 import os
 from pathlib import Path
 
+import numpy as np
 from mpi4py import MPI
 
 
@@ -57,7 +59,25 @@ def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
     write_atomically(path, lambda f: f.write(text.getvalue()))
 
 
+def finite_json(value):
+    """`value` for JSON, which has no NaN or Infinity: a non-finite number becomes None (null),
+    numpy scalars and arrays plain numbers and lists."""
+    if isinstance(value, dict):
+        return {k: finite_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [finite_json(v) for v in value]
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
 def write_json(path: Path, data: dict) -> None:
+    """`data` as strict JSON (finite_json: a value that is not a number there, such as the draw-in
+    at an angle the rim does not reach, is null)."""
     if MPI.COMM_WORLD.rank == 0:
-        text = json.dumps(data, indent=2, default=float) + "\n"
+        text = json.dumps(finite_json(data), indent=2, allow_nan=False, default=float) + "\n"
         write_atomically(path, lambda f: f.write(text))
