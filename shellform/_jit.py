@@ -55,10 +55,11 @@ _CACHE_DIR = str(cache_dir())
 
 
 def compiled() -> bool:
-    """Whether this version's numba functions were compiled on this machine before (its cache
-    folder holds something): a run without them compiles first, about a minute."""
+    """Whether this version's element kernels were compiled on this machine before: the sheet's
+    tangent loop, the dearest of them, is in the cache folder (other functions, such as those a
+    scene's checks call, may be there without it). A run without them compiles first."""
     folder = Path(_CACHE_DIR)
-    return folder.is_dir() and any(folder.iterdir())
+    return folder.is_dir() and any(folder.rglob("sheet_kernels.tensor_loop-*.nbi"))
 
 
 def _cpu_key() -> str:

@@ -60,8 +60,8 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     if way != "shell" and not jit.compiled():
         from shellform.results.log import say
 
-        say("shellform: compiling the element and material kernels (once per machine and version, about a "
-            "minute)")
+        say("shellform: compiling the element and material kernels: the sheet's element loops, the section "
+            "update and the return map (once per machine and version: one to two minutes)")
     if s.nonlinear and "plasticity" in s.effects:
         from shellform.results.log import say
 

@@ -73,7 +73,7 @@ from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
 from shellform.results import cup, fld, neck, run_folder
-from shellform.results.log import Progress
+from shellform.results.log import Progress, say
 from shellform.results.summary import DrawingSummary
 from shellform.results.tables import write_csv, write_json
 from shellform.scene import Scene
@@ -251,6 +251,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     if series is not None:
         series.close()
     d = p.driver
+    if d.verbose:
+        say("shellform: writing the tables and pictures" + (", then the springback" if s.process.springback else ""))
     for name, line in cup.thickness_lines(p).items():
         write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
     rim = cup.write_rim(outdir, p, s.title) if s.tools.shape == "round" else None
@@ -271,6 +273,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     sprung = None
     if s.process.springback and stopped is None:
         before = cup.profiles(p.initial_positions(), p.driver.displacements(), comm)
+        if d.verbose:
+            say("shellform: springback: the tools withdraw")
         try:
             released = springback.release(p.driver)
         except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
