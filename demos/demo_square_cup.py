@@ -26,11 +26,11 @@
 #     $ python demos/demo_square_cup.py
 #     parts: SheetNodes, ContactSet, PinchingHolder, CoulombFriction
 #      stroke_mm   DX_mm   DD_mm  punch_kN  thickness_strain  increments  iterations
-#            6.0   0.815   0.418     12.70           -0.0120          27          86
-#           12.0   3.609   1.872     36.68           -0.0408          54         176
-#           18.0   7.833   4.081     48.43           -0.0840          81         307
-#           24.0  11.812   6.118     60.84           -0.1168         108         390
-#           30.0  14.933   7.779     72.03           -0.2077         135         516
+#            6.0   0.771   0.426     11.94           -0.0119          27          89
+#           12.0   3.608   1.887     30.74           -0.0351          54         185
+#           18.0   8.416   4.506     45.69           -0.0696          81         296
+#           24.0  12.463   6.756     54.46           -0.1043         108         404
+#           30.0  18.111   9.949     60.88           -0.1520         135         528
 #     OK
 
 import argparse
@@ -59,8 +59,11 @@ args = parser.parse_args([] if "ipykernel" in sys.modules else None)  # in a not
 # (bending, membrane, geometric nonlinearity, plasticity, finite strain, contact, friction).
 # `Scene.changed` derives a variant that goes through the same checks as a file.
 
-ROOT = Path(__file__).resolve().parents[1] if "__file__" in globals() else Path.cwd()  # a notebook: the clone
-paper = scene.load(ROOT / "demos" / "square_cup.toml")
+# The scene files lie beside this demo. A notebook has no __file__: its kernel starts in the
+# notebook's folder (demos/) or, opened from the clone, in the clone.
+HERE = Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd()
+DEMOS = next((d for d in (HERE, HERE / "demos") if (d / "square_cup.toml").is_file()), HERE)
+paper = scene.load(DEMOS / "square_cup.toml")
 s = paper.changed({"mesh.n": args.n, "tools.stroke": args.stroke, "process.springback": False,
                    "output.vtx": False, "output.png": False})  # the scene's steps are mm of travel: the same
 

@@ -190,6 +190,27 @@ def test_clamped_disc_scene(tmp_path):
 
 
 @pytest.mark.timeout(600)
+def test_the_square_cup_demo_runs_as_a_notebook_in_its_folder():
+    """demo_square_cup.py as a notebook whose kernel starts in demos/ (where `jupytext --to
+    notebook` puts it): it finds its scene beside it and draws the cup on its defaults to the
+    header's last row (the same run as the script)."""
+    import jupytext
+    import nbclient
+
+    nb = jupytext.read(DEMOS / "demo_square_cup.py")
+    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(DEMOS)}}).execute()
+    out = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.outputs
+                  if o.output_type == "stream")
+    errors = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs if o.output_type == "error"]
+    assert not errors, errors
+    last = re.search(r"^\s*30\.0\s+(\S+)\s+(\S+)\s+(\S+)\s+\S+\s+135\s+\d+\s*$", out, re.M)
+    assert last, out
+    header = re.search(r"^#\s+30\.0\s+(\S+)\s+(\S+)\s+(\S+)", (DEMOS / "demo_square_cup.py").read_text(), re.M)
+    assert [float(v) for v in last.groups()] == pytest.approx([float(v) for v in header.groups()], rel=2e-3)
+    assert out.rstrip().endswith("OK")
+
+
+@pytest.mark.timeout(600)
 def test_a_demo_runs_as_a_notebook():
     """demo_circular_plate.py read by jupytext (its light format) and executed cell by cell in a
     Jupyter kernel, whose own arguments (-f kernel.json) the demo does not parse: it runs on its
