@@ -48,4 +48,32 @@ def check_dolfinx(version: str | None) -> None:
                           "conda-forge (fenics-dolfinx) into this environment")
 
 
+def missing_stack() -> list[str]:
+    """The modules of DOLFINx's stack that this Python cannot import (without importing them)."""
+    from importlib import util
+
+    missing = []
+    for name in ("mpi4py", "petsc4py", "dolfinx"):
+        try:
+            if util.find_spec(name) is None:
+                missing.append(name)
+        except (ImportError, ValueError):
+            missing.append(name)
+    return missing
+
+
+def require_stack() -> None:
+    """Without DOLFINx's stack nothing of shellform runs: say in one line what is missing and
+    how to install it, and exit with status 1 (no traceback)."""
+    missing = missing_stack()
+    if missing:
+        import sys
+
+        print(f"shellform: no {', '.join(missing)} in this Python ({sys.executable}): shellform needs DOLFINx "
+              f"{DOLFINX}; install it with `make venv` in the clone, `pip install dolfinx-solver-real` (Python >= "
+              "3.12), or conda-forge's fenics-dolfinx", file=sys.stderr)
+        raise SystemExit(1)
+
+
+require_stack()
 check_dolfinx(dolfinx_version())

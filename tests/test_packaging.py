@@ -78,3 +78,22 @@ def test_the_build_asks_for_a_setuptools_that_knows_license_expressions():
     """license = "MIT" (PEP 639) needs setuptools 77 (68 and 76 fail with --no-build-isolation)."""
     build = tomllib.loads((ROOT / "pyproject.toml").read_text())["build-system"]["requires"]
     assert build == ["setuptools>=77"]
+
+
+def test_without_dolfinx_one_line_says_what_to_install():
+    """In a Python that cannot import DOLFINx's stack (hidden here by a finder that refuses it),
+    importing shellform prints one line naming what is missing and how to install it, and exits
+    with status 1 without a traceback."""
+    hide = ("import sys\n"
+            "class Hide:\n"
+            "    def find_spec(self, name, path=None, target=None):\n"
+            "        if name.split('.')[0] in ('dolfinx', 'mpi4py', 'petsc4py', 'dolfinx_solver'):\n"
+            "            raise ModuleNotFoundError(name)\n"
+            "sys.meta_path.insert(0, Hide())\n"
+            "import shellform.run\n")
+    out = subprocess.run([sys.executable, "-c", hide], capture_output=True, text=True)
+    assert out.returncode == 1 and out.stdout == ""
+    lines = out.stderr.splitlines()
+    assert len(lines) == 1 and "Traceback" not in out.stderr
+    assert lines[0].startswith("shellform: no mpi4py, petsc4py, dolfinx in this Python")
+    assert "dolfinx-solver-real" in lines[0] and "make venv" in lines[0]
