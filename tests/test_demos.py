@@ -198,7 +198,8 @@ def test_the_square_cup_demo_runs_as_a_notebook_in_its_folder():
     import nbclient
 
     nb = jupytext.read(DEMOS / "demo_square_cup.py")
-    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(DEMOS)}}).execute()
+    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+                            resources={"metadata": {"path": str(DEMOS)}}).execute()
     out = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.outputs
                   if o.output_type == "stream")
     errors = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs if o.output_type == "error"]

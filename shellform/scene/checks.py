@@ -17,8 +17,8 @@ from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
                                     DIAGONALS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE, STROKE_STEP_KEYS,
-                                    YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES,
-                                    SUPPORTS, Scene, bounds)
+                                    YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
+                                    NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, Scene, bounds)
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
@@ -278,7 +278,8 @@ def _validate_process(s: Scene) -> None:
     steps = {name: getattr(pr, name) for name in (least, first, most)}
     for name, v in steps.items():
         require(math.isfinite(v) and v > 0, f"process.{name}", f"must be > 0, got {v}")
-    require(steps[least] <= steps[first], f"process.{least}", f"must be <= {first} ({steps[first]}), got {steps[least]}")
+    require(steps[least] <= steps[first], f"process.{least}",
+            f"must be <= {first} ({steps[first]}), got {steps[least]}")
     require(steps[first] <= steps[most], f"process.{first}", f"must be <= {most} ({steps[most]}), got {steps[first]}")
     require(s.tools is not None or steps[most] <= 1, f"process.{most}", f"must be <= 1, got {steps[most]}")
     require(pr.max_iterations >= 1, "process.max_iterations", f"must be >= 1, got {pr.max_iterations}")

@@ -12,8 +12,8 @@ from pathlib import Path
 
 from shellform.errors import InputError
 from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, LOAD_STEP_KEYS, SQUARE_TOOL_KEYS,
-                                    STROKE_STEP_KEYS, Drawbead, EdgeMoment, Probe, Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
-                                    Surface, ToolsSpec)
+                                    STROKE_STEP_KEYS, Drawbead, EdgeMoment, Probe, Geometry, Loads, Material,
+                                    MeshSpec, Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
 
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
@@ -121,8 +121,8 @@ def from_dict(data: dict) -> Scene:
     if isinstance(process, dict):
         for key in LOAD_STEP_KEYS if "tools" in data else STROKE_STEP_KEYS:
             if key in process:
-                raise InputError(f"process.{key}", f"a tool scene steps the punch's travel in mm: give process.{key}_mm "
-                                 "(the load-factor step times tools.stroke)" if "tools" in data else
+                raise InputError(f"process.{key}", f"a tool scene steps the punch's travel in mm: give "
+                                 f"process.{key}_mm (the load-factor step times tools.stroke)" if "tools" in data else
                                  "is a key of tool scenes (the punch's travel in mm): a sheet scene steps its load "
                                  f"factor with process.{key.removesuffix('_mm')}")
     if "loads" in data:
