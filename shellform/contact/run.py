@@ -17,6 +17,7 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
     thickness_diagonal.csv   initial distance from the centre along x = y, thickness strain
     thickness_transverse.csv the same along the transverse centre line y = 0 (round tools:
                              thickness_0deg.csv along y = 0, thickness_90deg.csv along x = 0)
+    thickness.png            the thickness strain along those lines against the initial distance
     rim.csv, rim.png         (round tools) the rim's ear profile: per node of the blank's outer
                              edge its initial angle from x, radial draw-in and height z;
                              summary.json: rim_0deg, rim_45deg, rim_90deg in draw_in_mm at each
@@ -253,8 +254,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     d = p.driver
     if d.verbose:
         say("shellform: writing the tables and pictures" + (", then the springback" if s.process.springback else ""))
-    for name, line in cup.thickness_lines(p).items():
+    lines = cup.thickness_lines(p)
+    for name, line in lines.items():
         write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
+    cup.plot_thickness(outdir / "thickness.png", lines, f"{s.title}: stroke {p.stroke:.1f} mm")
     rim = cup.write_rim(outdir, p, s.title) if s.tools.shape == "round" else None
     cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
     if s.output.png:

@@ -95,6 +95,11 @@ def write_rim(outdir: Path, p, title: str) -> dict:
         fig, (ax, az) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
         ax.plot(rows[:, 0], rows[:, 1], "o-", ms=3)
         ax.set_ylabel("radial draw-in R - r (mm)\n(least: an ear)")
+        mean, spread = float(rows[:, 1].mean()), float(np.ptp(rows[:, 1]))
+        half = max(spread, 0.05 * abs(mean)) * 0.6  # at least +-3 % of the mean: mesh noise stays flat
+        ax.set_ylim(mean - half, mean + half)
+        ax.text(0.01, 0.03, f"spread {spread:.3f} mm = {100 * spread / abs(mean):.2f} % of the mean {mean:.2f} mm"
+                if mean else f"spread {spread:.3f} mm", transform=ax.transAxes, fontsize=8)
         az.plot(rows[:, 0], rows[:, 2], "o-", ms=3)
         az.set_ylabel("rim height z (mm)")
         az.set_xlabel("angle from the x axis, initial (degrees)")
@@ -129,6 +134,32 @@ def thickness_lines(p) -> dict[str, list[dict]]:
     return lines
 
 
+def plot_thickness(path: Path, lines: dict[str, list[dict]], title: str) -> None:
+    """The thickness strain along the cup's lines (thickness_lines: the diagonal and the
+    transverse line, or 0 and 90 degrees) against the initial distance from the centre, the
+    paper's own view of a drawn cup; rank 0."""
+    if MPI.COMM_WORLD.rank != 0 or not any(lines.values()):
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for name, rows in lines.items():
+        ax.plot([r["initial_position_mm"] for r in rows], [r["thickness_strain"] for r in rows], "o-", ms=2,
+                label=name.replace("deg", " degrees"))
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("initial distance from the centre (mm)")
+    ax.set_ylabel("thickness strain ln(t / t0)")
+    ax.set_title(title, fontsize=10, parse_math=False)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def peak_thinning(p) -> dict:
     X, x, e33 = p.nodal_values()
     X, x, e33 = _gather(p.model.mesh.comm, X, x, e33)
@@ -157,8 +188,9 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
     fld.plot(outdir / "fld.png", f["major_strain"], f["minor_strain"], curve,
              f"{title}: stroke {p.stroke:.1f} mm", label, beside)
     if png:
-        picture(outdir / "cup_margin.png", p, f"{title}: margin to the forming-limit curve",
-                ("margin to the FLC", margin, (-0.1, 0.3), "RdYlGn"))
+        top = max(float(np.abs(margin).max(initial=0.0)), 1e-3)
+        picture(outdir / "cup_margin.png", p, f"{title}: margin to the forming-limit curve (< 0: past it)",
+                ("margin to the FLC", margin, (-top, top), "PuOr"), mark="least margin {:.3f}")
     worst = min(rows, key=lambda r: r["margin"])
     return {"forming_limit": label, "min_margin": float(worst["margin"]),
             "min_margin_at_initial_xy_mm": [float(worst["x0_mm"]), float(worst["y0_mm"])]}
@@ -284,10 +316,10 @@ class CupSeries:
             w.close()
 
 
-def force_label(copies: int) -> str:
+def force_label(copies: int, what: str = "punch force") -> str:
     """The force axis's label: the whole cup's force, and how it was made from the modelled part."""
     region = {4: "quarter", 2: "half"}.get(copies)
-    return "punch force on the whole cup (kN)" + (f"\n(the modelled {region}'s x {copies})" if region else "")
+    return f"{what} on the whole cup (kN)" + (f"\n(the modelled {region}'s x {copies})" if region else "")
 
 
 def thickness_colours(e33) -> tuple[tuple[float, float], str, str]:
@@ -298,8 +330,9 @@ def thickness_colours(e33) -> tuple[tuple[float, float], str, str]:
 
 
 def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> None:
-    """The punch force against the stroke. The force is the whole cup's (DrawingProblem's forces
-    are the modelled region's times its `copies`, 4 for a quarter), and the axis says so."""
+    """The punch force, and the blank holder's where the rows have it, against the stroke. The
+    forces are the whole cup's (DrawingProblem's forces are the modelled region's times its
+    `copies`, 4 for a quarter), and the axis says so."""
     if MPI.COMM_WORLD.rank != 0 or not rows:
         return
     import matplotlib
@@ -308,9 +341,13 @@ def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> Non
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    ax.plot([r["stroke_mm"] for r in rows], [r["punch_force_kN"] for r in rows], "-")
+    stroke = [r["stroke_mm"] for r in rows]
+    ax.plot(stroke, [r["punch_force_kN"] for r in rows], "-", label="punch")
+    if "holder_force_kN" in rows[0]:
+        ax.plot(stroke, [r["holder_force_kN"] for r in rows], "--", label="blank holder")
+        ax.legend(fontsize=8)
     ax.set_xlabel("punch stroke (mm)")
-    ax.set_ylabel(force_label(copies))
+    ax.set_ylabel(force_label(copies, "force"))
     ax.set_title(title, fontsize=10, parse_math=False)  # a scene's title is text, never TeX
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
@@ -318,12 +355,13 @@ def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> Non
     plt.close(fig)
 
 
-def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
+def picture(path: Path, p, title: str, cell_field: tuple | None = None, mark: str | None = None) -> None:
     """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
     an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
     strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only.
     The thickness strain takes a diverging map on limits symmetric about zero (+-its largest
-    magnitude), so that white is an unchanged thickness, red thickening and blue thinning."""
+    magnitude), so that white is an unchanged thickness, red thickening and blue thinning.
+    mark: a label format ("least {:.3f}") put on the cell where cell_field is least."""
     mesh = p.model.mesh
     if mesh.comm.size > 1:
         return
@@ -338,9 +376,13 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     e33[: len(owned)] = owned
     clim, cmap, name = thickness_colours(e33)
     grid.point_data[name] = e33
+    labels = None
     if cell_field is not None:
         name, values, clim, cmap = cell_field
         grid.cell_data[name] = values
+        if mark is not None and len(values):
+            i = int(np.argmin(values))
+            labels = (grid.cell_centers().points[i : i + 1], [mark.format(float(values[i]))])
     if p.symmetry == 4:  # the quarter and its mirror images in x = 0, y = 0 and both
         parts = [grid, grid.reflect((1, 0, 0), point=(0, 0, 0))]
         parts += [g.reflect((0, 1, 0), point=(0, 0, 0)) for g in parts]
@@ -349,6 +391,9 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None) -> None:
     pl.add_mesh(grid, scalars=name, show_edges=True, cmap=cmap, clim=clim, edge_color="#555555",
                 line_width=0.5, scalar_bar_args={"title": name})
     pl.add_text(title, font_size=10)
+    if labels is not None:
+        pl.add_point_labels(labels[0], labels[1], point_size=12, point_color="black", font_size=14,
+                            always_visible=True, shape_opacity=0.7)
     L = 2 * p.blank_size() if p.symmetry == 4 else p.blank_size()
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
     pl.screenshot(str(path))
@@ -391,7 +436,8 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
     `released`): wall angle and flange edge along the transverse line, the diagonal's corner,
     the unloading's plastic layers, the residual resultants; springback.csv (both profiles) and
     springback.png (the change along each line: sprung back minus drawn, in z and in the distance
-    from the centre, against the drawn distance)."""
+    from the centre, against the node's initial distance from the centre, which runs along the
+    wall where the drawn distance folds back on itself)."""
     from shellform.results.tables import write_csv
 
     lines = SPRINGBACK_LINES
@@ -423,11 +469,11 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
 
         fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
         for ax, k in zip(axes, lines):  # the change: on the profiles' scale it does not show
-            r = before[k][:, 1]
-            ax.plot(r, after[k][:, 2] - before[k][:, 2], "b-", label="z: vertical")
-            ax.plot(r, after[k][:, 1] - r, "r--", label="r: away from the centre")
+            s0, r = before[k][:, 0], before[k][:, 1]
+            ax.plot(s0, after[k][:, 2] - before[k][:, 2], "b-", label="z: vertical")
+            ax.plot(s0, after[k][:, 1] - r, "r--", label="r: away from the centre")
             ax.axhline(0.0, color="k", lw=0.5)
-            ax.set_xlabel("distance from the centre, drawn (mm)")
+            ax.set_xlabel("initial distance from the centre (mm)")
             ax.set_ylabel("sprung back minus drawn (mm)")
             ax.set_title(f"{k} line", fontsize=9)
             ax.grid(alpha=0.3)

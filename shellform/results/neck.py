@@ -66,8 +66,9 @@ class NeckWatch:
 
 
 def words(onset: dict, at: str = "stroke_mm", place: str = "initial_xy_mm") -> str:
-    """A watch's onset in words, for a run's log and closing line: 'neck from stroke 23.8 mm at
-    initial (25, 12.5), thickness strain -0.1650' (a load factor without a unit)."""
+    """A watch's onset in words, for a run's log and closing line: 'diffuse neck from stroke
+    23.8 mm at initial (25, 12.5), thickness strain -0.1650' (a load factor without a unit):
+    a material point's force maximum, which a drawn sheet may pass stably (docs/plastic.md)."""
     x, y = onset[place]
     where = f"stroke {onset[at]:.4g} mm" if at == "stroke_mm" else f"{at.replace('_', ' ')} {onset[at]:.4g}"
-    return f"neck from {where} at initial ({x:.4g}, {y:.4g}), thickness strain {onset['thickness_strain']:.4f}"
+    return f"diffuse neck from {where} at initial ({x:.4g}, {y:.4g}), thickness strain {onset['thickness_strain']:.4f}"
