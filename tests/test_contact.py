@@ -327,6 +327,8 @@ def test_drawn_cup_springback_outputs(tmp_path):
     assert sb["residual_max_N_per_mm"] > 1.0 and sb["residual_max_M_N"] > 0.1  # residual stresses
     assert sb["unloading_increments"] >= 1 and sb["plastic_layers_on_unloading"] >= 0
     assert (tmp_path / "springback.csv").exists() and (tmp_path / "springback.png").exists()
+    assert (tmp_path / "thickness.png").stat().st_size > 10_000  # the thickness along the cup's lines
+    assert (tmp_path / "force_stroke.png").stat().st_size > 10_000
 
 
 @pytest.mark.parametrize("name", ["numisheet93_aluminium.toml", "numisheet93_steel.toml",
