@@ -22,7 +22,7 @@ $(STAMP): pyproject.toml scripts/find-python.sh
 
 demo: $(STAMP)
 	$(VENV)/bin/shellform run demos/square_cup.toml --out $(OUT)
-	@echo "shellform: summary.json, cup.pvd (ParaView, pyvista), force_stroke.csv/.png, thickness_*.csv, cup.png in $(OUT) (docs/results.md)"
+	@echo "shellform: summary.json, cup.pvd (ParaView, pyvista), force_stroke.csv/.png, thickness_*.csv, thickness.png, cup.png in $(OUT) (docs/results.md)"
 
 test: $(STAMP)
 	$(PY) -m pytest -q -m "not slow" tests
