@@ -100,7 +100,8 @@ def test_forming_limit_view_uses_the_measured_curve(tmp_path):
     major, minor = np.array([0.1, 0.3, 0.2]), np.array([-0.2, 0.0, 0.2])
     coords = np.arange(27, dtype=float).reshape(3, 9)
     model = SimpleNamespace(cell_fields=lambda: {"major_strain": major, "minor_strain": minor},
-                            cell_coords=coords, mesh=SimpleNamespace(comm=MPI.COMM_WORLD))
+                            cell_centres=lambda: coords.reshape(-1, 3, 3).mean(axis=1)[:, :2],
+                            mesh=SimpleNamespace(comm=MPI.COMM_WORLD))
     p = SimpleNamespace(scene=s, model=model, stroke=10.0)
     out = cup.forming_limits(tmp_path, p, "test", png=False)
     curve = fld.measured(FLC)

@@ -91,10 +91,6 @@ class FormingLimitReached(Exception):
     """The stroke ends: an element's margin to the forming-limit curve reached 0."""
 
 
-class NeckReached(Exception):
-    """The stroke ends: the sheet starts to neck ([process] stop_at_neck)."""
-
-
 def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list, dict]:
     """Restore the last complete checkpoint in outdir (checkpoint.read: the previous one where
     the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
@@ -198,7 +194,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             if watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"]):
                 raise FormingLimitReached
         if necked and s.process.stop_at_neck:
-            raise NeckReached
+            raise neck.NeckReached
 
     def write_curve():
         write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
@@ -234,7 +230,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         p.driver.progress.note(f"shellform: the forming-limit curve is reached at {watch.limit['stroke_mm']:.4g} mm")
         report()
         checkpoint_now()
-    except NeckReached:  # the stroke ends where the sheet starts to neck
+    except neck.NeckReached:  # the stroke ends where the sheet starts to neck
         p.driver.progress.note(f"shellform: the stroke ends: {neck.words(necks.onset)}")
         report()
         checkpoint_now()

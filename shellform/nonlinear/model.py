@@ -167,11 +167,12 @@ class SheetModel:
                                  self.resultants, self.tangents, tangent, self.forms.vectors, self.forms.matrices)
 
     def commit(self) -> None:
-        """Accept the trial material state (an increment converged); the sections' membrane
+        """Accept the trial material state (an increment converged); a plastic sheet's membrane
         stability at it (membrane_stability), from the converged iterate's strains, resultants
-        and tangents."""
-        numba.set_num_threads(self.threads)
-        membrane_stability(self.strain, self.resultants, self.tangents, self.thickness, self.stability_n)
+        and tangents (an elastic one does not neck: nothing watches it)."""
+        if self.plastic:
+            numba.set_num_threads(self.threads)
+            membrane_stability(self.strain, self.resultants, self.tangents, self.thickness, self.stability_n)
         self.ep_n[...] = self.ep
         self.p_n[...] = self.p
         self.stretch_n[...] = self.stretch
@@ -232,7 +233,8 @@ class SheetModel:
         of the smallest eigenvalue of the tangent of the nominal membrane force on spin-free rates,
         per unit initial thickness (stress units; shellform.material.stability). At or below 0
         the material point has lost its stability: a neck may start there (Considere's force
-        maximum in uniaxial tension). NaN before the first increment after a start or a restore."""
+        maximum in uniaxial tension). NaN before the first increment after a start or a restore,
+        and for an elastic sheet."""
         return self.stability_n
 
     def cell_centres(self) -> np.ndarray:

@@ -88,10 +88,6 @@ def extremes(p: SheetProblem) -> dict:
     return out
 
 
-class NeckReached(Exception):
-    """The load path ends: the sheet starts to neck ([process] stop_at_neck)."""
-
-
 def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSummary:
     """Step the scene's load path into outdir, which is this run's alone (run_folder.start);
     scene_path: the scene's file, for run.json."""
@@ -115,7 +111,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         before = necks.onset
         if necks.reached(d.lam, p.model.membrane_stability(), p.model.thickness_strain(), centres):
             if s.process.stop_at_neck:
-                raise NeckReached
+                raise neck.NeckReached
             if before is None:
                 p.driver.progress.note(f"shellform: the sheet starts to neck: "
                                        f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
@@ -128,7 +124,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
                 p.driver.run(r, on_increment=on_increment)
                 reports.append(_record(p, s))
-    except NeckReached:  # the load path ends where the sheet starts to neck
+    except neck.NeckReached:  # the load path ends where the sheet starts to neck
         p.driver.progress.note(f"shellform: the load path ends: "
                                f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
         reports.append(_record(p, s))

@@ -179,7 +179,7 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
     (curve, label), beside = fld.curves(p.scene.material)
     f = p.model.cell_fields()
     margin = fld.margins(f["major_strain"], f["minor_strain"], curve)
-    centre = p.model.cell_coords.reshape(-1, 3, 3).mean(axis=1)[:, :2]
+    centre = p.model.cell_centres()
     rows = [{"x0_mm": c[0], "y0_mm": c[1], "major": a, "minor": b, "margin": m}
             for c, a, b, m in zip(centre, f["major_strain"], f["minor_strain"], margin)]
     comm = p.model.mesh.comm

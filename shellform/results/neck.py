@@ -20,6 +20,10 @@ reports it (summary.json "neck", null without a neck).
 import numpy as np
 
 
+class NeckReached(Exception):
+    """A run's stroke or load path ends: the sheet starts to neck ([process] stop_at_neck)."""
+
+
 class NeckWatch:
     """The onset of the neck along a run. at, place: the names of the load measure and of the
     place in `onset` ("stroke_mm", "initial_xy_mm" for tool scenes; "load_factor", "initial_xy"

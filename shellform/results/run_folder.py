@@ -32,8 +32,8 @@ from shellform.results.tables import write_json
 MANIFEST = "run.json"
 # what shellform's runs write into --out (shellform/run.py's routes: results/shell.py, nonlinear/run.py, contact/run.py)
 OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "force_stroke.csv",
-           "force_stroke.png", "thickness_*.csv", "thickness.png", "fld.csv", "fld.png", "strain_path.csv", "rim.csv", "rim.png",
-           "cup.png", "cup_margin.png",
+           "force_stroke.png", "thickness_*.csv", "thickness.png", "fld.csv", "fld.png", "strain_path.csv", "rim.csv",
+           "rim.png", "cup.png", "cup_margin.png",
            "springback.csv", "springback.png", "deformed.png", "cup.bp", "cup_cells.bp",
            "cup.pvd", "punch.pvd", "die.pvd", "blank_holder.pvd", "vtu", "nodal.bp", "cells.bp", "checkpoint.npz",
            "checkpoint.previous.npz", ".checkpoint.npz.new", "last_converged.rank*.npz")
