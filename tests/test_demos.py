@@ -189,6 +189,7 @@ def test_clamped_disc_scene(tmp_path):
     assert (tmp_path / "deformed.png").is_file()
 
 
+@pytest.mark.slow  # 22 s: the whole 30 mm cup in a Jupyter kernel
 @pytest.mark.timeout(600)
 def test_the_square_cup_demo_runs_as_a_notebook_in_its_folder():
     """demo_square_cup.py as a notebook whose kernel starts in demos/ (where `jupytext --to
