@@ -30,6 +30,7 @@ STUDIES = {
     "rollup": "a strip rolled into a full circle by an end moment",
     "plastic": "limit load and springback of an elastic-plastic cantilever",
     "strip": "finite-strain plasticity: a strip pulled to a stretch of 1.5 against closed forms",
+    "ironing": "a strip squeezed between faces and drawn through a gap against plane-strain closed forms",
     "assembly": "assembly benchmark",
     "newton": "one Newton iteration of the plastic sheet, benchmark",
     "cup-hard": "the square cup's five hard cases",

@@ -21,7 +21,7 @@ from shellform.errors import InputError
 from shellform.assembly.sheet_element import BS, COMPONENTS, NDOF
 from shellform.assembly import assumed_membrane
 from shellform.assembly.sheet_kernels import SheetKernels
-from shellform.material import hencky, plane_stress, section
+from shellform.material import hencky, ironing, plane_stress, section
 from shellform.material.stability import membrane_stability
 from shellform.material.update import section_update
 from shellform.nonlinear.assemble import CellArrayForms
@@ -138,6 +138,13 @@ class SheetModel:
         self.resultants = np.zeros((self.num_cells, self.nqp, 6))
         self.tangents = np.zeros((self.num_cells, self.nqp, 6, 6))
         self.stability_n = np.full(self.num_cells, np.nan)  # of the committed state (membrane_stability)
+        # ironing (shellform.material.ironing): the tools' clearance over each cell (inf: none)
+        # and the pressure on the sheet's faces at each point
+        self.ironing = "ironing" in self.effects
+        self.clearance = np.full(self.num_cells, np.inf)
+        self.face_pressure = np.zeros((self.num_cells, self.nqp))
+        self.pressed = 0  # points the last evaluation pressed
+        self._modulus33 = ironing.through_thickness_modulus(self.material)
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
         self.state_version = 0  # changes with the committed material state (Driver's reuse of an evaluation)
 
@@ -154,6 +161,10 @@ class SheetModel:
             self.strain, self.taper, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
             elastic_tangent)
+        if self.ironing:
+            self.pressed, failed = ironing.squeeze(self.strain, self.clearance, self.thickness, self._modulus33,
+                                                   self.resultants, self.tangents, self.face_pressure)
+            nguard += failed  # a mid-surface turned inside out: past the strain guard
         t2 = time.perf_counter()
         self.tensor_arrays(tangent)
         t3 = time.perf_counter()
@@ -165,6 +176,28 @@ class SheetModel:
         numba.set_num_threads(self.threads)
         self.kernels.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z,
                                  self.resultants, self.tangents, tangent, self.forms.vectors, self.forms.matrices)
+
+    def squeeze(self, clearance: np.ndarray) -> None:
+        """The clearance between two tools over each owned cell (mm; inf where no two tools
+        face each other across it): where the sheet is thicker, the tools press its faces
+        (shellform.material.ironing) from the next evaluation on. Refused without the effect
+        'ironing'."""
+        if not self.ironing:
+            raise InputError("effects", "a clearance between tools squeezes the sheet only with the effect 'ironing'")
+        clearance = np.asarray(clearance, dtype=float)
+        if clearance.shape != self.clearance.shape or np.any(np.isnan(clearance)) or np.any(clearance <= 0):
+            raise InputError("clearance", f"needs one positive value (or inf) per owned cell, {self.num_cells}")
+        if not np.array_equal(clearance, self.clearance):
+            self.clearance[...] = clearance
+            self.state_version += 1
+
+    def face_forces(self) -> np.ndarray:
+        """Per owned cell the force with which the tools' faces press the sheet at the last
+        evaluation, int p dA over the current area (N; zero where none presses)."""
+        E = self.strain[:, :, :3]
+        det = (1.0 + 2.0 * E[..., 0]) * (1.0 + 2.0 * E[..., 1]) - E[..., 2] ** 2
+        J = np.sqrt(np.maximum(det, 0.0))
+        return 2.0 * self.cell_area * ((self.face_pressure * J) @ self.kernels.element.weights)
 
     def commit(self) -> None:
         """Accept the trial material state (an increment converged); a plastic sheet's membrane

@@ -71,18 +71,19 @@ class SheetProblem:
     @classmethod
     def on_rectangle(cls, comm, lx, ly, n, material, thickness, effects, supports, loads=None,
                      prescribed=None, controls=None, region="full", kind="structured", diagonal="right",
-                     thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
+                     thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False, parts=()):
         points = [(p.x, p.y) for p in (loads or SheetLoads()).points]
         rect = rectangle(comm, lx, ly, region=region, kind=kind, n=n, diagonal=diagonal, points=points)
         return cls.on_blank(rect, material, thickness, effects, supports, loads, prescribed, controls,
-                            thickness_points, kappa0, checkpoint_dir, verbose)
+                            thickness_points, kappa0, checkpoint_dir, verbose, parts)
 
     @classmethod
     def on_blank(cls, rect, material, thickness, effects, supports, loads=None, prescribed=None, controls=None,
-                 thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False):
+                 thickness_points=5, kappa0=None, checkpoint_dir=None, verbose=False, parts=()):
         """The problem on a meshed blank (shellform.mesh.BlankMesh): supports on edges along x or
         y fix components; a clamped, sliding or simply supported curved or oblique edge is held in
-        its own frame (shellform.edge_frames.SheetEdgeFrames)."""
+        its own frame (shellform.edge_frames.SheetEdgeFrames). parts: callables model -> Part
+        (shellform.nonlinear.parts) that the driver composes."""
         loads = loads or SheetLoads()
         mat = material.pack() if hasattr(material, "pack") else np.asarray(material, dtype=np.float64)
         model = SheetModel(rect.mesh, mat, thickness, effects, thickness_points, kappa0,
@@ -112,7 +113,7 @@ class SheetProblem:
         nodal = NodalLoads(V, rect.facet_tags, loads, tol) if (loads.points or loads.moments) else None
         driver = Driver(model, bcs, prescribed=qbar if prescribed else None, pressure=loads.pressure,
                         nodal=nodal, controls=controls or Controls(), checkpoint_dir=checkpoint_dir,
-                        verbose=verbose, frames=frames)
+                        verbose=verbose, frames=frames, parts=[make(model) for make in parts])
         return cls(rect, model, driver, pdofs)
 
     def value(self, name: str, x: float, y: float) -> float:
