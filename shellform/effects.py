@@ -97,6 +97,11 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
     Effect("friction", "contact part", "shellform.contact.friction.CoulombFriction", (TOOLS,), ("contact",),
            why="acts at the contact with the tools", keys=("tools.friction",),
            doc="Coulomb friction at that contact, coefficient tools.friction > 0"),
+    Effect("ironing", "contact part", "shellform.contact.ironing.Ironing", (TOOLS,), ("contact", "finite_strain"),
+           why="bounds the thickness of a sheet that thins and thickens between the tools",
+           doc="where two tools face each other across the sheet closer than its thickness (the punch's and "
+               "the die's walls), their faces press it to the clearance: a through-thickness pressure in "
+               "the section (docs/contact.md, Ironing)"),
     Effect("drawbeads", "contact part", "shellform.contact.drawbead.Drawbeads", (TOOLS,), ("contact",),
            why="act on the flange the tools hold", keys=("tools.drawbead",),
            doc="drawbeads on the flange, [[tools.drawbead]]: lines that restrain the flow across them and "

@@ -98,6 +98,18 @@ def test_the_watch_interpolates_the_onset_and_keeps_it():
     assert watch.onset == first
 
 
+def test_a_thickening_cell_does_not_neck():
+    """A cell compressed in the mean (thickness strain > 0) whose membrane tangent turns indefinite
+    is not a neck: the watch sees only the cells that have thinned."""
+    watch = NeckWatch(MPI.COMM_SELF, "stretch", "initial_xy")
+    centres = np.array([[0.5, 0.5], [1.5, 0.5]])
+    assert not watch.reached(1.1, np.array([40.0, 30.0]), np.array([0.04, -0.05]), centres)
+    assert not watch.reached(1.2, np.array([-10.0, 20.0]), np.array([0.05, -0.08]), centres)
+    assert watch.onset is None
+    assert watch.reached(1.3, np.array([-10.0, -5.0]), np.array([0.06, -0.11]), centres)
+    assert watch.onset["initial_xy"] == [1.5, 0.5] and watch.onset["stability"] == -5.0
+
+
 def test_a_resumed_watch_keeps_an_earlier_onset():
     """A resumed run at 12 mm keeps the onset found at 10 mm (from the summary before), and
     ignores one past its state (a run resumed from before it finds it again)."""

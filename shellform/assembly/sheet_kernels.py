@@ -274,10 +274,13 @@ def _pack(w, offsets, nz, nqp, z, S, D):
 
 @jit.njit(parallel=True)
 def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst,
-                grads, weights, nt, cells, cells_coords, P, consts, beta, tying, z, S, D, want_tangent, R_out, K_out):
+                grads, weights, nt, cells, cells_coords, P, consts, beta, tying, z, S, D, ironed_d, ironed_k,
+                want_tangent, R_out, K_out):
     """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
     nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
-    (shellform.assembly.assumed_membrane, whose docstring has the terms)."""
+    (shellform.assembly.assumed_membrane, whose docstring has the terms). Where the tools' faces
+    press a cell (ironed_k > 0: phi'', ironed_d: d_g at its points, shellform.material.ironing),
+    K_z gets the rank-one coupling of its points phi'' / A0 G G^T, G = sum_g A0 w_g B_g^T d_g."""
     for t in numba.prange(nt):
         Q = np.zeros((nz, NDOF))
         w = np.zeros(nz + 42 * nqp)
@@ -288,6 +291,7 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
         B, Bm = np.zeros((nqp, 6, nz)), np.zeros((9, 3, nz))
         Bt, DB, wdet = np.zeros((6 * nqp, nz)), np.zeros((6 * nqp, nz)), np.zeros(nqp)
         sigma = np.zeros((9, 3))
+        G = np.zeros(nz)
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
             cidx = cells[k]
@@ -322,4 +326,23 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
             else:
                 _pack(w, to, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
                 jit.call_kernel(tangent, Kz, w, c, coords, local, perm)
+            if ironed_k[k] > 0.0:
+                area = 0.5 * abs(slope_map.determinant(J))
+                if not assumed:  # the compatible membrane rows B_g (the assumed ones are in Bt already)
+                    B[:, :, :] = 0.0
+                    jit.call_kernel(gradient, B.reshape(B.size), z[k], c, coords, local, perm)
+                    for i in range(nqp):
+                        for r in range(3):
+                            for j in range(nz):
+                                Bt[6 * i + r, j] = B[i, r, j]
+                G[:] = 0.0
+                for i in range(nqp):
+                    for r in range(3):
+                        f = 2.0 * area * weights[i] * ironed_d[k, i, r]
+                        for j in range(nz):
+                            G[j] += f * Bt[6 * i + r, j]
+                f = ironed_k[k] / area
+                for i in range(nz):
+                    for j in range(nz):
+                        Kz[i, j] += f * G[i] * G[j]
             congruence(Kz, J, P[cidx], qcols, qcodes, ccols, QtK, KQ, K_out[k])

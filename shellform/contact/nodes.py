@@ -56,10 +56,10 @@ class SheetNodes(Part):
         x = model.cell_coords.reshape(-1, 3, 3)[:, :, :2]
         self._edges = np.stack([x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]], axis=1)  # rows: the edges from vertex 0
         self._cell_area = 0.5 * np.abs(np.linalg.det(self._edges))
-        sums = self._cell_sums(self._cell_area / 3, self._cell_area**2 / 3)
+        sums = self.cell_sums(self._cell_area / 3, self._cell_area**2 / 3)
         self.area, self.cell_size = sums[:, 0], np.sqrt(2.0 * sums[:, 1] / sums[:, 0])
         # (cells, 3, 2): each cell's centroid from each of its vertices, in the vertex's cell sizes (recover)
-        self._centroid_offsets = (x.mean(axis=1)[:, None, :] - x) / self._at_vertices(self.cell_size)[..., None]
+        self._centroid_offsets = (x.mean(axis=1)[:, None, :] - x) / self.at_vertices(self.cell_size)[..., None]
         self.flat, self.pinched = np.zeros(self.n_owned, dtype=bool), np.zeros(self.n_owned, dtype=bool)
         self._set_thickness()
         self.q = None
@@ -81,7 +81,7 @@ class SheetNodes(Part):
         """(n_owned, 2) the slopes (w_x, w_y) of the owned nodes."""
         return self.q.x.array.reshape(-1, BS)[: self.n_owned, W_SLOPES]
 
-    def _cell_sums(self, *values) -> np.ndarray:
+    def cell_sums(self, *values) -> np.ndarray:
         """(n_owned, len(values)): per node the sum over the cells around it of each array in
         `values`, per cell or per cell and vertex (cells, 3) (all ranks' cells)."""
         f = fem.Function(self.model.V)
@@ -92,7 +92,7 @@ class SheetNodes(Part):
         f.x.scatter_reverse(la.InsertMode.add)
         return arr[: self.n_owned, : len(values)].copy()
 
-    def _at_vertices(self, values: np.ndarray) -> np.ndarray:
+    def at_vertices(self, values: np.ndarray) -> np.ndarray:
         """(cells, 3): the owned nodes' `values` at each cell's vertices (ghosts' from their owners)."""
         f = fem.Function(self.model.V)
         arr = f.x.array.reshape(-1, BS)
@@ -112,20 +112,20 @@ class SheetNodes(Part):
         x = self.local_positions()[:, :2][self.model.dofs.reshape(-1, 3)]
         e1, e2 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
         a = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-        return self._cell_sums(a / 3)[:, 0]
+        return self.cell_sums(a / 3)[:, 0]
 
     def spread(self, values: np.ndarray) -> np.ndarray:
         """(n_owned,): the area-weighted mean over the cells around each node of the spread
         (largest minus smallest) of the owned nodes' `values` over the cell's vertices: of a
         distance to a line, the spacing of the rows of nodes along it."""
-        v = self._at_vertices(values)
-        sums = self._cell_sums(self._cell_area * (v.max(axis=1) - v.min(axis=1)), self._cell_area)
+        v = self.at_vertices(values)
+        sums = self.cell_sums(self._cell_area * (v.max(axis=1) - v.min(axis=1)), self._cell_area)
         return sums[:, 0] / sums[:, 1]
 
     def _within(self, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((cells, 3), (cells,)): which vertices of each cell are in `region` (a mask of the
         owned nodes), and which cells lie wholly in it."""
-        inside = self._at_vertices(np.asarray(region, dtype=float)) > 0.5
+        inside = self.at_vertices(np.asarray(region, dtype=float)) > 0.5
         return inside, inside.all(axis=1)
 
     def interior(self, region: np.ndarray) -> np.ndarray:
@@ -133,7 +133,7 @@ class SheetNodes(Part):
         its boundary, the nodes with a cell that reaches outside."""
         inside, whole = self._within(region)
         reaches_out = inside & ~whole[:, None]
-        return np.asarray(region, dtype=bool) & ~(self._cell_sums(reaches_out.astype(float))[:, 0] > 0.0)
+        return np.asarray(region, dtype=bool) & ~(self.cell_sums(reaches_out.astype(float))[:, 0] > 0.0)
 
     def _weights(self) -> np.ndarray:
         """(cells, 3): the area with which each cell counts at each of its vertices: its area,
@@ -141,8 +141,8 @@ class SheetNodes(Part):
         node has a cell that does."""
         held, between = self._within(self.flat)
         a = np.repeat(self._cell_area[:, None], 3, axis=1)
-        inner = self._cell_sums(np.where(between[:, None], a, 0.0))[:, 0] > 0.0
-        keep = ~(held & ~between[:, None] & (self._at_vertices(inner.astype(float)) > 0.5))
+        inner = self.cell_sums(np.where(between[:, None], a, 0.0))[:, 0] > 0.0
+        keep = ~(held & ~between[:, None] & (self.at_vertices(inner.astype(float)) > 0.5))
         return np.where(keep, a, 0.0)
 
     def _set_thickness(self, half: np.ndarray | None = None) -> None:
@@ -165,7 +165,7 @@ class SheetNodes(Part):
         w = np.repeat(self._cell_area[:, None], 3, axis=1) if weights is None else weights
         d = self._centroid_offsets
         dx, dy, f = d[..., 0], d[..., 1], np.repeat(np.asarray(values, dtype=float)[:, None], 3, axis=1)
-        s = self._cell_sums(w, w * dx, w * dy, w * dx * dx, w * dx * dy, w * dy * dy, w * f, w * f * dx, w * f * dy)
+        s = self.cell_sums(w, w * dx, w * dy, w * dx * dx, w * dx * dy, w * dy * dy, w * f, w * f * dx, w * f * dy)
         mean = s[:, 6] / s[:, 0]
         M = np.stack([s[:, 0:3], s[:, [1, 3, 4]], s[:, [2, 4, 5]]], axis=1) / s[:, :1, None]
         cov = M[:, 1:, 1:] - M[:, 1:, :1] * M[:, :1, 1:]
@@ -179,10 +179,10 @@ class SheetNodes(Part):
         """(n_owned, 2): the mean over the cells around each node of the plan gradient of the
         linear interpolant of the owned nodes' `values`, weighted by the cells' areas (or by
         `weights`, (cells, 3))."""
-        v = self._at_vertices(values)
+        v = self.at_vertices(values)
         g = np.linalg.solve(self._edges, np.stack([v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]], axis=1)[..., None])[..., 0]
         w = np.repeat(self._cell_area[:, None], 3, axis=1) if weights is None else weights
-        sums = self._cell_sums(w, w * g[:, 0:1], w * g[:, 1:2])
+        sums = self.cell_sums(w, w * g[:, 0:1], w * g[:, 1:2])
         return sums[:, 1:] / sums[:, :1]
 
     def commit(self, lam: float) -> None:

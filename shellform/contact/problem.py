@@ -5,6 +5,7 @@ blank carries a quarter of the blank-holder force, and its forces are reported f
 blank (times 4).
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,7 @@ from shellform.nonlinear.problem import scene_controls
 from shellform.scene import Scene
 
 PUNCH, DIE, HOLDER = 0, 1, 2  # the open holder is the third tool of the contact set
+GAP_HOLDER = 2  # a holder at a gap is the third rigid tool
 
 
 @dataclass
@@ -51,12 +53,20 @@ class DrawingProblem:
         controls = scene_controls(s)
         mu = t.friction if "friction" in s.effects else 0.0
         beads = tuple(DrawbeadLine(tuple(map(tuple, b.points)), b.restraint, b.uplift) for b in t.drawbead)
+        if t.holder == "gap":  # a third rigid tool: the holder's face holder_gap above the die's top
+            holder = tools["holder"]
+            face = dataclasses.replace(holder, z_face=holder.z_face - s.material.thickness + t.holder_gap)
+            rigid, travel = [tools["punch"], tools["die"], face], [-t.stroke, 0.0, 0.0]
+            holder, force, edge = None, 0.0, None
+        else:
+            rigid, travel, holder, force = [tools["punch"], tools["die"]], [-t.stroke, 0.0], tools["holder"], \
+                t.blank_holder_force / symmetry
+            edge = edge_load(material, s.material.thickness, tools["die"], tools["holder"])
         driver = SemiInverseDriver(
-            model, bcs, [tools["punch"], tools["die"]], [-t.stroke, 0.0], friction=mu, holder=tools["holder"],
-            holder_force=t.blank_holder_force / symmetry, drawbeads=beads,
-            holder_edge=edge_load(material, s.material.thickness, tools["die"], tools["holder"]),
+            model, bcs, rigid, travel, friction=mu, holder=holder, holder_force=force, drawbeads=beads, die=DIE,
+            holder_edge=edge,
             contact=ContactControls(1e-2 * s.material.thickness, holder_spread=t.holder_spread, trace=trace),
-            controls=controls, checkpoint_dir=checkpoint_dir, verbose=verbose)
+            controls=controls, checkpoint_dir=checkpoint_dir, verbose=verbose, ironing="ironing" in s.effects)
         return cls(s, rect, model, driver, symmetry)
 
     # -- measurements (whole blank) ------------------------------------------------------------
@@ -76,6 +86,8 @@ class DrawingProblem:
         F = d.frames[: d.n_owned][on]
         f = np.einsum("nji,nj->ni", F, r) + d.friction.force[on]
         total = d.model.mesh.comm.allreduce(f.sum(axis=0), op=MPI.SUM)
+        if d.ironing is not None:  # its face's push on the nodes it irons on another tool
+            total = total + d.ironing.face_force(tool)
         return self.symmetry * total
 
     def punch_force(self) -> float:
@@ -89,6 +101,8 @@ class DrawingProblem:
         closed holder's face forces, or the open holder's reactions (a node frozen on its face
         after its switches in an increment may pull it, which friction does not see)."""
         d = self.driver
+        if self.scene.tools.holder == "gap":
+            return -float(self.tool_force(GAP_HOLDER)[2])
         if d.holder is None:
             return 0.0
         if d.holder.is_open:

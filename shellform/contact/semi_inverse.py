@@ -10,6 +10,8 @@ displacement (it follows the tool) and an unknown normal force, the residual of 
     Drawbeads       restraining and uplift forces along the beads' lines (drawbead.py)
     ContactSet      which node lies on which tool, its frame, the tools' curvature (contact_set.py)
     PinchingHolder  the pinch onto the die, the open holder's lift and its equation (holder.py)
+    Ironing         the faces' bound on the thickness between two tools (ironing.py; with the
+                    effect 'ironing')
     CoulombFriction the return mapping, its normal forces and their relaxation (friction.py)
 
 The driver (nonlinear/driver.py) knows none of them: it runs passes of Newton on their fixed
@@ -24,6 +26,7 @@ from shellform.contact.contact_set import FREE, ContactControls, ContactSet
 from shellform.contact.drawbead import Drawbeads
 from shellform.contact.friction import CoulombFriction
 from shellform.contact.holder import PinchingHolder
+from shellform.contact.ironing import Ironing
 from shellform.contact.nodes import SheetNodes
 from shellform.nonlinear.driver import Driver
 
@@ -38,12 +41,13 @@ class SemiInverseDriver(Driver):
     in contact order (e.g. punch, die); ``travel[k]`` is tool k's z-travel at lambda = 1 (punch:
     -stroke); holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool
     `die` (default: the last tool); friction: mu; drawbeads: DrawbeadLine's (drawbead.py);
-    holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge).
+    holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge);
+    ironing: the tools' faces bound the sheet's thickness where two face each other (ironing.py).
     """
 
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
                  prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None,
-                 drawbeads=(), holder_edge=None):
+                 drawbeads=(), holder_edge=None, ironing=False):
         c = contact or ContactControls(penetration=1e-3 * model.thickness)
         t, E, comm = model.thickness, model.material[0], model.mesh.comm
         self.nodes = nodes = SheetNodes(model, bcs)
@@ -57,7 +61,9 @@ class SemiInverseDriver(Driver):
                                    nodes) if drawbeads else None
         if self.holder is not None:
             self.holder.compose(self.contact, self.friction)
-        parts = [p for p in (nodes, self.drawbeads, self.contact, self.holder, self.friction) if p is not None]
+        self.ironing = Ironing(model, nodes, self.contact) if ironing else None
+        parts = [p for p in (nodes, self.drawbeads, self.contact, self.holder, self.ironing, self.friction)
+                 if p is not None]
         super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,
                          verbose=verbose, parts=parts, trace=c.trace)
         self.tools, self.travel = self.contact.tools, self.contact.travel

@@ -143,8 +143,10 @@ class SheetModel:
         self.ironing = "ironing" in self.effects
         self.clearance = np.full(self.num_cells, np.inf)
         self.face_pressure = np.zeros((self.num_cells, self.nqp))
+        self.ironed_d = np.zeros((self.num_cells, self.nqp, 3))  # d_g of the pressed cells' points
+        self.ironed_k = np.zeros(self.num_cells)  # their phi'' (0: not pressed)
         self.pressed = 0  # points the last evaluation pressed
-        self._modulus33 = ironing.through_thickness_modulus(self.material)
+        self.modulus33 = ironing.through_thickness_modulus(self.material)  # M of the faces' penalty
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
         self.state_version = 0  # changes with the committed material state (Driver's reuse of an evaluation)
 
@@ -162,8 +164,9 @@ class SheetModel:
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
             elastic_tangent)
         if self.ironing:
-            self.pressed, failed = ironing.squeeze(self.strain, self.clearance, self.thickness, self._modulus33,
-                                                   self.resultants, self.tangents, self.face_pressure)
+            self.pressed, failed = ironing.squeeze(self.strain, self.clearance, self.thickness, self.modulus33,
+                                                   2.0 * self.kernels.element.weights, self.resultants, self.tangents,
+                                                   self.face_pressure, self.ironed_d, self.ironed_k)
             nguard += failed  # a mid-surface turned inside out: past the strain guard
         t2 = time.perf_counter()
         self.tensor_arrays(tangent)
@@ -175,7 +178,8 @@ class SheetModel:
         section tangents: with tangent=True after an evaluation without, its K alone."""
         numba.set_num_threads(self.threads)
         self.kernels.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z,
-                                 self.resultants, self.tangents, tangent, self.forms.vectors, self.forms.matrices)
+                                 self.resultants, self.tangents, self.ironed_d, self.ironed_k, tangent,
+                                 self.forms.vectors, self.forms.matrices)
 
     def squeeze(self, clearance: np.ndarray) -> None:
         """The clearance between two tools over each owned cell (mm; inf where no two tools

@@ -6,6 +6,11 @@ is where a cell's membrane stability (shellform.material.stability, SheetModel.m
 the smallest eigenvalue of the tangent of the nominal membrane force, per unit initial
 thickness) first reaches 0; in uniaxial tension that is Considere's force maximum.
 
+A neck thins the sheet: only the cells thinner than the blank (thickness strain below 0) are
+watched. Where the sheet thickens, compressed in the mean (a cup's flange and its drawn-in rim,
+a rim ironed between the tools), the membrane tangent may turn indefinite too, but that is the
+membrane's own wrinkling, which the shell's bending resists, or the faces' pressure, not a neck.
+
 The watch is told the sheet's state after every converged increment (a run's on_increment;
 the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
 tool scene, the load factor of a sheet scene) interpolated linearly between the last increment
@@ -43,8 +48,10 @@ class NeckWatch:
 
     def reached(self, at: float, stability, thickness_strain, centres) -> bool:
         """After an increment at the load measure `at`: the local cells' stability, thickness
-        strain and initial centres (cells, 2). Whether the neck has started (now or before)."""
-        stability = np.asarray(stability, dtype=float)
+        strain and initial centres (cells, 2). Whether the neck has started (now or before); the
+        cells that have not thinned are not watched (module docstring)."""
+        thickness_strain = np.asarray(thickness_strain, dtype=float)
+        stability = np.where(thickness_strain < 0.0, np.asarray(stability, dtype=float), np.inf)
         local = float(np.nanmin(stability)) if np.any(np.isfinite(stability)) else np.inf
         least, owner = min(self.comm.allgather((local, self.comm.rank)))
         if least <= 0.0 and self.onset is None:

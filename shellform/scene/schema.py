@@ -19,7 +19,7 @@ from shellform.material import SheetMaterial, criteria
 from shellform.mesh import outline
 
 __all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS",
-           "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS",
+           "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS", "HOLDERS",
            "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS", "ANISOTROPY_LISTS",
@@ -39,6 +39,7 @@ CAD_TOOL_KEYS = ("punch_file", "die_file", "punch_translation", "die_translation
                  "holder_half_width", "holder_corner_radius")
 TOOL_NORMALS = ("outward", "inward")  # which way a CAD tool's faces' normals point: to the sheet, or away
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
+HOLDERS = ("force", "gap")  # the blank holder presses with a force, or is held at a gap over the die
 
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
 NONLINEAR_SUPPORTS = ("clamped_sliding",)  # only the nonlinear sheet knows these (shellform/supports.py)
@@ -226,6 +227,8 @@ class ToolsSpec:
     die_normals: str = "outward"
     holder_half_width: float = 0.0  # cad: the holder's inner edge, a rounded square (where the die's flat top begins)
     holder_corner_radius: float = 0.0
+    holder: str = "force"  # "force": the holder presses with blank_holder_force; "gap": its face is held at holder_gap
+    holder_gap: float = 0.0  # mm, holder = "gap": the distance between the holder's face and the die's top (>= t)
     blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
     friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
     stroke: float = 30.0  # punch travel, mm

@@ -11,7 +11,7 @@ import numpy as np
 
 from shellform.mesh.outline import MIRROR_NORMALS
 from shellform.scene.rules import keys_of_effects, require
-from shellform.scene.schema import CAD_TOOL_KEYS, SIDES, SPREADS, TOOL_NORMALS, TOOL_SHAPES, Scene, ToolsSpec
+from shellform.scene.schema import CAD_TOOL_KEYS, HOLDERS, SIDES, SPREADS, TOOL_NORMALS, TOOL_SHAPES, Scene, ToolsSpec
 
 
 def _validate_drawbead(bead, name: str, flat: float, corner: float) -> None:
@@ -49,6 +49,7 @@ def validate_tools(s: Scene) -> None:
     keys_of_effects(s, "tools")
     require(t.shape in TOOL_SHAPES, "tools.shape", f"must be one of {TOOL_SHAPES}, got {t.shape!r}")
     require(t.holder_spread in SPREADS, "tools.holder_spread", f"must be one of {SPREADS}, got {t.holder_spread!r}")
+    _validate_holder(s, t)
     for name in ("blank_holder_force", "friction", "stroke"):
         v = getattr(t, name)
         require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{name}", f"must be finite, got {v}")
@@ -86,6 +87,25 @@ def validate_tools(s: Scene) -> None:
                 f"the tools hold the blank: its outer edges must be 'free', got {v!r}")
 
 
+def _validate_holder(s: Scene, t) -> None:
+    """The holder's mode: pressing with blank_holder_force, or held at holder_gap over the die's top
+    (at least the sheet's thickness; the flange that thickens into the gap is ironed, which needs
+    the effect 'ironing')."""
+    require(t.holder in HOLDERS, "tools.holder", f"must be one of {HOLDERS}, got {t.holder!r}")
+    gap = t.holder_gap
+    require(isinstance(gap, (int, float)) and math.isfinite(gap), "tools.holder_gap", f"must be finite, got {gap}")
+    if t.holder == "force":
+        require(gap == 0, "tools.holder_gap", "is a key of tools.holder = 'gap' (the holder presses with "
+                "blank_holder_force)")
+        return
+    require("ironing" in s.effects, "tools.holder",
+            "'gap' needs the effect 'ironing': the flange thickens into the gap and the faces iron it")
+    thickness = s.material.thickness
+    require(gap >= thickness, "tools.holder_gap",
+            f"must be at least the sheet's thickness {thickness}, got {gap}: the holder would squeeze the blank "
+            "before the draw")
+
+
 def _validate_analytic_tools(s: Scene, t) -> float:
     """Square and round tools' dimensions; returns the half-width where the die's flat top
     (and the holder) begins."""
@@ -98,7 +118,7 @@ def _validate_analytic_tools(s: Scene, t) -> float:
                     "punch_half_width, punch_corner_radius, die_half_width, die_corner_radius)")
     for f in fields(ToolsSpec):
         v = getattr(t, f.name)
-        if f.name not in ("holder_spread", "shape", "drawbead", *CAD_TOOL_KEYS):
+        if f.name not in ("holder_spread", "holder", "shape", "drawbead", *CAD_TOOL_KEYS):
             require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{f.name}", f"must be finite, got {v}")
     for name in ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "stroke"):
         v = getattr(t, name)
