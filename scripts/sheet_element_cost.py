@@ -45,7 +45,7 @@ for extra in ((), ("assumed_membrane",)):
                 k.strain_loop(m.cells, m.cell_coords, m.dofs, q.x.array, m.P, m.consts, m.beta, m.tying, m.z, m.strain)
             else:
                 k.tensor_loop(m.cells, m.cell_coords, m.P, m.consts, m.beta, m.tying, m.z, m.resultants, m.tangents,
-                              m.ironed_d, m.ironed_k,
+                              m.ironed_d, m.ironed,
                               want_tangent, m.forms.vectors, m.forms.matrices)
         times.append((time.perf_counter() - t0) / args.repeat * 1e3)
     name = "assumed" if extra else "compatible"

@@ -274,13 +274,15 @@ def _pack(w, offsets, nz, nqp, z, S, D):
 
 @jit.njit(parallel=True)
 def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst,
-                grads, weights, nt, cells, cells_coords, P, consts, beta, tying, z, S, D, ironed_d, ironed_k,
+                grads, weights, nt, cells, cells_coords, P, consts, beta, tying, z, S, D, ironed_d, ironed,
                 want_tangent, R_out, K_out):
     """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
     nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
     (shellform.assembly.assumed_membrane, whose docstring has the terms). Where the tools' faces
-    press a cell (ironed_k > 0: phi'', ironed_d: d_g at its points, shellform.material.ironing),
-    K_z gets the rank-one coupling of its points phi'' / A0 G G^T, G = sum_g A0 w_g B_g^T d_g."""
+    press a cell (shellform.material.ironing: ironed[:, 0] phi'' > 0, ironed[:, 1] phi',
+    ironed[:, 2:] the clearance's gradient n_i at its three vertices, ironed_d d_g at its points),
+    r gets the faces' push -phi' A0 / 3 n_i on each vertex's u, v, w and K the rank-one
+    phi'' / A0 v v^T, v = Q^T G - A0 / 3 sum_i n_i (vertex i's rows), G = sum_g A0 w_g B_g^T d_g."""
     for t in numba.prange(nt):
         Q = np.zeros((nz, NDOF))
         w = np.zeros(nz + 42 * nqp)
@@ -292,6 +294,7 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
         Bt, DB, wdet = np.zeros((6 * nqp, nz)), np.zeros((6 * nqp, nz)), np.zeros(nqp)
         sigma = np.zeros((9, 3))
         G = np.zeros(nz)
+        v = np.zeros(NDOF)
         c, local, perm = _scratch(consts, nconst)
         for k in range(t, cells.size, nt):
             cidx = cells[k]
@@ -312,6 +315,12 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
             _pack(w, fo, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
             jit.call_kernel(force, rz, w, c, coords, local, perm)
             R_out[k, :] = Q.T @ rz
+            pressed = ironed[k, 0] > 0.0
+            if pressed:
+                area = 0.5 * abs(slope_map.determinant(J))
+                for i in range(3):
+                    for a in range(3):
+                        R_out[k, 9 * i + a] -= ironed[k, 1] * area / 3.0 * ironed[k, 2 + 3 * i + a]
             if not want_tangent:
                 continue
             Kz[:, :] = 0.0
@@ -326,8 +335,8 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
             else:
                 _pack(w, to, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
                 jit.call_kernel(tangent, Kz, w, c, coords, local, perm)
-            if ironed_k[k] > 0.0:
-                area = 0.5 * abs(slope_map.determinant(J))
+            congruence(Kz, J, P[cidx], qcols, qcodes, ccols, QtK, KQ, K_out[k])
+            if pressed:
                 if not assumed:  # the compatible membrane rows B_g (the assumed ones are in Bt already)
                     B[:, :, :] = 0.0
                     jit.call_kernel(gradient, B.reshape(B.size), z[k], c, coords, local, perm)
@@ -341,8 +350,14 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
                         f = 2.0 * area * weights[i] * ironed_d[k, i, r]
                         for j in range(nz):
                             G[j] += f * Bt[6 * i + r, j]
-                f = ironed_k[k] / area
-                for i in range(nz):
+                for i in range(NDOF):
+                    v[i] = 0.0
                     for j in range(nz):
-                        Kz[i, j] += f * G[i] * G[j]
-            congruence(Kz, J, P[cidx], qcols, qcodes, ccols, QtK, KQ, K_out[k])
+                        v[i] += Q[j, i] * G[j]
+                for i in range(3):
+                    for a in range(3):
+                        v[9 * i + a] -= area / 3.0 * ironed[k, 2 + 3 * i + a]
+                f = ironed[k, 0] / area
+                for i in range(NDOF):
+                    for j in range(NDOF):
+                        K_out[k, i, j] += f * v[i] * v[j]

@@ -16,13 +16,14 @@ thinner from leaving the set and thickening back into it in the next pass. The s
 after every converged pass from the pass's positions, as the contact set's is, and only grows
 within an increment (a cell drawn out from between the faces leaves it at the next); its
 changes count as the parts' changes, and the driver runs another pass on the new set. Within a
-pass the clearances are held (the energy's dependence on the positions through them is not in
-the tangent).
+pass the set's clearances follow every iterate's positions, with their gradients dc_i/dx_i =
+n_B (SheetModel.squeeze): the element's energy depends on the vertices' positions through them,
+and its force and tangent carry that (shellform.material.ironing).
 
-B presses each node between faces with its share of the cells' face forces F_i (a third of each
-cell's int p dA, SheetModel.face_forces) along B's normal: a nodal force in the nodes' frames.
-A, whose normal row is known, takes the balance in its reaction, so each tool's force on the
-sheet includes its face's pressure. Where the faces are parallel (the punch's wall and the die's,
+So B presses each node between faces with its share of the cells' face forces F_i (a third of
+each cell's int p dA, SheetModel.face_forces) along B's normal, a force of the element on its
+vertices. A, whose normal row is known, takes the balance in its reaction, so each tool's force
+on the sheet includes its face's pressure (face_force). Where the faces are parallel (the punch's wall and the die's,
 the holder at a gap over the die's top) the two forces cancel on the node and only the thickness
 feels them; where B is inclined to A (the die's shoulder over the punch's wall) the push has a
 component along the sheet that resists the draw. Friction on B's face is not modelled: the
@@ -32,9 +33,7 @@ friction part sees A's normal force (docs/contact.md, "Ironing").
 import numpy as np
 from mpi4py import MPI
 
-from shellform.assembly.sheet_element import BS
 from shellform.contact.contact_set import FREE
-from shellform.contact.frames import subtract_nodal_forces
 from shellform.nonlinear.parts import Change, Part
 
 FACING = -0.5  # A and B face each other where n_A . n_B is below this (60 degrees from opposite)
@@ -53,8 +52,6 @@ class Ironing(Part):
         self.facing = np.full(n, FREE, dtype=np.int8)  # the tool B facing each of them
         self.normal = np.zeros((n, 3))  # B's normal there (towards the sheet)
         self.cells = np.zeros(model.num_cells, dtype=bool)  # the cells pressed
-        self.force = np.zeros((n, 3))  # B's push on each node (x, y, z)
-        self.frames = None
         self.committed = None
 
     def _nodal(self, lam: float) -> np.ndarray:
@@ -90,14 +87,17 @@ class Ironing(Part):
         whose nodes are no longer all between faces keeps its last one). Returns the cells that
         changed (all ranks)."""
         at_cells = self.nodes.at_vertices(self._nodal(lam))
+        normals = np.stack([self.nodes.at_vertices(self.normal[:, a]) for a in range(3)], axis=2)
         full = np.all(np.isfinite(at_cells), axis=1)
         values = np.where(full, np.where(full[:, None], at_cells, 0.0).mean(axis=1), np.inf)
         cells = (full | self.cells) if grow else full if decide else self.cells
-        values = np.where(cells & ~full, self.model.clearance, values)
+        kept = cells & ~full  # in the set, a vertex no longer between faces: held where it was
+        values = np.where(kept, self.model.clearance, values)
         values[~cells] = np.inf
+        gradient = np.where((cells & full)[:, None, None], normals, 0.0)
         changed = int(np.sum(cells != self.cells))
         self.cells = cells
-        self.model.squeeze(values)
+        self.model.squeeze(values, gradient)
         return int(self.model.mesh.comm.allreduce(changed, op=MPI.SUM))
 
     # -- the part's protocol -------------------------------------------------------------------
@@ -118,15 +118,18 @@ class Ironing(Part):
         self.cells = s["cells"].copy()
         self.model.squeeze(s["clearance"])
 
-    def follow(self, frames: np.ndarray, lam: float) -> None:
-        self.frames = frames[: self.nodes.n_owned]
+    def constrain(self, c, lam: float) -> None:
+        """No constraint: the set's clearances and their gradients follow this iterate's
+        positions (the element's energy depends on them, and its tangent knows it)."""
+        self._squeeze(lam, decide=False)
 
-    def add_residual(self, R: np.ndarray) -> None:
-        """R -= B's push on the nodes between faces (module docstring)."""
-        share = self.nodes.cell_sums(np.where(self.cells, self.model.face_forces(), 0.0) / 3.0)[:, 0]
-        self.force = np.where(self.between[:, None], share[:, None] * self.normal, 0.0)
-        if self.frames is not None and self.between.any():
-            subtract_nodal_forces(R[: self.nodes.n_owned * BS].reshape(-1, BS)[:, :3], self.frames, self.force)
+    def pushes(self) -> np.ndarray:
+        """B's push on each owned node at the last evaluation (x, y, z; N): the elements' force on
+        their vertices, a third of each pressed cell's face force along the clearance's gradient
+        there (zero on a cell held in the set whose vertices are no longer all between faces)."""
+        m = self.model
+        share = m.face_forces()[:, None, None] / 3.0 * m.ironed[:, 2:].reshape(-1, 3, 3)
+        return self.nodes.cell_sums(share[:, :, 0], share[:, :, 1], share[:, :, 2])
 
     def update(self, lam: float, changes: int) -> Change:
         n = self._squeeze(lam, decide=True, grow=True)
@@ -141,10 +144,10 @@ class Ironing(Part):
     def face_force(self, tool: int) -> np.ndarray:
         """The push of `tool`'s face on the nodes it presses between faces (x, y, z; N), all ranks."""
         on = self.between & (self.facing == tool)
-        return self.model.mesh.comm.allreduce(self.force[on].sum(axis=0), op=MPI.SUM)
+        return self.model.mesh.comm.allreduce(self.pushes()[on].sum(axis=0), op=MPI.SUM)
 
     def report(self) -> dict:
         comm = self.model.mesh.comm
         pressed = comm.allreduce(int(self.cells.sum()), op=MPI.SUM)
-        push = comm.allreduce(float(np.linalg.norm(self.force, axis=1).sum()), op=MPI.SUM)
+        push = comm.allreduce(float(np.linalg.norm(self.pushes(), axis=1).sum()), op=MPI.SUM)
         return {"ironed_cells": pressed, "ironing_push": push}

@@ -39,7 +39,12 @@ gets at each point
 
     K_z += phi'' / A0 G G^T,    G = sum_g A0 w_g B_g^T d_g     (B_g = de_g/dz, membrane rows),
 
-which the element loop adds (shellform.assembly.sheet_kernels: `ironed_d`, `ironed_k`). The
+which the element loop adds (shellform.assembly.sheet_kernels: `ironed_d`, `ironed`). The
+clearance is the tools' at the cell's vertices, c = sum_i c_i(x_i) / 3, and moves with them:
+its gradient n_i = dc_i/dx_i (the facing tool's normal: the clearance grows as the node moves
+away from it) gives the faces' push on the vertices, dPhi/dx_i = -A0 phi' n_i / 3, and the
+rank-one term in full is phi'' / A0 v v^T with v = G - A0 / 3 sum_i n_i on vertex i's
+displacement rows: the push's stiffness and its coupling to the strains. The
 pressure on the faces is p = phi'(t_bar) / J_g (N_g = -p J t b: the Cauchy membrane force
 -p t I pulled back). The bound is met to the elastic through-thickness strain at p:
 (t_bar - c) / t0 = phi' / M, 0.2 % at p = 200 MPa on aluminium.
@@ -60,12 +65,13 @@ def through_thickness_modulus(material: np.ndarray) -> float:
 
 
 @jit.njit
-def squeeze(e, clearance, t0, modulus, weights, S, D, pressure, direction, stiffness):
+def squeeze(e, clearance, t0, modulus, weights, S, D, pressure, direction, ironed):
     """Add the faces' pressure to the membrane resultants S[:, :, :3] and tangents
     D[:, :, :3, :3] of the cells with a finite clearance whose mean thickness exceeds it, from
     the section strains e (cells, points, 6) and the quadrature weights (summing to 1). Fills
-    pressure (cells, points) with p, direction (cells, points, 3) with d_g and stiffness (cells,)
-    with phi'' for the element loop's rank-one term (0 and 0 where the faces do not press).
+    pressure (cells, points) with p, direction (cells, points, 3) with d_g and ironed[:, 0] and
+    ironed[:, 1] (cells) with phi'' and phi' for the element loop (0 where the faces do not
+    press; ironed[:, 2:], the clearance's gradient at the vertices, is the caller's).
     Returns (points pressed, points failed): a point of a cell between faces whose mid-surface
     has turned inside out (det C <= 0) has no thickness, and the iterate has left the physical
     range (the driver cuts back)."""
@@ -75,7 +81,7 @@ def squeeze(e, clearance, t0, modulus, weights, S, D, pressure, direction, stiff
     t = np.empty(npts)
     b = np.empty((npts, 3))
     for c in range(e.shape[0]):
-        stiffness[c] = 0.0
+        ironed[c, 0] = ironed[c, 1] = 0.0
         for g in range(npts):
             pressure[c, g] = 0.0
             for i in range(3):
@@ -97,7 +103,7 @@ def squeeze(e, clearance, t0, modulus, weights, S, D, pressure, direction, stiff
         if not real or mean <= gap:
             continue
         d1 = stiff * (mean - gap)  # phi'
-        stiffness[c] = stiff  # phi''
+        ironed[c, 0], ironed[c, 1] = stiff, d1
         for g in range(npts):
             tg = t[g]
             b0, b1, b2 = b[g, 0], b[g, 1], b[g, 2]

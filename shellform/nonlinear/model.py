@@ -144,7 +144,7 @@ class SheetModel:
         self.clearance = np.full(self.num_cells, np.inf)
         self.face_pressure = np.zeros((self.num_cells, self.nqp))
         self.ironed_d = np.zeros((self.num_cells, self.nqp, 3))  # d_g of the pressed cells' points
-        self.ironed_k = np.zeros(self.num_cells)  # their phi'' (0: not pressed)
+        self.ironed = np.zeros((self.num_cells, 11))  # phi'', phi' (0: not pressed), the clearance's gradient
         self.pressed = 0  # points the last evaluation pressed
         self.modulus33 = ironing.through_thickness_modulus(self.material)  # M of the faces' penalty
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
@@ -166,7 +166,7 @@ class SheetModel:
         if self.ironing:
             self.pressed, failed = ironing.squeeze(self.strain, self.clearance, self.thickness, self.modulus33,
                                                    2.0 * self.kernels.element.weights, self.resultants, self.tangents,
-                                                   self.face_pressure, self.ironed_d, self.ironed_k)
+                                                   self.face_pressure, self.ironed_d, self.ironed)
             nguard += failed  # a mid-surface turned inside out: past the strain guard
         t2 = time.perf_counter()
         self.tensor_arrays(tangent)
@@ -178,21 +178,25 @@ class SheetModel:
         section tangents: with tangent=True after an evaluation without, its K alone."""
         numba.set_num_threads(self.threads)
         self.kernels.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z,
-                                 self.resultants, self.tangents, self.ironed_d, self.ironed_k, tangent,
+                                 self.resultants, self.tangents, self.ironed_d, self.ironed, tangent,
                                  self.forms.vectors, self.forms.matrices)
 
-    def squeeze(self, clearance: np.ndarray) -> None:
+    def squeeze(self, clearance: np.ndarray, gradient: np.ndarray | None = None) -> None:
         """The clearance between two tools over each owned cell (mm; inf where no two tools
-        face each other across it): where the sheet is thicker, the tools press its faces
-        (shellform.material.ironing) from the next evaluation on. Refused without the effect
-        'ironing'."""
+        face each other across it), the mean of its vertices' c_i, and their gradients
+        dc_i/dx_i (cells, 3 vertices, 3; default 0: a clearance fixed in space): where the sheet
+        is thicker, the tools press its faces (shellform.material.ironing) from the next
+        evaluation on. Refused without the effect 'ironing'."""
         if not self.ironing:
             raise InputError("effects", "a clearance between tools squeezes the sheet only with the effect 'ironing'")
         clearance = np.asarray(clearance, dtype=float)
         if clearance.shape != self.clearance.shape or np.any(np.isnan(clearance)) or np.any(clearance <= 0):
             raise InputError("clearance", f"needs one positive value (or inf) per owned cell, {self.num_cells}")
-        if not np.array_equal(clearance, self.clearance):
+        gradient = np.zeros((self.num_cells, 9)) if gradient is None else np.asarray(gradient, dtype=float)
+        gradient = gradient.reshape(self.num_cells, 9)
+        if not (np.array_equal(clearance, self.clearance) and np.array_equal(gradient, self.ironed[:, 2:])):
             self.clearance[...] = clearance
+            self.ironed[:, 2:] = gradient
             self.state_version += 1
 
     def face_forces(self) -> np.ndarray:

@@ -73,8 +73,10 @@ class Die(Part):
     """Flat frictionless faces over start <= x <= start + entry + land in the current
     configuration: their clearance narrows linearly from t0 to t1 over the entry, then stays t1
     over the land. A cell is pressed while its centre lies under them (the set is updated after
-    every pass, as a contact set is). The die closes on the strip as lambda goes from 0 to
-    `close`: its clearance is t0 - (t0 - c(x)) min(1, lambda / close)."""
+    every pass, as a contact set is), with the clearance at its centre's current position and its
+    gradient along x (the inclined faces push the strip back: the element's force). The die
+    closes on the strip as lambda goes from 0 to `close`: its clearance is
+    t0 - (t0 - c(x)) min(1, lambda / close)."""
 
     def __init__(self, model, t1: float, start: float, entry: float, land: float, close: float):
         self.model, self.t1, self.start_x, self.entry, self.land, self.close = model, t1, start, entry, land, close
@@ -90,37 +92,31 @@ class Die(Part):
         u = self.q.x.array[m.dofs * len(m.components)]  # u at the cells' vertices
         return m.cell_centres()[:, 0] + u.mean(axis=1)
 
-    def _set(self) -> int:
+    def _set(self, decide: bool) -> int:
+        """The cells under the faces (with `decide`; else the set stays) and their clearances
+        at the current positions, with the gradient dc/dx at their vertices."""
         x = self.centres() - self.start_x
-        over = (x >= 0.0) & (x <= self.entry + self.land)
-        shape = T0 + (self.t1 - T0) * np.clip(x / self.entry, 0.0, 1.0)
+        over = (x >= 0.0) & (x <= self.entry + self.land) if decide else self.over
         closing = min(1.0, self.lam / self.close)
+        shape = T0 + (self.t1 - T0) * np.clip(x / self.entry, 0.0, 1.0)
+        slope = np.where((x >= 0.0) & (x <= self.entry), (self.t1 - T0) / self.entry * closing, 0.0)
+        gradient = np.zeros((self.model.num_cells, 3, 3))
+        gradient[:, :, 0] = np.where(over, slope, 0.0)[:, None]
         changes = int(self.model.mesh.comm.allreduce(int(np.sum(over != self.over)), op=MPI.SUM))
         self.over = over
-        self.model.squeeze(np.where(over, T0 - (T0 - shape) * closing, np.inf))
+        self.model.squeeze(np.where(over, T0 - (T0 - shape) * closing, np.inf), gradient)
         return changes
 
     def start(self, lam: float, predicting: bool) -> None:
         self.lam = lam
-        self._set()
+        self._set(decide=True)
 
-    def add_residual(self, R: np.ndarray) -> None:
-        """The faces' push along x: where the clearance narrows (the entry) the faces are
-        inclined and press the strip back, dPhi/dx = -F dc/dx per cell (F its face force,
-        SheetModel.face_forces), a third on each vertex. Serial: the strip's ghost rows are not
-        gathered."""
-        m = self.model
-        x = self.centres() - self.start_x
-        slope = np.where((x >= 0.0) & (x <= self.entry), (self.t1 - T0) / self.entry, 0.0)
-        slope *= min(1.0, self.lam / self.close)
-        push = m.face_forces() * slope / 3.0
-        rows = (m.dofs * len(m.components)).ravel()
-        f = np.repeat(push, 3)
-        owned = rows < R.size
-        np.add.at(R, rows[owned], -f[owned])
+    def constrain(self, c, lam: float) -> None:
+        """No constraint: the clearances follow this iterate's positions."""
+        self._set(decide=False)
 
     def update(self, lam: float, changes: int) -> Change:
-        n = self._set()
+        n = self._set(decide=True)
         return Change(changes=n, line=f"{n} cells in or out of the die" if n else "")
 
 
