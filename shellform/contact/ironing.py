@@ -1,33 +1,33 @@
 """Ironing in a drawn part: where two tools face each other across the sheet closer than its
 thickness, their faces bound it (shellform.material.ironing). A part of the contact.
 
-A node on tool A (the contact set's: its normal row is known, the semi-inverse split) whose other
-face lies within a quarter of the thickness of a tool B that faces A (their normals opposite
-within 60 degrees) is *between faces*. There the clearance is the distance between the two
-tools' surfaces through the node,
+A node whose two faces lie within a quarter of the thickness of two tools a and b that face each
+other (their normals opposite within 60 degrees: the punch's wall and the die's, a holder at a
+gap and the die's top), whether it is on one of them (the contact set's) or on neither, is
+*between faces*. There the clearance is the distance between the two tools' surfaces through the
+node,
 
-    c_i = 2 h_i + g_B,i            (h_i its half thickness, g_B,i the gap of its B-side face to B),
+    c_i = 2 h_i + g_a,i + g_b,i     (h_i its half thickness, g its faces' gaps to the tools),
 
 and a cell whose three nodes are between faces gets the mean of their clearances
 (SheetModel.squeeze): its sections' thickness is bounded by it, and where the sheet is thicker
 the faces press it with p. The bound is one-sided, so a cell whose sheet is thinner than its
 clearance is in the set at no cost: the band keeps a cell that the faces have just pressed
 thinner from leaving the set and thickening back into it in the next pass. The set is decided
-after every converged pass from the pass's positions, as the contact set's is, and only grows
-within an increment (a cell drawn out from between the faces leaves it at the next); its
-changes count as the parts' changes, and the driver runs another pass on the new set. Within a
-pass the set's clearances follow every iterate's positions, with their gradients dc_i/dx_i =
-n_B (SheetModel.squeeze): the element's energy depends on the vertices' positions through them,
-and its force and tangent carry that (shellform.material.ironing).
+after every converged pass from the pass's positions, as the contact set's is; its changes
+count as the parts' changes, and the driver runs another pass on the new set. Within a pass the
+set's clearances follow every iterate's positions, with their gradients dc_i/dx_i = n_a + n_b
+(SheetModel.squeeze): the element's energy depends on the vertices' positions through them, and
+its force and tangent carry that (shellform.material.ironing). A node of the set that leaves
+the faces within a pass keeps its last clearance, with no gradient, until the pass ends.
 
-So B presses each node between faces with its share of the cells' face forces F_i (a third of
-each cell's int p dA, SheetModel.face_forces) along B's normal, a force of the element on its
-vertices. A, whose normal row is known, takes the balance in its reaction, so each tool's force
-on the sheet includes its face's pressure (face_force). Where the faces are parallel (the punch's wall and the die's,
-the holder at a gap over the die's top) the two forces cancel on the node and only the thickness
-feels them; where B is inclined to A (the die's shoulder over the punch's wall) the push has a
-component along the sheet that resists the draw. Friction on B's face is not modelled: the
-friction part sees A's normal force (docs/contact.md, "Ironing").
+So each face presses each node between faces with its share of the cells' face forces (a third
+of each cell's int p dA, SheetModel.face_forces) along its normal, a force of the element on its
+vertices: where the faces are parallel the two cancel on the node and only the thickness feels
+them; where one is inclined to the other (the die's shoulder over the punch's wall) their sum
+has a component along the sheet that resists the draw. Each tool's force on the sheet includes
+its face's share (face_force). Friction on the faces' squeeze is not modelled: the friction part
+sees the normal force of the tool a node is on (docs/contact.md, "Ironing").
 """
 
 import numpy as np
@@ -36,7 +36,7 @@ from mpi4py import MPI
 from shellform.contact.contact_set import FREE
 from shellform.nonlinear.parts import Change, Part
 
-FACING = -0.5  # A and B face each other where n_A . n_B is below this (60 degrees from opposite)
+FACING = -0.5  # two tools face each other where n_a . n_b is below this (60 degrees from opposite)
 BAND = 0.25  # a node is between faces while its other face lies within this many thicknesses of B
 
 
@@ -49,52 +49,50 @@ class Ironing(Part):
         self.model, self.nodes, self.contact = model, nodes, contact
         n = nodes.n_owned
         self.between = np.zeros(n, dtype=bool)  # the owned nodes between faces
-        self.facing = np.full(n, FREE, dtype=np.int8)  # the tool B facing each of them
-        self.normal = np.zeros((n, 3))  # B's normal there (towards the sheet)
+        self.pair = np.full((n, 2), FREE, dtype=np.int8)  # the two tools whose faces they lie between
+        self.normals = np.zeros((n, 2, 3))  # the two faces' normals there (towards the sheet)
+        self.last = np.full(n, np.inf)  # each node's last clearance
         self.cells = np.zeros(model.num_cells, dtype=bool)  # the cells pressed
         self.committed = None
 
     def _nodal(self, lam: float) -> np.ndarray:
         """The owned nodes' clearances c_i at the current positions (inf where a node is not
-        between faces); sets their facing tool and its normal."""
+        between faces); sets the two tools whose faces it lies between and their normals."""
         c = self.contact
         x = self.nodes.positions()
         h = self.nodes.half_thickness
         gaps = c.gaps(x, lam)
-        on = c.tool
         clearance = np.full(x.shape[0], np.inf)
-        facing = np.full(x.shape[0], FREE, dtype=np.int8)
-        normal = np.zeros((x.shape[0], 3))
-        for a, (_, na) in enumerate(gaps):
-            at = on == a
-            if not at.any():
-                continue
-            for b, (gb, nb) in enumerate(gaps):
-                if b == a:
-                    continue
-                near = at & np.isfinite(gb) & (gb <= BAND * 2.0 * h)
+        pair = np.full((x.shape[0], 2), FREE, dtype=np.int8)
+        normals = np.zeros((x.shape[0], 2, 3))
+        for a, (ga, na) in enumerate(gaps):
+            for b, (gb, nb) in enumerate(gaps[a + 1:], start=a + 1):
+                near = np.isfinite(ga) & np.isfinite(gb) & (ga <= BAND * 2.0 * h) & (gb <= BAND * 2.0 * h)
                 near &= np.einsum("ij,ij->i", na, nb) < FACING
-                cb = 2.0 * h + gb
-                tighter = near & (cb < clearance)
-                clearance[tighter], facing[tighter], normal[tighter] = cb[tighter], b, nb[tighter]
-        self.between, self.facing, self.normal = np.isfinite(clearance), facing, normal
+                cab = 2.0 * h + ga + gb
+                tighter = near & (cab < clearance)
+                clearance[tighter] = cab[tighter]
+                pair[tighter] = (a, b)
+                normals[tighter, 0], normals[tighter, 1] = na[tighter], nb[tighter]
+        self.between, self.pair, self.normals = np.isfinite(clearance), pair, normals
         return clearance
 
-    def _squeeze(self, lam: float, decide: bool, grow: bool = False) -> int:
-        """The cells' clearances at the current positions: the mean of their nodes' where all three
-        are between faces. With `decide`, the set of cells is decided anew (with `grow` it keeps the
-        cells it had); else the set stays and only its clearances follow the positions (a cell
-        whose nodes are no longer all between faces keeps its last one). Returns the cells that
-        changed (all ranks)."""
-        at_cells = self.nodes.at_vertices(self._nodal(lam))
-        normals = np.stack([self.nodes.at_vertices(self.normal[:, a]) for a in range(3)], axis=2)
+    def _squeeze(self, lam: float, decide: bool) -> int:
+        """The cells' clearances at the current positions, the mean of their vertices', and the
+        gradients n_a + n_b at the vertices. With `decide` the set is the cells whose three
+        vertices are between faces; else the set stays, and a vertex of it no longer between faces
+        keeps its last clearance, with no gradient. Returns the cells that changed (all ranks)."""
+        nodal = self._nodal(lam)
+        held = ~self.between
+        nodal[held] = self.last[held]
+        self.last = nodal
+        at_cells = self.nodes.at_vertices(nodal)
         full = np.all(np.isfinite(at_cells), axis=1)
-        values = np.where(full, np.where(full[:, None], at_cells, 0.0).mean(axis=1), np.inf)
-        cells = (full | self.cells) if grow else full if decide else self.cells
-        kept = cells & ~full  # in the set, a vertex no longer between faces: held where it was
-        values = np.where(kept, self.model.clearance, values)
-        values[~cells] = np.inf
-        gradient = np.where((cells & full)[:, None, None], normals, 0.0)
+        cells = full if decide else self.cells
+        values = np.where(cells, np.where(cells[:, None], at_cells, 0.0).mean(axis=1), np.inf)
+        g = self.normals.sum(axis=1)  # d c_i / d x_i
+        gradient = np.stack([self.nodes.at_vertices(g[:, k]) for k in range(3)], axis=2)
+        gradient = np.where(cells[:, None, None], gradient, 0.0)
         changed = int(np.sum(cells != self.cells))
         self.cells = cells
         self.model.squeeze(values, gradient)
@@ -106,33 +104,30 @@ class Ironing(Part):
         self.committed = self._copy()
 
     def _copy(self) -> dict:
-        return {"between": self.between.copy(), "facing": self.facing.copy(), "normal": self.normal.copy(),
-                "cells": self.cells.copy(), "clearance": self.model.clearance.copy()}
+        return {"between": self.between.copy(), "pair": self.pair.copy(), "normals": self.normals.copy(),
+                "cells": self.cells.copy(), "last": self.last.copy()}
 
     def start(self, lam: float, predicting: bool) -> None:
         if self.committed is None:  # restored: decided at the restored positions
             self._squeeze(lam, decide=True)
             self.committed = self._copy()
         s = self.committed
-        self.between, self.facing, self.normal = s["between"].copy(), s["facing"].copy(), s["normal"].copy()
-        self.cells = s["cells"].copy()
-        self.model.squeeze(s["clearance"])
+        self.between, self.pair, self.normals = s["between"].copy(), s["pair"].copy(), s["normals"].copy()
+        self.cells, self.last = s["cells"].copy(), s["last"].copy()
+        self._squeeze(lam, decide=False)
 
     def constrain(self, c, lam: float) -> None:
         """No constraint: the set's clearances and their gradients follow this iterate's
         positions (the element's energy depends on them, and its tangent knows it)."""
         self._squeeze(lam, decide=False)
 
-    def pushes(self) -> np.ndarray:
-        """B's push on each owned node at the last evaluation (x, y, z; N): the elements' force on
-        their vertices, a third of each pressed cell's face force along the clearance's gradient
-        there (zero on a cell held in the set whose vertices are no longer all between faces)."""
-        m = self.model
-        share = m.face_forces()[:, None, None] / 3.0 * m.ironed[:, 2:].reshape(-1, 3, 3)
-        return self.nodes.cell_sums(share[:, :, 0], share[:, :, 1], share[:, :, 2])
+    def _shares(self) -> np.ndarray:
+        """Per owned node its share of the pressed cells' face forces at the last evaluation,
+        a third of each (N)."""
+        return self.nodes.cell_sums(self.model.face_forces() / 3.0)[:, 0]
 
     def update(self, lam: float, changes: int) -> Change:
-        n = self._squeeze(lam, decide=True, grow=True)
+        n = self._squeeze(lam, decide=True)
         return Change(changes=n, line=f"ironing: {n} cells between faces changed" if n else "")
 
     def commit(self, lam: float) -> None:
@@ -142,12 +137,15 @@ class Ironing(Part):
         self.committed = None  # decided again from the restored positions at the first start
 
     def face_force(self, tool: int) -> np.ndarray:
-        """The push of `tool`'s face on the nodes it presses between faces (x, y, z; N), all ranks."""
-        on = self.between & (self.facing == tool)
-        return self.model.mesh.comm.allreduce(self.pushes()[on].sum(axis=0), op=MPI.SUM)
+        """The push of `tool`'s face on the nodes it presses between faces (x, y, z; N), all ranks:
+        each node's share along that face's normal (the elements' force on their vertices)."""
+        share = np.where(self.between, self._shares(), 0.0)
+        push = sum((np.where((self.pair[:, k] == tool)[:, None], share[:, None] * self.normals[:, k], 0.0)
+                    for k in range(2)), np.zeros((share.size, 3)))
+        return self.model.mesh.comm.allreduce(push.sum(axis=0), op=MPI.SUM)
 
     def report(self) -> dict:
         comm = self.model.mesh.comm
         pressed = comm.allreduce(int(self.cells.sum()), op=MPI.SUM)
-        push = comm.allreduce(float(np.linalg.norm(self.pushes(), axis=1).sum()), op=MPI.SUM)
+        push = comm.allreduce(float(np.where(self.between, self._shares(), 0.0).sum()), op=MPI.SUM)
         return {"ironed_cells": pressed, "ironing_push": push}
