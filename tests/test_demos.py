@@ -163,7 +163,7 @@ def test_round_cup_scene_is_axisymmetric(tmp_path):
     doubled every Newton iteration; tests/test_contact.py.)"""
     s = scene.load(DEMOS / "round_cup.toml")
     assert (s.tools.punch_half_width, s.tools.punch_corner_radius) == (30.0, 30.0)  # a round punch
-    text = (DEMOS / "round_cup.toml").read_text().replace("stroke = 30.0", "stroke = 15.0")
+    text = (DEMOS / "round_cup.toml").read_text().replace("stroke = 45.0", "stroke = 15.0")
     (tmp_path / "round.toml").write_text(text)
     assert cli.main(["run", str(tmp_path / "round.toml"), "--out", str(tmp_path / "out")]) == 0
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())

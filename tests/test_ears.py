@@ -20,7 +20,7 @@ def round_cup(tmp_path, stroke: float, n: int, r0: float, r45: float, r90: float
     along the radius, the given stroke, and no series or pictures; the scene's path."""
     text = (DEMOS / "round_cup.toml").read_text()
     hill48 = f'\nyield_function = "hill48"\nr0 = {r0}\nr45 = {r45}\nr90 = {r90}\n'
-    for pattern, new in ((r"stroke = 30\.0", f"stroke = {stroke}"), (r"\nn = 12\n", f"\nn = {n}\n"),
+    for pattern, new in ((r"stroke = 45\.0", f"stroke = {stroke}"), (r"\nn = 12\n", f"\nn = {n}\n"),
                          (r"\nr = 0\.41\nm = 2\.0\n", hill48)):
         text, count = re.subn(pattern, new, text)
         assert count == 1, pattern
