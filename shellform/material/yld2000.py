@@ -31,6 +31,10 @@ rho -> sqrt(rho^2 + eps^2 (s11^2 + s22^2 + 2 s12^2)), eps = 1e-12 (a norm of a l
 degree 1 and convexity kept, smooth where rho = 0). a >= 2 is required so that the Hessian
 stays finite where a u_i vanishes.
 
+The alphas are given, fitted exactly to eight data (``fit``), or fitted by least squares to r
+values and yield stresses at any angles (shellform.material.yld2000_fit, which states r(theta)
+and sigma(theta) of a plane-stress yield function).
+
 Parameters (packed at PAR_): the rows of L' and L'' (2 x 2 normal block and the shear entry
 each) and a. ``parameters`` refuses (naming material.alpha) a set whose sigma_bar vanishes for
 some stress (the yield surface is open: the map s -> (rho', rho'', m'') has a kernel) or is
@@ -41,13 +45,14 @@ import math
 
 import numpy as np
 
-from shellform.material import PAR_, number, require
+from shellform.material import PAR_, number, require, yld2000_fit
 from shellform import _jit as jit
 
 NAME = "yld2000"
 PLANAR_ISOTROPIC = False  # the rolling direction matters: the return mapping turns into its axes
 FIT_DATA = ("r0", "r45", "r90", "r_b", "sigma0", "sigma45", "sigma90", "sigma_b")  # what ``fit`` takes
-PARAMETERS = ("alpha", "a") + FIT_DATA  # its scene keys: alpha or the data to fit them, and a
+FIT_LISTS = ("fit_angles", "fit_r", "fit_sigma")  # with sigma_b (and r_b): yld2000_fit's least squares
+PARAMETERS = ("alpha", "a") + FIT_DATA + FIT_LISTS  # its scene keys: alpha or the data to fit them, and a
 EPS2 = 1.0e-24
 
 
@@ -76,20 +81,25 @@ def directions(n=1000) -> np.ndarray:
 
 
 def parameters(values: dict) -> list[float]:
-    """The packed L', L'' and a from alpha (8 numbers), or from the data FIT_DATA (``fit``), and
-    a (>= 2); InputError names the field."""
+    """The packed L', L'' and a from alpha (8 numbers), or from the data FIT_DATA (``fit``), or
+    from the lists FIT_LISTS with sigma_b, r_b (``yld2000_fit.fit``, least squares), and a
+    (>= 2); InputError names the field."""
     require("a" in values, "material.a", "is required by yield_function = 'yld2000' (its exponent: 6 for bcc, "
                                          "8 for fcc metals)")
     a = number("material.a", values["a"])
     require(a >= 2.0, "material.a", f"must be >= 2, got {a}")
     alpha = values.get("alpha")
     if alpha is None:
-        require(any(k in values for k in FIT_DATA), "material.alpha",
+        require(any(k in values for k in FIT_DATA + FIT_LISTS), "material.alpha",
                 f"is required by yield_function = 'yld2000' (alpha1..alpha8, or the data {', '.join(FIT_DATA)} "
-                "to fit them)")
-        alpha = fit(values, a)
+                f"to fit them exactly, or {', '.join(FIT_LISTS)} with sigma_b (and r_b) to fit them by least "
+                "squares)")
+        if yld2000_fit.given(values):
+            alpha = list(yld2000_fit.fit(values, a).alpha)
+        else:
+            alpha = fit(values, a)
     else:
-        for k in FIT_DATA:
+        for k in FIT_LISTS + FIT_DATA:
             require(k not in values, f"material.{k}", "give Yld2000-2d's alpha or the data to fit them, not both")
     require(isinstance(alpha, (list, tuple, np.ndarray)) and len(alpha) == 8, "material.alpha",
             f"must list the 8 coefficients alpha1..alpha8, got {alpha!r}")

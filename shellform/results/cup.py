@@ -97,7 +97,8 @@ def write_rim(outdir: Path, p, title: str) -> dict:
         ax.set_ylabel("radial draw-in R - r (mm)\n(least: an ear)")
         mean, spread = float(rows[:, 1].mean()), float(np.ptp(rows[:, 1]))
         half = max(spread, 0.05 * abs(mean)) * 0.6  # at least +-3 % of the mean: mesh noise stays flat
-        ax.set_ylim(mean - half, mean + half)
+        middle = 0.5 * float(rows[:, 1].min() + rows[:, 1].max())  # not the mean: every node within the axis
+        ax.set_ylim(middle - half, middle + half)
         ax.text(0.01, 0.03, f"spread {spread:.3f} mm = {100 * spread / abs(mean):.2f} % of the mean {mean:.2f} mm"
                 if mean else f"spread {spread:.3f} mm", transform=ax.transAxes, fontsize=8)
         az.plot(rows[:, 0], rows[:, 2], "o-", ms=3)

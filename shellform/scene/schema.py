@@ -118,6 +118,11 @@ class Material:
     sigma90: float = 0.0
     sigma_b: float = 0.0
     alpha: list[float] = field(default_factory=list, metadata={"items": "numbers"})  # yld2000: alpha1..alpha8
+    # yld2000, least squares (with sigma_b, r_b): angles to the rolling direction (degrees, 0 among them),
+    # the r value and the uniaxial yield stress at each (MPa; only the ratios to the one at 0 count)
+    fit_angles: list[float] = field(default_factory=list, metadata={"items": "numbers"})
+    fit_r: list[float] = field(default_factory=list, metadata={"items": "numbers"})
+    fit_sigma: list[float] = field(default_factory=list, metadata={"items": "numbers"})
     a: float = 0.0  # yld2000: the exponent (6 bcc, 8 fcc; >= 2)
 
 

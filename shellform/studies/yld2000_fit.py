@@ -1,0 +1,70 @@
+"""Yld2000-2d fitted by least squares to the ESAFORM 2021 AA6016-T4 data: the errors per angle.
+
+    shellform study yld2000-fit --out docs/results/yld2000_fit        # about 5 s
+
+The data and the exponent are those of demos/esaform2021_cup.toml's [material] (r values and
+yield stresses at 0, 15, ..., 90 degrees to the rolling direction, sigma_b, r_b; their sources
+are in docs/references.md); shellform.material.yld2000_fit states the fit and its weights.
+Writes residuals.csv (quantity, angle, measured, fitted, error: one row per datum),
+alphas.csv and fit.png (r and sigma/sigma0 against the angle, measured and fitted on a
+1-degree grid). tests/test_yld2000_fit.py checks the table against a new fit.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from shellform import scene
+from shellform.material import yld2000_fit
+from shellform.results.log import say
+from shellform.results.tables import write_csv
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENE = ROOT / "demos" / "esaform2021_cup.toml"
+
+
+def fit_of(path=SCENE) -> yld2000_fit.Fit:
+    """The least-squares fit of a scene's [material] (its yield_parameters as the run takes them)."""
+    values = scene.load(path).hill79().yield_parameters
+    return yld2000_fit.fit(values, values["a"])
+
+
+def run(outdir, path=SCENE) -> list[dict]:
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    fit = fit_of(path)
+    rows = list(fit.rows)
+    write_csv(outdir / "residuals.csv", rows, yld2000_fit.COLUMNS)
+    write_csv(outdir / "alphas.csv", [{"name": f"alpha{i + 1}", "value": x} for i, x in enumerate(fit.alpha)]
+              + [{"name": "a", "value": fit.a}], ["name", "value"])
+    for r in rows:
+        angle = f"{r['angle_deg']:4.0f}" if r["angle_deg"] != "" else "    "
+        say(f"{r['quantity']:>15s} {angle}  measured {r['measured']:.4f}  fitted {r['fitted']:.4f}  "
+            f"error {r['error']:+.4f}")
+    say(fit.text)
+    plot(outdir / "fit.png", fit)
+    return rows
+
+
+def plot(path: Path, fit: yld2000_fit.Fit) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    theta = np.linspace(0.0, 90.0, 91)
+    sigma, r, _, _ = yld2000_fit.predicted(fit.alpha, fit.a, theta)
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.6))
+    for ax, quantity, curve, label in ((axes[0], "r", r, "r value"),
+                                       (axes[1], "sigma/sigma0", sigma / sigma[0], "sigma / sigma0")):
+        data = [row for row in fit.rows if row["quantity"] == quantity]
+        ax.plot([row["angle_deg"] for row in data], [row["measured"] for row in data], "ko", label="measured")
+        ax.plot(theta, curve, "C0-", label=f"Yld2000-2d, a = {fit.a:g}, least squares")
+        ax.set_xlabel("angle to the rolling direction (degrees)")
+        ax.set_ylabel(label)
+        ax.set_xticks(range(0, 91, 15))
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
