@@ -17,7 +17,6 @@ from pathlib import Path
 
 import shellform  # noqa: F401  (DOLFINx runtime first)
 
-import numba
 import numpy as np
 from mpi4py import MPI
 
@@ -27,7 +26,8 @@ parser.add_argument("--stroke", type=float, default=12.0)
 parser.add_argument("--capture", type=Path, default=Path("/tmp/section_states.pkl"))
 args = parser.parse_args()
 
-KEYS = ("strain", "material", "thickness", "plastic", "finite", "zeta", "wz", "ep_n", "p_n", "lever", "ep", "p")
+KEYS = ("strain", "taper", "material", "thickness", "plastic", "finite", "zeta", "wz", "ep_n", "p_n", "lever", "ep",
+        "p")
 
 if not args.capture.exists():
     import shellform.nonlinear.model as model
@@ -51,21 +51,20 @@ from shellform.material.update import section_update  # noqa: E402
 records = pickle.loads(args.capture.read_bytes())
 
 
-def sweep() -> float:
+def sweep(threads: int) -> float:
     total = 0.0
     for r in records:
         nc, nq = r["strain"].shape[:2]
         ep, p = r["ep"].copy(), r["p"].copy()  # the last state: the warm start
         out = np.ones((nc, nq)), np.zeros((nc, nq, 6)), np.zeros((nc, nq, 6, 6))
         t0 = time.perf_counter()
-        section_update(*(r[k] for k in KEYS[:10]), ep, p, *out)
+        section_update(*(r[k] for k in KEYS[:11]), ep, p, *out, threads=threads)
         total += time.perf_counter() - t0
     return 1e3 * total / len(records)
 
 
 layers = sum(r["p_n"].size for r in records) / len(records)
 for threads in (1, 2):
-    numba.set_num_threads(threads)
-    sweep()
+    sweep(threads)
     print(f"{len(records)} section updates of {layers:.0f} layers, {threads} thread(s): "
-          f"{min(sweep() for _ in range(5)):.1f} ms per evaluation")
+          f"{min(sweep(threads) for _ in range(5)):.1f} ms per evaluation")

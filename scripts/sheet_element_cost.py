@@ -13,7 +13,6 @@ import time
 
 import shellform  # noqa: F401  (DOLFINx runtime first)
 
-import numba
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
@@ -36,17 +35,16 @@ for extra in ((), ("assumed_membrane",)):
     q.x.array[:] = 1e-3 * np.random.default_rng(0).standard_normal(q.x.array.size)
     m.evaluate(q)  # compile and warm up
     k = m.kernels
-    numba.set_num_threads(m.threads)
     times = []
     for want_tangent in (None, False, True):
         t0 = time.perf_counter()
         for _ in range(args.repeat):
             if want_tangent is None:
-                k.strain_loop(m.cells, m.cell_coords, m.dofs, q.x.array, m.P, m.consts, m.beta, m.tying, m.z, m.strain)
+                k.strain_loop(m.threads, m.cells, m.cell_coords, m.dofs, q.x.array, m.P, m.consts, m.beta, m.tying, m.z,
+                              m.strain)
             else:
-                k.tensor_loop(m.cells, m.cell_coords, m.P, m.consts, m.beta, m.tying, m.z, m.resultants, m.tangents,
-                              m.ironed_d, m.ironed,
-                              want_tangent, m.forms.vectors, m.forms.matrices)
+                k.tensor_loop(m.threads, m.cells, m.cell_coords, m.P, m.consts, m.beta, m.tying, m.z, m.resultants,
+                              m.tangents, m.ironed_d, m.ironed, want_tangent, m.forms.vectors, m.forms.matrices)
         times.append((time.perf_counter() - t0) / args.repeat * 1e3)
     name = "assumed" if extra else "compatible"
     print(f"{name:10s} {m.num_cells} cells, {m.threads} threads: strain loop {times[0]:.1f} ms, force only "

@@ -1,8 +1,9 @@
 """The constitutive update's cost per layer for each yield function (docs/material.md: cost).
 
-    NUMBA_NUM_THREADS=1 python scripts/yield_function_cost.py
+    python scripts/yield_function_cost.py
 
-Times shellform.material.update.section_update (the sheet's material loop, finite strains) on
+Times shellform.material.update.section_update (the sheet's material loop, finite strains, one
+thread) on
 2,000 cells x 3 quadrature points x 5 layers, every layer plastic from a virgin state (the
 local Newton from its radial start), the least process CPU time of 7 runs after a warm-up
 (CPU time: a machine shared with other jobs slows the wall clock, less the CPU time), and
@@ -47,7 +48,8 @@ def main():
     zeta, wz = through_thickness_rule(NZ)
     for name, material in materials().items():
         mat = material.pack()
-        args = lambda: (e, mat, 0.8, True, True, zeta, wz, np.zeros((CELLS, QP, NZ, 3)),  # noqa: E731
+        args = lambda: (e, np.zeros((CELLS, QP, 3)), mat, 0.8, True, True, zeta, wz,  # noqa: E731
+                        np.zeros((CELLS, QP, NZ, 3)),
                         np.zeros((CELLS, QP, NZ)), np.ones((CELLS, QP)), np.zeros((CELLS, QP, NZ, 3)),
                         np.zeros((CELLS, QP, NZ)), np.ones((CELLS, QP)), np.zeros((CELLS, QP, 6)),
                         np.zeros((CELLS, QP, 6, 6)))

@@ -20,9 +20,12 @@ by machines of other CPUs never loads code their CPU cannot run.
 
 import hashlib
 import os
+import threading
+from concurrent.futures import ThreadPoolExecutor, wait
 from pathlib import Path
 
 import numba
+import numpy as np
 from llvmlite import binding, ir
 from numba import types
 from numba.extending import intrinsic
@@ -126,3 +129,67 @@ def kernel_address(kernel) -> int:
     import cffi
 
     return int(cffi.FFI().cast("uintptr_t", kernel))
+
+
+CHUNK = 16  # cells a thread takes at a time from a loop's shared counter (next_chunk)
+
+_pool, _pool_size, _pool_lock = None, 0, threading.Lock()
+
+
+def over_threads(share, nt: int, *args) -> list:
+    """[share(counter, *args) on each of nt threads], run at once: one on the calling thread,
+    the others on a pool of nt - 1 threads kept for the process. ``share`` is a numba function
+    compiled with nogil=True that takes the chunks of its loop from the shared counter
+    (next_chunk) until none is left, so the threads run on separate cores and one that starts
+    late or is held up does fewer chunks. Plain numba functions on a Python pool instead of
+    numba's parallel=True: numba compiles a prange loop through its parfor passes, which cost
+    more compile time than the loops themselves (docs/performance.md, issue 44). Returns once
+    every share has ended; an error of a share is raised after that."""
+    counter = np.zeros(1, dtype=np.int64)
+    if nt <= 1:
+        return [share(counter, *args)]
+    global _pool, _pool_size
+    with _pool_lock:
+        if _pool_size < nt - 1:
+            if _pool is not None:
+                _pool.shutdown(wait=False)
+            _pool, _pool_size = ThreadPoolExecutor(nt - 1, thread_name_prefix="shellform-cells"), nt - 1
+        pool = _pool
+    futures = [pool.submit(share, counter, *args) for _ in range(1, nt)]
+    try:
+        first = share(counter, *args)
+    finally:
+        wait(futures)  # every share ends before the arrays are touched again
+    return [first] + [f.result() for f in futures]
+
+
+@intrinsic
+def next_chunk(typingctx, counter):
+    """The first item of the next chunk of CHUNK items of a loop whose threads share `counter`
+    (an int64 array, its element 0 the next item not yet taken): an atomic add. The loop ends
+    where this is past its last item."""
+    if not (isinstance(counter, types.Array) and counter.dtype == types.int64):
+        return None
+
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        return builder.atomic_rmw("add", ary.data, ir.Constant(ir.IntType(64), CHUNK), "seq_cst")
+
+    return types.int64(counter), codegen
+
+
+@intrinsic
+def borrowed(typingctx, a):
+    """The array `a` without its reference count (its meminfo NULL): the views taken from it in
+    a loop then count no references either (an atomic add to the array's one counter per view,
+    which threads working on the same array contend for). Only for an array that its caller
+    keeps alive for the call, and never returned or stored."""
+    if not isinstance(a, types.Array):
+        return None
+
+    def codegen(context, builder, signature, args):
+        ary = context.make_array(signature.args[0])(context, builder, args[0])
+        ary.meminfo = context.get_constant_null(types.MemInfoPointer(types.voidptr))
+        return ary._getvalue()
+
+    return a(a), codegen

@@ -11,7 +11,8 @@ Compiled once per (effects, quadrature degree) on a mesh-free domain, like Eleme
     gradient, geometric          B = de/dz at the points, int S . d2e (the assumed membrane strain)
 
 Two numba loops over the owned cells do the element around the constitutive update (which is
-shellform.material.section.update, a loop of its own so that its time is measured apart):
+shellform.material.update.section_update, a loop of its own so that its time is measured apart),
+each in shares of the cells run on threads at once (shellform._jit.over_threads):
 
     strain_loop   gather the carrier values q, map them (z = Q q), strains e at the points
                   (the membrane rows tied to the edges: shellform.assembly.assumed_membrane)
@@ -20,10 +21,8 @@ shellform.material.section.update, a loop of its own so that its time is measure
 Assembly is DOLFINx's (shellform.nonlinear.assemble).
 """
 
-import functools
 
 import basix.ufl
-import numba
 import numpy as np
 import ufl
 from dolfinx.jit import ffcx_jit
@@ -162,21 +161,21 @@ class SheetKernels:
                    el.sym_dim, cells_coords, P_out, F_out)
 
     def _strain_loop(self):
+        """strain_loop(threads, cells, ...): the loop's shares on `threads` threads."""
         el = self.element
-        bound = functools.partial(strain_loop, kernel_address(self.strain), kernel_address(self.edge_strain),
-                                  *el.q_map(), el.component_columns(), el.nz, self.nconst)
-        return lambda *args: bound(numba.get_num_threads(), *args)
+        bound = (kernel_address(self.strain), kernel_address(self.edge_strain), *el.q_map(), el.component_columns(),
+                 el.nz, self.nconst)
+        return lambda threads, *args: jit.over_threads(strain_loop, threads, *bound, *args)
 
     def _tensor_loop(self):
+        """tensor_loop(threads, cells, ...): the loop's shares on `threads` threads."""
         el = self.element
         geometric = kernel_address(self.geometric) if self.geometric is not None else 0
         go = self.geometric_offsets if self.geometric is not None else self.tangent_offsets
-        bound = functools.partial(tensor_loop, kernel_address(self.force), kernel_address(self.tangent), geometric,
-                                  kernel_address(self.gradient), kernel_address(self.edge_gradient), self.force_offsets,
-                                  self.tangent_offsets, go,
-                                  *el.q_map(), el.component_columns(), el.nz, el.nqp, self.nconst, self.edge_gradients,
-                                  el.weights)
-        return lambda *args: bound(numba.get_num_threads(), *args)
+        bound = (kernel_address(self.force), kernel_address(self.tangent), geometric, kernel_address(self.gradient),
+                 kernel_address(self.edge_gradient), self.force_offsets, self.tangent_offsets, go, *el.q_map(),
+                 el.component_columns(), el.nz, el.nqp, self.nconst, self.edge_gradients, el.weights)
+        return lambda threads, *args: jit.over_threads(tensor_loop, threads, *bound, *args)
 
 
 # -- numba loops (cached: the kernels come in as addresses) ------------------------------------
@@ -218,41 +217,50 @@ def setup_loop(hc, hf, pk, iq, ie, il, hcols, hcodes, qcols, qcodes, ccols, nzh,
                         CT[a, hcols[r, k]] += C[a, r] * coef[r, k]
         CT *= -1.0
         condensation.cholesky_solve(condensation.cholesky(G), CT)
-        P_out[cidx] = CT
+        for a in range(ns):
+            for b in range(9):
+                P_out[cidx, a, b] = CT[a, b]
         build_q(J, P_out[cidx], qcols, qcodes, ccols, Q)
         fz[:] = 0.0
         local[0] = 0
         jit.call_kernel(pk, fz, wz, one, coords, local, perm)
-        F_out[cidx, :] = Q.T @ fz
+        np.dot(Q.T, fz, F_out[cidx])
 
 
 @jit.njit
 def _scratch(consts, nconst):
     """A loop's per-thread buffers: the constants and the kernel's index arguments."""
     c = np.zeros(max(nconst, 1))
-    c[:nconst] = consts[:nconst]
+    for i in range(nconst):
+        c[i] = consts[i]
     return c, np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.uint8)
 
 
-@jit.njit(parallel=True)
-def strain_loop(strain, edge_strain, qcols, qcodes, ccols, nz, nconst, nt, cells, cells_coords, dofs, x, P, consts,
+@jit.njit(nogil=True)
+def strain_loop(counter, strain, edge_strain, qcols, qcodes, ccols, nz, nconst, cells, cells_coords, dofs, x, P, consts,
                 beta, tying, z_out, e_out):
-    """z = Q q and the section strains e at the quadrature points of every cell (the cells dealt
-    out to the nt threads, each with its own buffers); the membrane rows are the assumed
-    membrane strain where beta < 1 (assumed_membrane)."""
-    for t in numba.prange(nt):
-        Q = np.zeros((nz, NDOF))
-        q = np.empty(NDOF)
-        E_edge = np.zeros((9, 3))
-        c, local, perm = _scratch(consts, nconst)
-        for k in range(t, cells.size, nt):
+    """z = Q q and the section strains e at the quadrature points of the cells, a chunk of them
+    at a time from the threads' shared counter (jit.over_threads, jit.next_chunk); the membrane
+    rows are the assumed membrane strain where beta < 1 (assumed_membrane)."""
+    # the views taken below count no references (jit.borrowed)
+    cells, cells_coords, dofs, x, P = jit.borrowed(cells), jit.borrowed(cells_coords), jit.borrowed(dofs), \
+        jit.borrowed(x), jit.borrowed(P)
+    beta, tying, z_out, e_out = jit.borrowed(beta), jit.borrowed(tying), jit.borrowed(z_out), jit.borrowed(e_out)
+    Q = np.zeros((nz, NDOF))
+    q = np.empty(NDOF)
+    E_edge = np.zeros((9, 3))
+    c, local, perm = _scratch(consts, nconst)
+    n = cells.size
+    start = jit.next_chunk(counter)
+    while start < n:
+        for k in range(start, min(start + jit.CHUNK, n)):
             cidx = cells[k]
             coords = cells_coords[cidx]
             build_q(slope_map.jacobian(coords), P[cidx], qcols, qcodes, ccols, Q)
             for v in range(3):
                 for b in range(9):
                     q[9 * v + b] = x[9 * dofs[cidx, v] + b]
-            z_out[k, :] = Q @ q
+            np.dot(Q, q, z_out[k])
             e = e_out[k].ravel()
             e[:] = 0.0
             jit.call_kernel(strain, e, z_out[k], c, coords, local, perm)
@@ -260,61 +268,72 @@ def strain_loop(strain, edge_strain, qcols, qcodes, ccols, nz, nconst, nt, cells
                 E_edge[:, :] = 0.0
                 jit.call_kernel(edge_strain, E_edge.reshape(E_edge.size), z_out[k], c, coords, local, perm)
                 assumed_membrane.assumed_strain(E_edge, tying[cidx], beta[cidx], e_out[k])
+        start = jit.next_chunk(counter)
 
 
 @jit.njit
 def _pack(w, offsets, nz, nqp, z, S, D):
-    if offsets[0] >= 0:
-        w[offsets[0]: offsets[0] + nz] = z
-    if offsets[1] >= 0:
-        w[offsets[1]: offsets[1] + 6 * nqp] = S
-    if offsets[2] >= 0:
-        w[offsets[2]: offsets[2] + 36 * nqp] = D
+    """The kernel's coefficients z, S and D at their offsets in w (those it has)."""
+    for offset, v in ((offsets[0], z), (offsets[1], S), (offsets[2], D)):
+        if offset >= 0:
+            for i in range(v.size):
+                w[offset + i] = v[i]
 
 
-@jit.njit(parallel=True)
-def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp, nconst,
-                grads, weights, nt, cells, cells_coords, P, consts, beta, tying, z, S, D, ironed_d, ironed,
+@jit.njit(nogil=True)
+def tensor_loop(counter, force, tangent, geometric, gradient, edge_gradient, fo, to, go, qcols, qcodes, ccols, nz, nqp,
+                nconst, grads, weights, cells, cells_coords, P, consts, beta, tying, z, S, D, ironed_d, ironed,
                 want_tangent, R_out, K_out):
-    """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for every cell (the cells dealt out to the
-    nt threads, each with its own buffers). Where beta < 1 the membrane strain is the assumed one
-    (shellform.assembly.assumed_membrane, whose docstring has the terms). Where the tools' faces
-    press a cell (shellform.material.ironing: ironed[:, 0] phi'' > 0, ironed[:, 1] phi',
-    ironed[:, 2:] the clearance's gradient n_i at its three vertices, ironed_d d_g at its points),
-    r gets the faces' push -phi' A0 / 3 n_i on each vertex's u, v, w and K the rank-one
-    phi'' / A0 v v^T, v = Q^T G - A0 / 3 sum_i n_i (vertex i's rows), G = sum_g A0 w_g B_g^T d_g."""
-    for t in numba.prange(nt):
-        Q = np.zeros((nz, NDOF))
-        w = np.zeros(nz + 42 * nqp)
-        rz = np.zeros(nz)
-        Kz = np.zeros((nz, nz))
-        QtK, KQ = np.zeros((NDOF, nz)), np.zeros((nz, NDOF))
-        Sp = np.zeros((nqp, 6))
-        B, Bm = np.zeros((nqp, 6, nz)), np.zeros((9, 3, nz))
-        Bt, DB, wdet = np.zeros((6 * nqp, nz)), np.zeros((6 * nqp, nz)), np.zeros(nqp)
-        sigma = np.zeros((9, 3))
-        G = np.zeros(nz)
-        v = np.zeros(NDOF)
-        c, local, perm = _scratch(consts, nconst)
-        for k in range(t, cells.size, nt):
+    """r = Q^T r_z(z, S) and K = Q^T K_z(z, S, D) Q for the cells, a chunk of them at a time
+    from the threads' shared counter (jit.over_threads, jit.next_chunk). Where beta < 1 the
+    membrane strain is the assumed one (shellform.assembly.assumed_membrane, whose docstring has
+    the terms). Where the tools' faces press a cell (shellform.material.ironing: ironed[:, 0]
+    phi'' > 0, ironed[:, 1] phi', ironed[:, 2:] the clearance's gradient n_i at its three
+    vertices, ironed_d d_g at its points), r gets the faces' push -phi' A0 / 3 n_i on each
+    vertex's u, v, w and K the rank-one phi'' / A0 v v^T, v = Q^T G - A0 / 3 sum_i n_i (vertex
+    i's rows), G = sum_g A0 w_g B_g^T d_g."""
+    # the views taken below count no references (jit.borrowed)
+    cells, cells_coords, P, beta, tying = jit.borrowed(cells), jit.borrowed(cells_coords), jit.borrowed(P), \
+        jit.borrowed(beta), jit.borrowed(tying)
+    z, S, D, R_out, K_out = jit.borrowed(z), jit.borrowed(S), jit.borrowed(D), jit.borrowed(R_out), jit.borrowed(K_out)
+    ironed_d, ironed = jit.borrowed(ironed_d), jit.borrowed(ironed)
+    Q = np.zeros((nz, NDOF))
+    w = np.zeros(nz + 42 * nqp)
+    rz = np.zeros(nz)
+    Kz = np.zeros((nz, nz))
+    QtK, KQ = np.zeros((NDOF, nz)), np.zeros((nz, NDOF))
+    Sp = np.zeros((nqp, 6))
+    B, Bm = np.zeros((nqp, 6, nz)), np.zeros((9, 3, nz))
+    Bt, DB, wdet = np.zeros((6 * nqp, nz)), np.zeros((6 * nqp, nz)), np.zeros(nqp)
+    sigma = np.zeros((9, 3))
+    G = np.zeros(nz)
+    v = np.zeros(NDOF)
+    c, local, perm = _scratch(consts, nconst)
+    n = cells.size
+    start = jit.next_chunk(counter)
+    while start < n:
+        for k in range(start, min(start + jit.CHUNK, n)):
             cidx = cells[k]
             coords = cells_coords[cidx]
             J = slope_map.jacobian(coords)
             build_q(J, P[cidx], qcols, qcodes, ccols, Q)
             bk = beta[cidx]
             assumed = bk < 1.0
-            Sp[:, :] = S[k]
+            for g in range(nqp):
+                for a in range(6):
+                    Sp[g, a] = S[k, g, a] * bk if assumed and a < 3 else S[k, g, a]
             rz[:] = 0.0
             if assumed:
-                Sp[:, :3] *= bk
-                wdet[:] = weights * abs(slope_map.determinant(J))
+                detJ = abs(slope_map.determinant(J))
+                for g in range(nqp):
+                    wdet[g] = weights[g] * detJ
                 assumed_membrane.tied_stress(S[k], wdet, tying[cidx], sigma)
                 Bm[:, :, :] = 0.0
                 jit.call_kernel(edge_gradient, Bm.reshape(Bm.size), z[k], c, coords, local, perm)
                 assumed_membrane.tied_force(Bm, sigma, 1.0 - bk, rz)
             _pack(w, fo, nz, nqp, z[k], Sp.ravel(), D[k].ravel())
             jit.call_kernel(force, rz, w, c, coords, local, perm)
-            R_out[k, :] = Q.T @ rz
+            np.dot(Q.T, rz, R_out[k])
             pressed = ironed[k, 0] > 0.0
             if pressed:
                 area = 0.5 * abs(slope_map.determinant(J))
@@ -361,3 +380,4 @@ def tensor_loop(force, tangent, geometric, gradient, edge_gradient, fo, to, go, 
                 for i in range(NDOF):
                     for j in range(NDOF):
                         K_out[k, i, j] += f * v[i] * v[j]
+        start = jit.next_chunk(counter)

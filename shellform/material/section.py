@@ -45,7 +45,7 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, p_w, w):
         if not hencky.log_strain(e, eps, P, W):
             return p_n, -1, 0.0
     else:
-        eps[:] = e
+        eps[0], eps[1], eps[2] = e[0], e[1], e[2]
     (t0, t1, t2, d00, d01, d02, d11, d12, d22, q0, q1, q2, p, st) = return_core(
         eps[0], eps[1], eps[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat, ep_new[0], ep_new[1], ep_new[2], p_w)
     ep_new[0], ep_new[1], ep_new[2] = q0, q1, q2

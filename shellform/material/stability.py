@@ -46,7 +46,6 @@ reported), a tensile one takes from it.
 
 import math
 
-import numba
 import numpy as np
 
 from shellform import _jit as jit
@@ -98,19 +97,32 @@ def membrane_stiffness(E, N, A, M):
     return True
 
 
-@jit.njit(parallel=True)
-def membrane_stability(strain, resultants, tangents, thickness, out):
+def membrane_stability(strain, resultants, tangents, thickness, out, threads=1):
     """Per cell (out, cells): the least over its quadrature points of the smallest eigenvalue of
     membrane_stiffness over the initial thickness (stress units; <= 0: the material point may
     neck). strain (cells, points, 6), resultants (cells, points, 6) and tangents (cells, points,
     6, 6) of the sections (shellform.nonlinear.model.SheetModel); NaN where a point's C is not
-    positive definite."""
-    for c in numba.prange(strain.shape[0]):
-        M = np.empty((3, 3))  # scratch, once per cell
-        least = math.inf
-        for g in range(strain.shape[1]):
-            if not membrane_stiffness(strain[c, g, :3], resultants[c, g, :3], tangents[c, g, :3, :3], M):
-                least = math.nan
-                break
-            least = min(least, smallest_eigenvalue(M[0, 0], M[0, 1], M[0, 2], M[1, 1], M[1, 2], M[2, 2]))
-        out[c] = least / thickness
+    positive definite. On `threads` threads."""
+    jit.over_threads(stability_share, threads, strain, resultants, tangents, thickness, out)
+
+
+@jit.njit(nogil=True)
+def stability_share(counter, strain, resultants, tangents, thickness, out):
+    """membrane_stability on the cells, a chunk of them at a time from the threads' shared
+    counter (jit.over_threads, jit.next_chunk)."""
+    # the views taken below count no references (jit.borrowed)
+    strain, resultants, tangents, out = jit.borrowed(strain), jit.borrowed(resultants), jit.borrowed(tangents), \
+        jit.borrowed(out)
+    M = np.empty((3, 3))  # scratch
+    n = strain.shape[0]
+    start = jit.next_chunk(counter)
+    while start < n:
+        for c in range(start, min(start + jit.CHUNK, n)):
+            least = math.inf
+            for g in range(strain.shape[1]):
+                if not membrane_stiffness(strain[c, g, :3], resultants[c, g, :3], tangents[c, g, :3, :3], M):
+                    least = math.nan
+                    break
+                least = min(least, smallest_eigenvalue(M[0, 0], M[0, 1], M[0, 2], M[1, 1], M[1, 2], M[2, 2]))
+            out[c] = least / thickness
+        start = jit.next_chunk(counter)

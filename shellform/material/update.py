@@ -20,41 +20,60 @@ along the very direction in which the sheet unloads elastically.
 
 import math
 
-import numba
 import numpy as np
 
 from shellform.material import section
 from shellform import _jit as jit
 
 
-@jit.njit(parallel=True)
 def section_update(e, taper, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, lever_stretch, ep, p, stretch,
-                   S, D, elastic_tangent=False):
+                   S, D, elastic_tangent=False, threads=1):
+    """Every cell's sections, on `threads` threads (update_share); returns the counts (plastic
+    layers, failed layers, points past the guard)."""
+    counts = jit.over_threads(update_share, threads, e, taper, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n,
+                              lever_stretch, ep, p, stretch, S, D, elastic_tangent)
+    return tuple(sum(c[i] for c in counts) for i in range(3))
+
+
+@jit.njit(nogil=True)
+def update_share(counter, e, taper, mat, thickness, plastic, finite, zeta, wz, ep_n, p_n, lever_stretch, ep, p,
+                 stretch, S, D, elastic_tangent):
+    """The sections of the cells, a chunk of them at a time from the threads' shared counter
+    (jit.over_threads, jit.next_chunk); returns this thread's counts."""
+    # the views taken below count no references (jit.borrowed)
+    e, taper, mat, zeta, wz = jit.borrowed(e), jit.borrowed(taper), jit.borrowed(mat), jit.borrowed(zeta), \
+        jit.borrowed(wz)
+    ep_n, p_n, lever_stretch = jit.borrowed(ep_n), jit.borrowed(p_n), jit.borrowed(lever_stretch)
+    ep, p, stretch, S, D = jit.borrowed(ep), jit.borrowed(p), jit.borrowed(stretch), jit.borrowed(S), jit.borrowed(D)
     nplastic, nfail, nguard = 0, 0, 0
-    for c in numba.prange(e.shape[0]):  # cells are independent: threads share them
-        w = np.zeros((4, 16))  # scratch, once per cell
-        zero, k = np.zeros(3), np.zeros(3)
-        for g in range(e.shape[1]):
-            em = e[c, g, :3]
-            for a in range(3):
-                k[a] = e[c, g, 3 + a] - taper[c, g, a]
-            Sg, Dg = S[c, g], D[c, g]
-            size, real = 0.0, True  # real: every strain finite
-            for a in range(3):
-                size = max(size, abs(em[a]), abs(k[a]) * thickness)
-                real = real and math.isfinite(em[a]) and math.isfinite(k[a])
-            if not real or size > 10.0:  # the strain guard: no material takes 1000 %
-                nguard += 1
-                section.elastic_section(zero, zero, thickness, mat, Sg, Dg)
-            elif plastic:
-                lever = thickness * lever_stretch[c, g] if finite else thickness
-                st, e33 = section.section_response(em, k, thickness, lever, zeta, wz, ep_n[c, g], p_n[c, g],
-                                                   mat, finite, elastic_tangent, Sg, Dg, ep[c, g], p[c, g], w)
-                stretch[c, g] = math.exp(e33) if finite else 1.0
-                if st < 0:
-                    nfail += 1
+    w = np.zeros((4, 16))  # scratch
+    zero, k = np.zeros(3), np.zeros(3)
+    n = e.shape[0]
+    start = jit.next_chunk(counter)
+    while start < n:
+        for c in range(start, min(start + jit.CHUNK, n)):
+            for g in range(e.shape[1]):
+                em = e[c, g, :3]
+                for a in range(3):
+                    k[a] = e[c, g, 3 + a] - taper[c, g, a]
+                Sg, Dg = S[c, g], D[c, g]
+                size, real = 0.0, True  # real: every strain finite
+                for a in range(3):
+                    size = max(size, abs(em[a]), abs(k[a]) * thickness)
+                    real = real and math.isfinite(em[a]) and math.isfinite(k[a])
+                if not real or size > 10.0:  # the strain guard: no material takes 1000 %
+                    nguard += 1
+                    section.elastic_section(zero, zero, thickness, mat, Sg, Dg)
+                elif plastic:
+                    lever = thickness * lever_stretch[c, g] if finite else thickness
+                    st, e33 = section.section_response(em, k, thickness, lever, zeta, wz, ep_n[c, g], p_n[c, g],
+                                                       mat, finite, elastic_tangent, Sg, Dg, ep[c, g], p[c, g], w)
+                    stretch[c, g] = math.exp(e33) if finite else 1.0
+                    if st < 0:
+                        nfail += 1
+                    else:
+                        nplastic += st
                 else:
-                    nplastic += st
-            else:
-                section.elastic_section(em, k, thickness, mat, Sg, Dg)
+                    section.elastic_section(em, k, thickness, mat, Sg, Dg)
+        start = jit.next_chunk(counter)
     return nplastic, nfail, nguard

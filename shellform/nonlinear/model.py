@@ -154,15 +154,14 @@ class SheetModel:
     def evaluate(self, q: fem.Function, tangent: bool = True, elastic_tangent: bool = False) -> Evaluation:
         """Element forces (and tangents) at the carrier state q, into the copy forms."""
         k = self.kernels
-        numba.set_num_threads(self.threads)
         t0 = time.perf_counter()
-        k.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta, self.tying,
-                      self.z, self.strain)
+        k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta,
+                      self.tying, self.z, self.strain)
         t1 = time.perf_counter()
         nplastic, nfail, nguard = section_update(
             self.strain, self.taper, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
             self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
-            elastic_tangent)
+            elastic_tangent, self.threads)
         if self.ironing:
             self.pressed, failed = ironing.squeeze(self.strain, self.clearance, self.thickness, self.modulus33,
                                                    2.0 * self.kernels.element.weights, self.resultants, self.tangents,
@@ -176,9 +175,8 @@ class SheetModel:
     def tensor_arrays(self, tangent: bool) -> None:
         """The element vectors (and tangents) from the last evaluation's strains, stresses and
         section tangents: with tangent=True after an evaluation without, its K alone."""
-        numba.set_num_threads(self.threads)
-        self.kernels.tensor_loop(self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, self.z,
-                                 self.resultants, self.tangents, self.ironed_d, self.ironed, tangent,
+        self.kernels.tensor_loop(self.threads, self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying,
+                                 self.z, self.resultants, self.tangents, self.ironed_d, self.ironed, tangent,
                                  self.forms.vectors, self.forms.matrices)
 
     def squeeze(self, clearance: np.ndarray, gradient: np.ndarray | None = None) -> None:
@@ -212,8 +210,8 @@ class SheetModel:
         stability at it (membrane_stability), from the converged iterate's strains, resultants
         and tangents (an elastic one does not neck: nothing watches it)."""
         if self.plastic:
-            numba.set_num_threads(self.threads)
-            membrane_stability(self.strain, self.resultants, self.tangents, self.thickness, self.stability_n)
+            membrane_stability(self.strain, self.resultants, self.tangents, self.thickness, self.stability_n,
+                               self.threads)
         self.ep_n[...] = self.ep
         self.p_n[...] = self.p
         self.stretch_n[...] = self.stretch
@@ -238,8 +236,8 @@ class SheetModel:
         strain = self.strain
         if q is not None:
             strain = np.zeros_like(self.strain)
-            self.kernels.strain_loop(self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta,
-                                     self.tying, np.zeros_like(self.z), strain)
+            self.kernels.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q.x.array, self.P,
+                                     self.consts, self.beta, self.tying, np.zeros_like(self.z), strain)
         self.taper[cells] = strain[cells, :, 3:]
         self.state_version += 1
 
