@@ -9,7 +9,8 @@ worker threads spin for about 2^28 cycles (a tenth of a second) on the cores tha
 and material loops' threads need next. MUMPS gains nothing from a second BLAS thread on the
 cup's tangents (the solve took 8.1 to 8.3 s either way on 2,450 cells to 8 mm), while the
 spinning slowed the element loop by a third (6.1 -> 9.0 s; docs/performance.md). Parallel work
-goes through numba's threads over the cells and MPI ranks.
+goes through the element and material loops' threads over the cells (shellform._jit.over_threads)
+and MPI ranks.
 """
 
 import os

@@ -16,6 +16,14 @@ that the loops around them hold no address of this process and can be cached too
 compiled for this CPU (-O3 -march=native: the sheet's tangent kernel 27-29 -> 22-24 us per
 cell) into a cache of this CPU model's own (FFCX_JIT_OPTIONS), so that a home directory shared
 by machines of other CPUs never loads code their CPU cannot run.
+
+The loops over the cells run on threads without numba's parallel=True: each is a numba function
+compiled with nogil=True that takes chunks of cells from a counter its threads share
+(next_chunk), run at once on a small pool of Python threads (over_threads), and it takes its
+arrays without their reference counts (borrowed), so that its threads do not contend for them.
+What a cold first run compiles is kept small (docs/performance.md, "Where a cold first run's time
+goes"): no parfor passes, no formatted error messages (no array-from-array slice assignment,
+whose shape check formats one), division by zero as numpy's (OPTIONS).
 """
 
 import hashlib
@@ -81,15 +89,22 @@ def _ffcx_cache_dir() -> Path:
 FFCX_JIT_OPTIONS = {"cffi_extra_compile_args": ["-O3", "-g0", "-march=native"], "cache_dir": _ffcx_cache_dir()}
 
 
+# numba options of every function of the package unless it names others: a division by zero
+# gives inf or nan, as numpy's (the material loops report a point that is not finite; numba's
+# default raises ZeroDivisionError, a check and an exception path compiled at every division),
+# and no C callback wrapper (no function is passed to C as a cfunc)
+OPTIONS = {"error_model": "numpy", "no_cfunc_wrapper": True}
+
+
 def njit(*args, **options):
-    """numba.njit(cache=True, ...) with the cache in shellform's source-keyed folder (numba binds
-    a function to its cache folder when it is decorated)."""
+    """numba.njit(cache=True, **OPTIONS, ...) with the cache in shellform's source-keyed folder
+    (numba binds a function to its cache folder when it is decorated)."""
 
     def decorate(f):
         saved = numba.config.CACHE_DIR
         numba.config.CACHE_DIR = _CACHE_DIR
         try:
-            return numba.njit(cache=True, **options)(f)
+            return numba.njit(cache=True, **{**OPTIONS, **options})(f)
         finally:
             numba.config.CACHE_DIR = saved
 

@@ -101,8 +101,8 @@ def _parser() -> argparse.ArgumentParser:
 
 def limit_threads(n: int | None) -> None:
     """Cap the element and material loops' threads: shellform.nonlinear.model.use_cores reads
-    SHELLFORM_THREADS when a model is built. (Not NUMBA_NUM_THREADS: numba re-reads it at each
-    compilation and refuses a change once its threads have started.)"""
+    SHELLFORM_THREADS when a model is built. (Not NUMBA_NUM_THREADS: numba reads it once, when
+    it is imported.)"""
     if n is None:
         return
     if n < 1:

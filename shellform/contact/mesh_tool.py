@@ -512,7 +512,7 @@ def _less(a, s, b):
     return a[0] - s * b[0], a[1] - s * b[1], a[2] - s * b[2]
 
 
-@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+@njit  # a division by 0 gives inf or nan (_jit.OPTIONS)
 def _flat(y, P):
     """The closest point's barycentric (u, v) on the flat triangle P and the distance to it:
     the plane's foot point where it lies inside, else the nearest of the three edges' (clamped
@@ -539,7 +539,7 @@ def _flat(y, P):
     return best_u, best_v, dist
 
 
-@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+@njit  # a division by 0 gives inf or nan (_jit.OPTIONS)
 def _newton(A, y, u, v, X, Xu, Xv):
     """Newton on patch A from (u, v) for the minimiser of |X - y|^2 (the Hessian J^T J + (X - y)
     . X_ij, or J^T J where that is not positive): (u, v) and whether it converged inside the
@@ -588,7 +588,7 @@ def _edge_curve(A, k, u0, v0, du, dv, y):
         A[3, k] * (du * du) + A[4, k] * (dv * dv) + A[5, k] * (du * dv)
 
 
-@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+@njit  # a division by 0 gives inf or nan (_jit.OPTIONS)
 def _edge_curves(A, P, y, X, Xu, Xv):
     """The nearest point on patch A's three edge curves (0: u-axis, 1: u + v = 1, 2: v-axis):
     on each, Newton in its parameter s from the flat edge's closest point, clamped to [0, 1],
@@ -643,7 +643,7 @@ def _nearer(dist, t, best, best_t):
     return dist < best or (dist == best and t < best_t)
 
 
-@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+@njit  # a division by 0 gives inf or nan (_jit.OPTIONS)
 def _warm_pass(y, delta, ref, last_y, last_c, last_t, last_u, last_v, last_kind, last_dist, last_rest, start,
                length, near, bound, patches, corners, centre, radius, bulge, size):
     """Points y moved by delta from the remembered points ref: their closest points from the
@@ -758,7 +758,7 @@ def _search_pass(y, p, t, upper, rest, patches, corners, bulge, size):
     return t_out, u_out, v_out, kind_out, dist_out, near_out[:at], bound_out[:at], np.cumsum(length) - length, length
 
 
-@njit(error_model="numpy")  # a division by 0 gives inf or nan, as numpy's
+@njit  # a division by 0 gives inf or nan (_jit.OPTIONS)
 def _signed_pass(y, t, u, v, kind, patches, sign, tiny, c, d, n, H, J, S):
     """Closest points c, signed distances d, normals n at the closest points (u, v) of patches t;
     H on the edge curves (kind 0, 1, 2: the curve's, (I - n n^T - x' x'^T / (|x'|^2 - (y - c)

@@ -263,8 +263,9 @@ def return_map(e, ep_n, p_n, mat, s_out, D_out, ep_out):
     state, all finite). m -> 1 is the non-smooth limit (cone with an apex and an edge): there
     the local Newton may fail; m >= 1.2 converged on all sampled states.
     """
+    # no warm start, its arguments given as the section gives them (one compiled signature)
     (s0, s1, s2, D00, D01, D02, D11, D12, D22, q0, q1, q2, p, st) = return_core(
-        e[0], e[1], e[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat)
+        e[0], e[1], e[2], ep_n[0], ep_n[1], ep_n[2], p_n, mat, 0.0, 0.0, 0.0, -1.0)
     s_out[0], s_out[1], s_out[2] = s0, s1, s2
     D_out[0, 0], D_out[0, 1], D_out[0, 2] = D00, D01, D02
     D_out[1, 0], D_out[1, 1], D_out[1, 2] = D01, D11, D12

@@ -57,10 +57,10 @@ CELLS_PER_THREAD = 256  # below this many cells a thread costs more to start tha
 
 def use_cores(comm, num_cells: int) -> int:
     """Threads of the element and material loops on this rank: the cores this process may run
-    on, shared by the ranks on its node, at most NUMBA_NUM_THREADS and SHELLFORM_THREADS
-    (`shellform run --threads N` sets it; read when the model is built, and unlike
-    NUMBA_NUM_THREADS free to change after numba started its threads), and no more than one
-    per CELLS_PER_THREAD cells."""
+    on, shared by the ranks on its node, at most NUMBA_NUM_THREADS (read when numba is imported)
+    and SHELLFORM_THREADS (`shellform run --threads N` sets it; read when the model is built),
+    and no more than one per CELLS_PER_THREAD cells. The loops run their chunks of cells on that
+    many threads (shellform._jit.over_threads)."""
     import os
 
     local = comm.Split_type(MPI.COMM_TYPE_SHARED)
