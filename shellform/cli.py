@@ -38,7 +38,7 @@ STUDIES = {
     "cup-strain": "the square cup before and after finite strains",
     "cup-paper": "the paper's Figs. 5 to 8 (after cup-mesh and cup-hard)",
     "numisheet": "the NUMISHEET'93 cups to 40 mm",
-    "numisheet-cost": "the aluminium cup: 4 meshes x 2 steps, error against time",
+    "numisheet-cost": "the aluminium cup: mesh, step, thickness points, rtol against the converged answers and CPU time",
     "cup-benchmark": "the aluminium cup at 900 to 10,000 cells on 1 and 2 ranks: speed",
     "outlines": "circle and triangle plates, error against time",
     "locking": "membrane locking: thin roll-ups and a curved roof",

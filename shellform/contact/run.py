@@ -6,6 +6,7 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              volume change (V - V0)/V0 (elastic only, with finite strains); increments,
                              Newton iterations, contact passes, element evaluations (run,
                              reused, and how many computed a tangent); wall_time_s and its split;
+                             cpu_time_s, the CPU seconds of every thread of every rank
                              over_the_stroke: the worst penetration, z-balance, holder share
                              and count of free nodes under the closed holder
     reports.json             the reports so far (rewritten at each; a resumed run takes them over)
@@ -143,7 +144,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     (run_folder.start). scene_path: the scene's file, for run.json."""
     outdir = Path(outdir)
     run_folder.start(outdir, s, scene_path, resume, comm)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
     p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     curve, reports, stopped, resumed, signum = [], [], None, None, 0
@@ -296,6 +297,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
         "resumed_from_stroke_mm": resumed["from_stroke_mm"] if resumed else None, "resumed": resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
+        "cpu_time_s": comm.allreduce(time.process_time() - c0, op=MPI.SUM),
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
     }, outdir)
     write_json(outdir / "summary.json", summary)
