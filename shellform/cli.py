@@ -9,6 +9,10 @@
                                           resolved and what its mesh will cost; run nothing
     shellform study NAME -o DIR           run a study (shellform study --help lists them)
 
+Each command takes -q (the closing line, warnings and errors only) or -v (every increment's
+line, also on a terminal, where the default rewrites one line in place). The library logs
+through Python's logging (shellform.results.log) and prints nothing itself: the command shows its log.
+
 Exit status: 0 done, 2 input error, 3 stopped early, 128 + the signal when Ctrl-C or SIGTERM
 stopped it. Scenes: docs/scenes.md; results: docs/results.md; studies: docs/checked.md.
 """
@@ -62,8 +66,13 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="shellform", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"shellform {__version__}")
+    talk = argparse.ArgumentParser(add_help=False)
+    how = talk.add_mutually_exclusive_group()
+    how.add_argument("-q", "--quiet", action="store_true", help="print only the closing line, warnings and errors")
+    how.add_argument("-v", "--verbose", action="store_true",
+                     help="print every increment's line (also on a terminal, where one line is rewritten in place)")
     sub = parser.add_subparsers(dest="command", required=True)
-    p_run = sub.add_parser("run", help="solve a scene file",
+    p_run = sub.add_parser("run", help="solve a scene file", parents=[talk],
                            description="Solve a scene (docs/scenes.md) into --out: summary.json, tables, fields, "
                                        "pictures. Exit status 0 done, 2 input error, 3 stopped early, "
                                        "128 + the signal when Ctrl-C or SIGTERM stopped it (docs/reliability.md).")
@@ -77,7 +86,7 @@ def _parser() -> argparse.ArgumentParser:
     p_run.add_argument("--threads", type=int, metavar="N", help=THREADS_HELP)
     p_run.add_argument("--trace", action="store_true",
                        help="tool scenes: log every contact pass, Newton step and iterate (diagnosis)")
-    p_check = sub.add_parser("check", help="check a scene and print it resolved, without running it",
+    p_check = sub.add_parser("check", help="check a scene and print it resolved, without running it", parents=[talk],
                              description="Check a scene as `shellform run` does (every key, the files it reads, "
                                          "the memory its mesh needs), then print it with every key resolved (a "
                                          "TOML document that `shellform run` accepts) and its estimated cells "
@@ -85,7 +94,7 @@ def _parser() -> argparse.ArgumentParser:
     p_check.add_argument("scene", type=Path, help=SCENE_HELP)
     p_check.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings", help=SET_HELP)
     width = max(map(len, STUDIES))
-    p_study = sub.add_parser("study", help="run a study (convergence, accuracy against time, benchmarks)",
+    p_study = sub.add_parser("study", help="run a study (convergence, accuracy against time, benchmarks)", parents=[talk],
                              formatter_class=argparse.RawDescriptionHelpFormatter,
                              description="Run a study into --out: its tables, plots and log (docs/checked.md gives "
                                          "each one's run time).\n\nstudies:\n"
@@ -134,21 +143,24 @@ def check(s) -> str:
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
 
-    from shellform.nonlinear.interrupt import Interrupted
-    from shellform.results.log import say  # every line below once per run, on rank 0
+    import logging
 
+    from shellform.nonlinear.interrupt import Interrupted
+    from shellform.results.log import RESULT, console, quiet, say  # every line below once per run, on rank 0
+
+    shown = console(RESULT if args.quiet else logging.DEBUG if args.verbose else logging.INFO)
     try:
         limit_threads(getattr(args, "threads", None))
         if args.command == "run":
             from shellform import run
 
             summary = run.run(_scene(args), args.out, scene_path=args.scene, trace=args.trace, resume=args.resume)
-            say(summary.closing_line())
+            say(summary.closing_line(), level=RESULT)
             if summary.stop_line():
                 say(summary.stop_line(), file=sys.stderr)
             return summary.exit_status()
         elif args.command == "check":
-            say(check(_scene(args)).rstrip("\n"))
+            say(check(_scene(args)).rstrip("\n"), level=RESULT)
         else:
             import importlib
 
@@ -171,6 +183,8 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:  # before any increment converged, or a second Ctrl-C
         say("shellform: interrupted; nothing newer than the last checkpoint was kept", file=sys.stderr)
         return 128 + signal.SIGINT
+    finally:
+        quiet(shown)
     return 0
 
 

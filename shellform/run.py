@@ -3,6 +3,9 @@
     summary = run(scene, outdir, scene_path=path, trace=False, resume=False)
     print(summary.closing_line()); sys.exit(summary.exit_status())
 
+A run logs what it does to the logger "shellform" and prints nothing itself
+(shellform.results.log: console() shows it as the command line does).
+
 The scene's route solves it and writes its files and summary.json; each route first claims
 the output folder (results.run_folder.start: checked writable, before any computation):
 

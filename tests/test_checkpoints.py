@@ -5,6 +5,7 @@ the counts of the whole run; checkpoints that resume on another number of ranks.
 
 import io
 import json
+import logging
 import os
 import shutil
 from pathlib import Path
@@ -73,7 +74,7 @@ def test_a_kill_while_a_checkpoint_is_written_keeps_the_one_before(tmp_path, who
 
 
 @pytest.mark.timeout(300)
-def test_a_damaged_checkpoint_is_named_and_the_previous_one_used(tmp_path, whole, capsys):
+def test_a_damaged_checkpoint_is_named_and_the_previous_one_used(tmp_path, whole, caplog):
     """checkpoint.npz cut to half its length (what an in-place write leaves): the resume says
     that file is damaged, takes checkpoint.previous.npz (0.5 mm) and ends where the
     uninterrupted run ends."""
@@ -81,12 +82,13 @@ def test_a_damaged_checkpoint_is_named_and_the_previous_one_used(tmp_path, whole
     out = tmp_path / "out"
     data = (out / "checkpoint.npz").read_bytes()
     (out / "checkpoint.npz").write_bytes(data[: len(data) // 2])
+    caplog.set_level(logging.INFO, logger="shellform")
     summary = contact_run.run(cup(), out, resume=True)
     assert summary["resumed"]["checkpoint"] == "checkpoint.previous.npz"
     assert summary["resumed_from_stroke_mm"] == pytest.approx(0.5)
     damaged = summary["resumed"]["damaged"]
     assert len(damaged) == 1 and str(out / "checkpoint.npz") in damaged[0] and "damaged" in damaged[0]
-    assert f"{out / 'checkpoint.npz'}: damaged" in capsys.readouterr().out
+    assert f"{out / 'checkpoint.npz'}: damaged" in caplog.text
     assert_same_end(summary, whole[1])
 
 

@@ -122,3 +122,20 @@ def test_levels_of_a_study_without_levels_is_an_input_error(capsys, tmp_path):
     """--levels reaches a study that has mesh levels; one without them names the option."""
     assert cli.main(["study", "assembly", "--out", str(tmp_path), "--levels", "4", "8"]) == 2
     assert "input error: --levels: the study assembly has no mesh levels" in capsys.readouterr().err
+
+
+def test_quiet_prints_only_the_closing_line(tmp_path, capsys):
+    """`shellform run SCENE -q`: the closing line and nothing else on stdout, nothing on stderr;
+    without -q the same run says what it does before it."""
+    from shellform.results.summary import SheetSummary
+
+    scene_file = Path(__file__).resolve().parents[1] / "demos" / "levy_plate.toml"
+    args = ["run", str(scene_file), "--set", "mesh.n=2", "--set", "process.path=[0.01]", "--set", "process.report=[]",
+            "--set", "output.vtx=false", "--set", "output.png=false"]
+    assert cli.main([*args, "-o", str(tmp_path / "q"), "-q"]) == 0
+    out, err = capsys.readouterr()
+    closing = SheetSummary(json.loads((tmp_path / "q" / "summary.json").read_text()), tmp_path / "q").closing_line()
+    assert out == closing + "\n" and err == ""
+    assert cli.main([*args, "-o", str(tmp_path / "all")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) > 1 and lines[0].startswith("increment") and lines[-1].startswith("shellform: ")

@@ -6,6 +6,8 @@ test_tools.py; the cases they share are in contact_cases.py."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
+import logging
+
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -490,15 +492,16 @@ def test_passes_that_only_move_the_contact_front_are_not_counted():
     assert force2 == force and np.array_equal(q2, q)
 
 
-def test_the_trace_names_every_node_that_switches(capsys):
+def test_the_trace_names_every_node_that_switches(caplog):
     """The trace (shellform run --trace) logs each node that joins or leaves a tool, with its position and force:
     in the aluminium cup's first increment (the blank peeling off the punch's face, the holder
     closed throughout) one line per counted set change."""
     s = scene.load(ROOT / "demos" / "numisheet93_aluminium.toml")
     s.mesh.n = 16
     p = DrawingProblem.from_scene(s, verbose=False, trace=True)
+    caplog.set_level(logging.INFO, logger="shellform")
     p.driver.run(p.driver.controls.initial_step)
-    lines = capsys.readouterr().out.splitlines()
+    lines = caplog.messages
     switches = [ln for ln in lines if " joins tool " in ln or " leaves tool " in ln]
     h = p.driver.history[0].contact
     assert h["holder_closed"] and h["set_changes"] > 0

@@ -1,11 +1,13 @@
 """The results stage: the progress line of a run."""
 
 import io
+import logging
+import sys
 
 import numpy as np
 import pytest
 
-from shellform.results.log import Progress
+from shellform.results import log
 
 
 class Terminal(io.StringIO):
@@ -13,13 +15,28 @@ class Terminal(io.StringIO):
         return True
 
 
-def test_progress_rewrites_one_line_on_a_terminal_and_keeps_notes(monkeypatch):
+@pytest.fixture
+def shown():
+    """The console handler of the command line on streams of the test's own; removed after."""
+    handlers = []
+
+    def install(level=logging.INFO, out=None, err=None):
+        handlers.append(log.console(level, out, err))
+        return handlers[-1]
+
+    yield install
+    for h in handlers:
+        log.quiet(h)
+
+
+def test_progress_rewrites_one_line_on_a_terminal_and_keeps_notes(monkeypatch, shown):
     """One line rewritten in place, as wide as the terminal (80 columns: 79 characters, so that
     no increment wraps onto a new line); the time left from the progress since the first
     increment, once three are done."""
     monkeypatch.setenv("COLUMNS", "80")
     out = Terminal()
-    p = Progress("stroke", 1.0, " mm", 30.0, stream=out)
+    shown(out=out)
+    p = log.Progress("stroke", 1.0, " mm", 30.0)
     p.increment(0.1, 1, 8, "increment   1 ...")
     p.increment(0.25, 10, 80, "increment  10 ...")
     p.increment(0.5, 20, 170, "increment  20 ...")
@@ -29,19 +46,47 @@ def test_progress_rewrites_one_line_on_a_terminal_and_keeps_notes(monkeypatch):
     assert all(len(line) == 79 for line in lines)
     assert "s left" not in lines[0]  # under three increments: no estimate yet
     assert "stroke 15 of 30 mm: 20 increments, 170 iterations" in lines[-1] and "s left" in lines[-1]
+    p.note("  cut back: ...")
+    assert out.getvalue().endswith("\n  cut back: ...\n")  # the note below the in-place line
+    p.increment(0.6, 21, 175, "increment  21 ...")
     p.close()
-    assert out.getvalue().endswith("\n")
+    assert out.getvalue().endswith("\n") and out.getvalue().count("\r") == 4
 
 
-def test_progress_in_a_log_keeps_the_plain_increment_lines():
-    log = io.StringIO()  # not a terminal
-    p = Progress("load factor", 1.0, stream=log)
+def test_progress_in_a_log_keeps_the_plain_increment_lines(shown):
+    out = io.StringIO()  # not a terminal
+    shown(out=out)
+    p = log.Progress("load factor", 1.0)
     p.increment(0.5, 3, 12, "increment   3  lambda 0.5")
     p.note("  cut back: ...")
-    assert log.getvalue() == "increment   3  lambda 0.5\n  cut back: ...\n"
-    log = io.StringIO()  # a tool scene's log: the stroke too
-    Progress("stroke", 1.0, " mm", 30.0, stream=log).increment(0.5, 3, 12, "increment   3  lambda 0.5")
-    assert log.getvalue() == "increment   3  lambda 0.5  (stroke 15 mm)\n"
+    p.close()
+    assert out.getvalue() == "increment   3  lambda 0.5\n  cut back: ...\n"
+    out.truncate(0), out.seek(0)  # a tool scene's log: the stroke too
+    log.Progress("stroke", 1.0, " mm", 30.0).increment(0.5, 3, 12, "increment   3  lambda 0.5")
+    assert out.getvalue() == "increment   3  lambda 0.5  (stroke 15 mm)\n"
+
+
+def test_verbose_shows_every_increment_on_a_terminal_and_quiet_only_the_closing_line(shown):
+    out, err = Terminal(), io.StringIO()
+    verbose = shown(logging.DEBUG, out, err)
+    log.Progress("load factor", 1.0).increment(0.5, 3, 12, "increment   3")
+    assert out.getvalue() == "increment   3\n"
+    log.quiet(verbose)
+    out, err = io.StringIO(), io.StringIO()
+    shown(log.RESULT, out, err)
+    log.Progress("load factor", 1.0).increment(0.5, 3, 12, "increment   3")
+    log.say("shellform: writing the tables")
+    log.say("shellform: done", level=log.RESULT)
+    log.say("shellform: stopped", file=sys.stderr)
+    assert out.getvalue() == "shellform: done\n" and err.getvalue() == "shellform: stopped\n"
+
+
+def test_the_library_prints_nothing_unless_asked(capsys):
+    """Without a handler (a script, a notebook): no line on stdout or stderr, warnings neither."""
+    log.Progress("load factor", 1.0).increment(0.5, 3, 12, "increment   3")
+    log.say("a line")
+    log.say("a stop", file=sys.stderr)
+    assert capsys.readouterr() == ("", "")
 
 
 def test_keeler_brazier_curve():

@@ -3,6 +3,7 @@ both nonlinear routes, and the summary each route returns, which knows its closi
 exit status; the command line's --version."""
 
 import json
+import logging
 import re
 from pathlib import Path
 
@@ -186,7 +187,7 @@ def test_probes_belong_to_nonlinear_sheet_scenes():
         scene.load(ROOT / "demos" / "square_cup.toml").changed({"output.probe": [{"name": "c", "x": 0.0, "y": 0.0}]})
 
 
-def test_a_first_run_says_it_compiles(tmp_path, capsys, monkeypatch):
+def test_a_first_run_says_it_compiles(tmp_path, caplog, monkeypatch):
     """Where this version's numba cache lacks the element kernels (a first run on a machine;
     the scene's checks may have cached another function there), a nonlinear run says that it
     compiles them, and what, before the silence of compiling; with the cache, nothing."""
@@ -198,8 +199,10 @@ def test_a_first_run_says_it_compiles(tmp_path, capsys, monkeypatch):
     other.mkdir(parents=True)
     (other / "criteria.hill48-10.py312.nbi").write_bytes(b"")  # a function the checks compiled
     monkeypatch.setattr(_jit, "_CACHE_DIR", str(tmp_path / "cache"))
+    caplog.set_level(logging.INFO, logger="shellform")
     run.run(s, tmp_path / "a")
-    assert "compiling the element and material kernels: the sheet's element loops" in capsys.readouterr().out
+    assert "compiling the element and material kernels: the sheet's element loops" in caplog.text
     monkeypatch.undo()
+    caplog.clear()
     run.run(s, tmp_path / "b")
-    assert "compiling" not in capsys.readouterr().out
+    assert "compiling" not in caplog.text

@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from shellform.results.log import say
+
 
 def mpiexec() -> str | None:
     """The mpiexec beside this Python (the wheel's), else the one on PATH, else None."""
@@ -39,7 +41,7 @@ def deflection_table(scenes, reference: float, x: float = 0.0, y: float = 0.0) -
     from shellform import linear
 
     rows = []
-    print(f"{'level':>5s} {'cells':>6s} {'w_center':>13s} {'rel_error':>11s} {'rate':>5s} {'time_s':>7s}")
+    say(f"{'level':>5s} {'cells':>6s} {'w_center':>13s} {'rel_error':>11s} {'rate':>5s} {'time_s':>7s}")
     for k, scene in enumerate(scenes):
         result = linear.solve(scene)
         w = result.value("w", x, y)
@@ -47,7 +49,7 @@ def deflection_table(scenes, reference: float, x: float = 0.0, y: float = 0.0) -
                      "time_s": result.timings["total_s"]})
         rate, r = observed_rates(rows)[-1], rows[-1]
         rate_text = "    -" if k == 0 else f"{rate:5.2f}"
-        print(f"{k:5d} {r['cells']:6d} {r['w_center']:13.10f} {r['rel_error']:11.2e} {rate_text} {r['time_s']:7.2f}")
+        say(f"{k:5d} {r['cells']:6d} {r['w_center']:13.10f} {r['rel_error']:11.2e} {rate_text} {r['time_s']:7.2f}")
     return rows
 
 
