@@ -97,3 +97,14 @@ def test_without_dolfinx_one_line_says_what_to_install():
     assert len(lines) == 1 and "Traceback" not in out.stderr
     assert lines[0].startswith("shellform: no mpi4py, petsc4py, dolfinx in this Python")
     assert "dolfinx-solver-real" in lines[0] and "make venv" in lines[0]
+
+
+def test_the_metadata_names_the_licence_and_citation_the_paper():
+    """pyproject's metadata (licence file, authors, classifiers) and CITATION.cff: the software
+    at the package's version, with the paper whose method it implements among its references."""
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert meta["license"] == "MIT" and meta["license-files"] == ["LICENSE"] and (ROOT / "LICENSE").exists()
+    assert meta["authors"] and any(c.startswith("Topic :: Scientific/Engineering") for c in meta["classifiers"])
+    cff = (ROOT / "CITATION.cff").read_text()
+    assert "cff-version: 1.2.0" in cff and f"version: {meta['version']}\n" in cff and "type: software" in cff
+    assert "family-names: Jiang" in cff and "given-names: Heyang" in cff
