@@ -5,6 +5,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 OUT    ?= results/square_cup
+# test processes (pytest-xdist): one per core of the 2-core machines the suite is sized for
 NPROC  ?= 2
 
 .PHONY: demo test test-slow venv clean bench docs
@@ -25,10 +26,10 @@ demo: $(STAMP)
 	@echo "shellform: summary.json, cup.pvd (ParaView, pyvista), force_stroke.csv/.png, thickness_*.csv, thickness.png, cup.png in $(OUT) (docs/results.md)"
 
 test: $(STAMP)
-	$(PY) -m pytest -q -m "not slow" tests
+	$(PY) -m pytest -q -n $(NPROC) --dist loadfile -m "not slow" tests
 
 test-slow: $(STAMP)
-	$(PY) -m pytest -q -m slow tests
+	$(PY) -m pytest -q -n $(NPROC) --dist loadfile -m slow tests
 
 clean:
 	rm -rf $(VENV) results

@@ -1,5 +1,6 @@
-"""The tool scenes' time series (results/vtu.py, results/cup.py CupSeries) as a user opens
-them: with pyvista's readers, the drawn cup at the last report and the tools where they are."""
+"""The scenes' time series (results/vtu.py; results/cup.py CupSeries, results/fields.py
+SheetSeries) as a user opens them: with pyvista's readers, the drawn cup at the last report and
+the tools where they are; a plate's or a shell's deformed sheet with its fields."""
 
 import json
 import os
@@ -47,6 +48,38 @@ def test_a_written_series_reads_back_exactly(tmp_path):
     np.testing.assert_array_equal(second.point_data["u"], 2.0 * points)
     np.testing.assert_array_equal(second.point_data["state"], [0, 1, 2, 4])
     np.testing.assert_array_equal(second.cell_data["peq"], [0.2, 0.4])
+
+
+def test_a_sheet_scene_writes_its_reports_as_a_series(tmp_path):
+    """Levy's clamped plate (the nonlinear sheet route, quarter, 4 x 4) to load factors 0.05
+    and 0.1: sheet.pvd has a step at each report; the last is the deformed mid-surface (initial
+    position + displacement) with the summary's centre deflection at the origin and the cells'
+    fields, every cell once."""
+    s = scene.load(ROOT / "demos" / "levy_plate.toml").changed({
+        "mesh.n": 4, "process.path": [0.1], "process.report": [0.05], "output.vtx": False, "output.png": False})
+    summary = run.run(s, tmp_path)
+    times, sheet = last_step(tmp_path / "sheet.pvd")
+    assert times == pytest.approx([0.05, 0.1])
+    assert sheet.n_cells == summary["cells"] and sheet.n_points == 25
+    initial = sheet.points - sheet.point_data["displacement"]
+    origin = np.flatnonzero(np.hypot(initial[:, 0], initial[:, 1]) < 1e-12)
+    assert origin.size == 1
+    assert sheet.point_data["displacement"][origin[0], 2] == pytest.approx(summary["reports"][-1]["w"], rel=1e-12)
+    assert sheet.points[origin[0], 2] == pytest.approx(summary["reports"][-1]["w"], rel=1e-12)
+    assert {"slopes"} <= set(sheet.point_data) and {"equivalent_plastic_strain", "thickness_strain"} <= set(sheet.cell_data)
+
+
+def test_a_shell_scene_writes_its_solution_as_a_series(tmp_path):
+    """The linear square plate: sheet.pvd's one step is the deflected plate, w at the centre
+    the summary's, with the strains and resultants per cell."""
+    s = scene.load(ROOT / "demos" / "square_plate.toml").changed({"output.vtx": False, "output.png": False})
+    summary = run.run(s, tmp_path)
+    times, sheet = last_step(tmp_path / "sheet.pvd")
+    assert times == [1.0] and sheet.n_cells == summary["cells"]
+    d = sheet.point_data["displacement"]
+    centre = np.flatnonzero(np.hypot(*(sheet.points - d)[:, :2].T) < 1e-12)
+    assert d[centre[0], 2] == pytest.approx(summary["w_center"], rel=1e-12)
+    assert {"curvature", "moment"} <= set(sheet.cell_data) and sheet.cell_data["moment"].shape == (sheet.n_cells, 3)
 
 
 def test_tool_surfaces_lie_on_the_tools():

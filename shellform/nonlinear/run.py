@@ -8,6 +8,10 @@ Writes into the output folder:
     increments.csv     every increment: load factor, step, iterations, residuals, plastic layers
     nodal.bp, cells.bp the final state for ParaView (displacement, slopes; plastic and thickness
                        strain per cell)
+    sheet.pvd, vtu/    ([output] vtu) the states at the reports as a series a stock ParaView and
+                       pyvista open: the deformed mid-surface with displacement and slopes per node,
+                       the cell fields of cells.bp and the major and minor strains per cell
+                       (results/fields.py SheetSeries)
     deformed.png       the final shape (serial runs)
     checkpoint.npz     only if the run stops (no convergence, a limit load, Ctrl-C or SIGTERM): the
                        last converged state (nonlinear/checkpoint.py;
@@ -104,6 +108,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
     targets = sorted(set(s.process.report))
     necks = neck.NeckWatch(comm, "load_factor", "initial_xy") if p.model.plastic else None
     centres = p.model.cell_centres()
+    series = fields.SheetSeries(p.model.V, p.model.num_cells, outdir) if s.output.vtu else None
+
+    def record():
+        reports.append(_record(p, s))
+        if series is not None:
+            series.write(p.driver.lam, p.driver.q, p.model.components, p.model.cell_fields())
 
     def on_increment(d):
         if necks is None:
@@ -123,18 +133,18 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             stops = [r for r in targets if lo < r < hi]
             for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
                 p.driver.run(r, on_increment=on_increment)
-                reports.append(_record(p, s))
+                record()
     except neck.NeckReached:  # the load path ends where the sheet starts to neck
         p.driver.progress.note(f"shellform: the load path ends: "
                                f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
-        reports.append(_record(p, s))
+        record()
     except (ConvergenceFailure, Interrupted) as err:
         stopped = str(err)
         if isinstance(err, Interrupted):
             signum = err.signal
             stopped = f"{err} at load factor {p.driver.lam:.6g}"
         p.driver.progress.note(f"shellform: stopped: {stopped}")
-        reports.append(_record(p, s))  # the last converged state, which the driver restored
+        record()  # the last converged state, which the driver restored
     p.driver.progress.close()
     d = p.driver
     summary = SheetSummary({

@@ -20,6 +20,7 @@ import numpy as np
 from dolfinx import fem, io
 from mpi4py import MPI
 
+from shellform.results import fields
 from shellform.results.fields import offscreen_backend
 
 
@@ -236,73 +237,48 @@ class CupSeries:
         if vtu:
             from shellform.results.vtu import PVDSeries
 
-            self.order = self._input_order()
+            self.order = fields.input_order(p.model.V, p.model.num_cells)
             names = ("cup", *p.tool_placements())  # on every rank: the placements reduce over them
             if mesh.comm.rank == 0:
                 self.series = {name: PVDSeries(self.outdir, name) for name in names}
 
-    def _input_order(self):
-        """Per owned node and per owned cell their index in the mesh's input (the same on any
-        number of ranks), and each owned cell's nodes by that index."""
-        m = self.p.model
-        mesh, V = m.mesh, m.V
-        imap = V.dofmap.index_map
-        n_local = imap.size_local + imap.num_ghosts
-        dofs = V.dofmap.list
-        node = np.full(n_local, -1, dtype=np.int64)
-        node[dofs.ravel()] = mesh.geometry.input_global_indices[mesh.geometry.dofmaps[0].ravel()]
-        cells = np.asarray(mesh.topology.original_cell_index[: m.num_cells], dtype=np.int64)
-        return node[: imap.size_local], cells, node[dofs[: m.num_cells]]
-
     def write(self, stroke):
         p = self.p
-        fields = p.model.cell_fields()
+        values = p.model.cell_fields()
         if self.writers:
             e33 = p.nodal_values()[2]
             n = len(e33)  # the owned nodes
             self.disp.x.array.reshape(-1, 3)[:n] = p.displacements()[:n]
             self.e33.x.array[:n] = e33
             for f in self.cells:
-                f.x.array[: p.model.num_cells] = fields[f.name]
+                f.x.array[: p.model.num_cells] = values[f.name]
             for f in (self.disp, self.e33, *self.cells):
                 f.x.scatter_forward()
             for w in self.writers:
                 w.write(stroke)
         if hasattr(self, "order"):
-            self._write_vtu(stroke, fields)
+            self._write_vtu(stroke, values)
 
-    def _write_vtu(self, stroke, fields):
+    def _write_vtu(self, stroke, values):
         from shellform.contact.tools import surface_mesh
 
         p = self.p
         comm = p.model.mesh.comm
-        nodes, cells, triangles = self.order
         _, x, e33 = p.nodal_values()
         state, pressure = p.contact_nodes()
-        n = len(nodes)
-        cell_values = {k: fields[k] for k in self.CELL_FIELDS}
+        n = len(self.order[0])
+        cell_values = {k: values[k] for k in self.CELL_FIELDS}
         if self.fld_curve is not None:
             from shellform.results import fld
 
-            cell_values["fld_margin"] = fld.margins(fields["major_strain"], fields["minor_strain"], self.fld_curve)
+            cell_values["fld_margin"] = fld.margins(values["major_strain"], values["minor_strain"], self.fld_curve)
         point_values = {"displacement": p.displacements()[:n], "thickness_strain": e33,
                         "contact_state": state, "contact_pressure": pressure}
-        parts = comm.gather((nodes, x, point_values, cells, triangles, cell_values), root=0)
+        whole = fields.gather_in_input_order(comm, self.order, x, point_values, cell_values)
         placements = p.tool_placements()
-        if comm.rank != 0:
+        if whole is None:
             return
-        node_ids = np.concatenate([q[0] for q in parts])
-        by_node = np.argsort(node_ids)
-        node_ids = node_ids[by_node]
-        by_cell = np.argsort(np.concatenate([q[3] for q in parts]))
-
-        def joined(i, key=None):
-            values = [q[i] if key is None else q[i][key] for q in parts]
-            return np.concatenate(values)[by_node if i < 3 else by_cell]
-
-        connectivity = np.searchsorted(node_ids, joined(4))
-        self.series["cup"].write(stroke, joined(1), connectivity,
-                                 {k: joined(2, k) for k in point_values}, {k: joined(5, k) for k in cell_values})
+        self.series["cup"].write(stroke, *whole)
         x0, x1, y0, y1 = p.blank_bounds()
         t = p.scene.tools
         span = t.stroke + max(t.punch_profile_radius, t.die_profile_radius)  # the walls, as deep as the stroke

@@ -1,7 +1,11 @@
-"""Fields on disk: VTX (ADIOS2) for ParaView and a PNG of the deformed shape.
+"""Fields on disk: VTX (ADIOS2) for ParaView, a PVD series that a stock ParaView and pyvista
+open, and a PNG of the deformed shape.
 
 The carrier holds physical nodal values, so output reads it directly: DOLFINx's interpolation
-and plotting know nothing of the slope map and are not used for the element's fields.
+and plotting know nothing of the slope map and are not used for the element's fields. The PVD
+series (results/vtu.py) is written by rank 0, which gathers the sheet with its nodes and cells
+in the mesh's input order (input_order, gather_in_input_order), so that the files do not depend
+on the number of ranks.
 """
 
 import os
@@ -41,6 +45,89 @@ def write_vtx(outdir: Path, q, components, cell_fields: dict) -> list[Path]:
             with io.VTXWriter(comm, path, funcs, engine="BP4") as vtx:
                 vtx.write(0.0)
     return paths
+
+
+def input_order(V, num_cells: int):
+    """Per owned node of the carrier space V its index in the mesh's input (the same on any
+    number of ranks), per owned cell its input index, and each owned cell's nodes by that index."""
+    mesh = V.mesh
+    imap = V.dofmap.index_map
+    dofs = V.dofmap.list
+    node = np.full(imap.size_local + imap.num_ghosts, -1, dtype=np.int64)
+    node[dofs.ravel()] = mesh.geometry.input_global_indices[mesh.geometry.dofmaps[0].ravel()]
+    cells = np.asarray(mesh.topology.original_cell_index[:num_cells], dtype=np.int64)
+    return node[: imap.size_local], cells, node[dofs[:num_cells]]
+
+
+def node_positions(V) -> np.ndarray:
+    """The initial position of every node of the carrier space V (owned, then ghosts)."""
+    mesh = V.mesh
+    imap = V.dofmap.index_map
+    x = np.zeros((imap.size_local + imap.num_ghosts, 3))
+    x[V.dofmap.list.ravel()] = mesh.geometry.x[mesh.geometry.dofmaps[0].ravel()]
+    return x
+
+
+def gather_in_input_order(comm, order, x, point_values: dict, cell_values: dict):
+    """On rank 0, the whole sheet in the mesh's input order: (points, triangles, point_values,
+    cell_values); None on the other ranks. order: input_order(...); x and point_values per owned
+    node, cell_values per owned cell."""
+    nodes, cells, triangles = order
+    parts = comm.gather((nodes, x, point_values, cells, triangles, cell_values), root=0)
+    if comm.rank != 0:
+        return None
+    node_ids = np.concatenate([q[0] for q in parts])
+    by_node = np.argsort(node_ids)
+    by_cell = np.argsort(np.concatenate([q[3] for q in parts]))
+
+    def joined(i, key=None):
+        values = [q[i] if key is None else q[i][key] for q in parts]
+        return np.concatenate(values)[by_node if i < 3 else by_cell]
+
+    connectivity = np.searchsorted(node_ids[by_node], joined(4))
+    return (joined(1), connectivity, {k: joined(2, k) for k in point_values},
+            {k: joined(5, k) for k in cell_values})
+
+
+class SheetSeries:
+    """<name>.pvd: a sheet or shell scene's states as a series (results/vtu.py), one step per
+    call of write: the modelled region (a quarter or a half is not mirrored) on its deformed
+    mid-surface, with the point fields displacement (and slopes where the carrier has w_x, w_y)
+    and the cell fields given."""
+
+    def __init__(self, V, num_cells: int, outdir: Path, name: str = "sheet"):
+        from shellform.results.vtu import PVDSeries
+
+        self.V, self.num_cells = V, num_cells
+        self.comm = V.mesh.comm
+        self.order = input_order(V, num_cells)
+        n = V.dofmap.index_map.size_local
+        self.X = node_positions(V)[:n]
+        self.series = PVDSeries(outdir, name) if self.comm.rank == 0 else None
+
+    def write(self, time: float, q, components, cell_values: dict) -> None:
+        """The state q (a carrier with these components) at `time`; cell_values: per owned
+        cell an array (cells,) or (cells, k), or a DG0 Function."""
+        n = len(self.X)
+        values = q.x.array.reshape(-1, len(components))[:n]
+        disp = np.zeros((n, 3))
+        for k, name in enumerate(("u", "v", "w")):
+            if name in components:
+                disp[:, k] = values[:, components.index(name)]
+        points = {"displacement": disp}
+        if "w_x" in components:
+            i = components.index("w_x")
+            points["slopes"] = values[:, i : i + 2]
+        cells = {}
+        for name, v in cell_values.items():
+            if isinstance(v, fem.Function):
+                bs = v.function_space.dofmap.index_map_bs
+                v = v.x.array.reshape(-1, bs)[: self.num_cells]
+                v = v[:, 0] if bs == 1 else v
+            cells[name] = np.asarray(v)[: self.num_cells]
+        whole = gather_in_input_order(self.comm, self.order, self.X + disp, points, cells)
+        if whole is not None:
+            self.series.write(time, *whole)
 
 
 def offscreen_backend() -> None:

@@ -35,7 +35,7 @@ OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "fo
            "force_stroke.png", "thickness_*.csv", "thickness.png", "fld.csv", "fld.png", "strain_path.csv", "rim.csv",
            "rim.png", "cup.png", "cup_margin.png",
            "springback.csv", "springback.png", "deformed.png", "cup.bp", "cup_cells.bp",
-           "cup.pvd", "punch.pvd", "die.pvd", "blank_holder.pvd", "vtu", "nodal.bp", "cells.bp", "checkpoint.npz",
+           "cup.pvd", "sheet.pvd", "punch.pvd", "die.pvd", "blank_holder.pvd", "vtu", "nodal.bp", "cells.bp", "checkpoint.npz",
            "checkpoint.previous.npz", ".checkpoint.npz.new", "last_converged.rank*.npz")
 # what may change when a run is resumed ("how to continue"; `shellform run --resume`)
 CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force", "effects.friction",

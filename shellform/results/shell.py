@@ -6,6 +6,9 @@ Writes into the output folder:
                        (u, v, w) the vertex value largest in magnitude over all ranks and its
                        (x, y); wall_time_s and the solve's time split (compile, assembly, solve)
     nodal.bp, cells.bp the solution for ParaView ([output] vtx)
+    sheet.pvd, vtu/    ([output] vtu) the solution as a one-step series a stock ParaView and pyvista
+                       open: the deformed mid-surface, displacement and slopes per node, the
+                       strains and resultants per cell (results/fields.py SheetSeries)
     deformed.png       the deformed blank ([output] png, where w is a component)
 """
 
@@ -54,8 +57,14 @@ def write(outdir: Path, s, res, wall_time_s: float) -> ShellSummary:
         "ranks": res.q.function_space.mesh.comm.size, "w_center": centre_w(res), "extremes": extremes(res),
         "wall_time_s": wall_time_s, **res.timings,
     }, outdir)
-    if s.output.vtx:
-        fields.write_vtx(outdir, res.q, res.components, res.cell_fields())
+    if s.output.vtx or s.output.vtu:
+        cells = res.cell_fields()
+        if s.output.vtx:
+            fields.write_vtx(outdir, res.q, res.components, cells)
+        if s.output.vtu:
+            V = res.q.function_space
+            fields.SheetSeries(V, V.mesh.topology.index_map(2).size_local, outdir).write(
+                1.0, res.q, res.components, cells)
     if s.output.png and "w" in res.components:
         fields.write_png(outdir / "deformed.png", res.q, res.components, title=s.title)
     write_json(outdir / "summary.json", summary)

@@ -259,7 +259,7 @@ class Probe:
 @dataclass
 class Output:
     vtx: bool = True
-    vtu: bool = True  # tool scenes: cup.pvd and the tools' .pvd series (results/cup.py CupSeries)
+    vtu: bool = True  # a .pvd series: cup.pvd and the tools' (tool scenes, results/cup.py), sheet.pvd (others)
     png: bool = True
     fld: bool = True  # tool scenes with plasticity: the forming-limit view (results/fld.py)
     checkpoint_every: float = 60.0  # tool scenes: seconds of wall time between checkpoints (0: at reports only)
