@@ -152,7 +152,7 @@ from pathlib import Path
 sys.path.insert(0, {tests!r})
 from test_series import small_cup
 from shellform import run
-run.run(small_cup(), Path({out!r}))
+run.run(small_cup().changed({{"output.png": True}}), Path({out!r}))
 """
 
 
@@ -161,7 +161,7 @@ run.run(small_cup(), Path({out!r}))
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
 def test_the_series_does_not_depend_on_the_ranks(tmp_path):
     """small_cup on 2 ranks writes the serial run's last step: the same nodes and triangles in
-    the same order, the same fields to the solver's tolerance."""
+    the same order, the same fields to the solver's tolerance; and rank 0 draws cup.png."""
     run.run(small_cup(), tmp_path / "serial")
     script = tmp_path / "two.py"
     script.write_text(TWO_RANKS.format(tests=str(Path(__file__).parent), out=str(tmp_path / "two")))
@@ -177,6 +177,8 @@ def test_the_series_does_not_depend_on_the_ranks(tmp_path):
         np.testing.assert_allclose(two.point_data[name], serial.point_data[name], atol=1e-6)
     np.testing.assert_allclose(two.cell_data["equivalent_plastic_strain"],
                                serial.cell_data["equivalent_plastic_strain"], atol=1e-6)
+    png = (tmp_path / "two" / "cup.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and int.from_bytes(png[16:20], "big") == 1000  # its width
     _, punch = last_step(tmp_path / "two" / "punch.pvd")
     _, punch1 = last_step(tmp_path / "serial" / "punch.pvd")
     np.testing.assert_allclose(punch.points, punch1.points, atol=1e-9)

@@ -31,7 +31,7 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              pyvista open: the deformed sheet with its point and cell fields,
                              and punch.pvd, die.pvd, blank_holder.pvd, the tools' surfaces
                              (results/cup.py CupSeries, docs/results.md)
-    cup.png                  the drawn cup coloured by thickness strain, white at zero (serial runs)
+    cup.png                  the drawn cup coloured by thickness strain, white at zero (rank 0 draws it)
     fld.csv, fld.png         ([output] fld) the cells' major and minor true strains over the
                              Keeler-Brazier forming-limit curve, each cell's margin to it;
                              cup_margin.png the cup coloured by that margin (results/fld.py)

@@ -190,7 +190,7 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
     fld.plot(outdir / "fld.png", f["major_strain"], f["minor_strain"], curve,
              f"{title}: stroke {p.stroke:.1f} mm", label, beside)
     if png:
-        top = max(float(np.abs(margin).max(initial=0.0)), 1e-3)
+        top = max(comm.allreduce(float(np.abs(margin).max(initial=0.0)), op=MPI.MAX), 1e-3)
         picture(outdir / "cup_margin.png", p, f"{title}: margin to the forming-limit curve (< 0: past it)",
                 ("margin to the FLC", margin, (-top, top), "PuOr"), mark="least margin {:.3f}")
     worst = min(rows, key=lambda r: r["margin"])
@@ -335,27 +335,28 @@ def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> Non
 def picture(path: Path, p, title: str, cell_field: tuple | None = None, mark: str | None = None) -> None:
     """The drawn cup (true scale, a quarter blank mirrored to the whole cup) seen from above at
     an angle, so that the flange, the wall and the bottom show, coloured by the nodal thickness
-    strain or by cell_field = (name, values per cell, (min, max), colour map); serial runs only.
-    The thickness strain takes a diverging map on limits symmetric about zero (+-its largest
+    strain or by cell_field = (name, values per owned cell, (min, max), colour map). The
+    thickness strain takes a diverging map on limits symmetric about zero (+-its largest
     magnitude), so that white is an unchanged thickness, red thickening and blue thinning.
-    mark: a label format ("least {:.3f}") put on the cell where cell_field is least."""
-    mesh = p.model.mesh
-    if mesh.comm.size > 1:
+    mark: a label format ("least {:.3f}") put on the cell where cell_field is least. On several
+    ranks rank 0 gathers the sheet (fields.gather_in_input_order) and draws it: collective."""
+    m = p.model
+    _, x, e33 = p.nodal_values()
+    cells = {} if cell_field is None else {"field": np.asarray(cell_field[1])[: m.num_cells]}
+    whole = fields.gather_in_input_order(m.mesh.comm, fields.input_order(m.V, m.num_cells), x, {"e33": e33}, cells)
+    if whole is None:
         return
+    points, triangles, point_values, cell_values = whole
     offscreen_backend()
     import pyvista
-    from dolfinx import plot
 
-    topology, cell_types, x = plot.vtk_mesh(mesh)
-    grid = pyvista.UnstructuredGrid(topology, cell_types, x + p.displacements()[: x.shape[0]])
-    e33 = np.zeros(x.shape[0])
-    owned = p.nodal_values()[2]
-    e33[: len(owned)] = owned
-    clim, cmap, name = thickness_colours(e33)
-    grid.point_data[name] = e33
+    grid = pyvista.PolyData(points, faces=np.column_stack([np.full(len(triangles), 3), triangles]).ravel())
+    clim, cmap, name = thickness_colours(point_values["e33"])
+    grid.point_data[name] = point_values["e33"]
     labels = None
     if cell_field is not None:
-        name, values, clim, cmap = cell_field
+        name, _, clim, cmap = cell_field
+        values = cell_values["field"]
         grid.cell_data[name] = values
         if mark is not None and len(values):
             i = int(np.argmin(values))
