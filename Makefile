@@ -7,6 +7,8 @@ STAMP  := $(VENV)/.installed
 OUT    ?= results/square_cup
 # test processes (pytest-xdist): one per core of the 2-core machines the suite is sized for
 NPROC  ?= 2
+# make venv compiles the numba and FFCx kernels into the user's caches once (WARM=0: not)
+WARM   ?= 1
 
 .PHONY: demo test test-slow venv clean bench docs
 
@@ -19,6 +21,12 @@ $(STAMP): pyproject.toml scripts/find-python.sh
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[wheel,test]'
 	$(PY) -c "import shellform; shellform.check_install()"
+ifneq ($(WARM),0)
+	@echo "shellform: compiling the kernels once (a short cup; WARM=0 skips it; docs/performance.md, issue 44)"
+	$(VENV)/bin/shellform run demos/numisheet93_aluminium.toml -o $(VENV)/warm-up --set mesh.n=6 \
+	    --set tools.stroke=0.5 --set output.png=false --set output.vtx=false --set output.fld=false >/dev/null
+	rm -rf $(VENV)/warm-up
+endif
 	@touch $(STAMP)
 
 demo: $(STAMP)

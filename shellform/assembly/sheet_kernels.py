@@ -8,7 +8,12 @@ Compiled once per (effects, quadrature degree) on a mesh-free domain, like Eleme
     tangent    int de . D . te + S . d2e   (coefficients z, S, D)
     pressure   d/dz int p U_3              (dead pressure per unit p)
     edge_strain, edge_gradient   E and dE/dz at the edge points      (the assumed membrane strain)
-    gradient, geometric          B = de/dz at the points, int S . d2e (the assumed membrane strain)
+    gradient, geometric          B = de/dz at the points, int S . d2e (the assumed membrane strain;
+                                 B also where the tools' faces press, the effect ironing)
+
+The last four are compiled only when a sheet that needs them is built (SheetKernels.require):
+a first run without the assumed membrane strain or ironing does not compile them (7 s of CPU
+of the cold run's 20 s of FFCx kernels, docs/performance.md, "Where a cold first run's time goes").
 
 Two numba loops over the owned cells do the element around the constitutive update (which is
 shellform.material.update.section_update, a loop of its own so that its time is measured apart),
@@ -59,6 +64,11 @@ def packed_offsets(ufcx, form, coefficients) -> np.ndarray:
                 out[k] = start
         start += c.ufl_element().dim
     return out
+
+
+def _address(kernel) -> int:
+    """A kernel's address, 0 for one not compiled (SheetKernels.require)."""
+    return 0 if kernel is None else kernel_address(kernel)
 
 
 def _facet_kernel(ufcx):
@@ -124,24 +134,43 @@ class SheetKernels:
         ufcx_e, _, _ = ffcx_jit(comm, (e, el.points), form_compiler_options=_OPTIONS,
                                 jit_options=JIT_OPTIONS)
         self.strain = ufcx_e.tabulate_tensor_float64
-        # The assumed membrane strain (assumed_membrane) needs the membrane strain E and dE/dz at
-        # the edge points, B = de/dz at the area points, and the initial-stress tangent on its own.
-        edges = assumed_membrane.edge_points()
-        E = ufl.as_vector([e[i] for i in range(3)])
-        ufcx_m, _, _ = ffcx_jit(comm, (E, edges), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
-        ufcx_dm, _, _ = ffcx_jit(comm, (ufl.derivative(E, z, dz), edges), form_compiler_options=_OPTIONS,
-                                 jit_options=JIT_OPTIONS)
-        ufcx_b, _, _ = ffcx_jit(comm, (de, el.points), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
-        self.edge_strain, self.edge_gradient = ufcx_m.tabulate_tensor_float64, ufcx_dm.tabulate_tensor_float64
-        self.gradient = ufcx_b.tabulate_tensor_float64
-        self.geometric = None
-        if nonlinear:
-            fgeo = ufl.derivative(ufl.derivative(kl.internal_work(e, Sq, dx), z, dz), z, tz)
-            self.geometric, ufcx_g = _cell_kernel(comm, fgeo)
-            self.geometric_offsets = packed_offsets(ufcx_g, fgeo, [z, Sq, Dq])
         self.nconst = 4 if shallow is True else 0  # a constant kappa0 in every kernel that sees it
         self.edge_gradients = assumed_membrane.cubic_gradients()  # reference, at the edge points
+        # the kernels only the assumed membrane strain or ironing calls: compiled when a sheet
+        # first needs them (require), not before (docs/performance.md, issue 44)
+        self._fields = (z, dz, tz, e, de, Sq, Dq, dx)
+        self.edge_strain = self.edge_gradient = self.gradient = self.geometric = None
+        self.geometric_offsets = self.tangent_offsets
+        self.assumed, self.pressed = False, False
+        self.strain_loop = self._strain_loop()
+        self.tensor_loop = self._tensor_loop()
 
+    def require(self, assumed: bool, pressed: bool) -> None:
+        """Compile the kernels a sheet with the assumed membrane strain (assumed: E and dE/dz at
+        the edge points, B = de/dz at the area points, the initial-stress tangent on its own)
+        or pressed by the tools' faces (pressed, the effect ironing: B) calls, where not done
+        yet, and bind the loops to them. Until then the loops hold address 0 for them, which
+        they never call: beta = 1 and no cell pressed."""
+        assumed, pressed = assumed and not self.assumed, (assumed or pressed) and not self.pressed
+        if not (assumed or pressed):
+            return
+        comm, el = self._comm, self.element
+        z, dz, tz, e, de, Sq, Dq, dx = self._fields
+        if pressed:
+            ufcx_b, _, _ = ffcx_jit(comm, (de, el.points), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
+            self.gradient, self.pressed = ufcx_b.tabulate_tensor_float64, True
+        if assumed:
+            edges = assumed_membrane.edge_points()
+            E = ufl.as_vector([e[i] for i in range(3)])
+            ufcx_m, _, _ = ffcx_jit(comm, (E, edges), form_compiler_options=_OPTIONS, jit_options=JIT_OPTIONS)
+            ufcx_dm, _, _ = ffcx_jit(comm, (ufl.derivative(E, z, dz), edges), form_compiler_options=_OPTIONS,
+                                     jit_options=JIT_OPTIONS)
+            self.edge_strain, self.edge_gradient = ufcx_m.tabulate_tensor_float64, ufcx_dm.tabulate_tensor_float64
+            if self.nonlinear:
+                fgeo = ufl.derivative(ufl.derivative(kl.internal_work(e, Sq, dx), z, dz), z, tz)
+                self.geometric, ufcx_g = _cell_kernel(comm, fgeo)
+                self.geometric_offsets = packed_offsets(ufcx_g, fgeo, [z, Sq, Dq])
+            self.assumed = True
         self.strain_loop = self._strain_loop()
         self.tensor_loop = self._tensor_loop()
 
@@ -163,17 +192,16 @@ class SheetKernels:
     def _strain_loop(self):
         """strain_loop(threads, cells, ...): the loop's shares on `threads` threads."""
         el = self.element
-        bound = (kernel_address(self.strain), kernel_address(self.edge_strain), *el.q_map(), el.component_columns(),
+        bound = (kernel_address(self.strain), _address(self.edge_strain), *el.q_map(), el.component_columns(),
                  el.nz, self.nconst)
         return lambda threads, *args: jit.over_threads(strain_loop, threads, *bound, *args)
 
     def _tensor_loop(self):
         """tensor_loop(threads, cells, ...): the loop's shares on `threads` threads."""
         el = self.element
-        geometric = kernel_address(self.geometric) if self.geometric is not None else 0
-        go = self.geometric_offsets if self.geometric is not None else self.tangent_offsets
-        bound = (kernel_address(self.force), kernel_address(self.tangent), geometric, kernel_address(self.gradient),
-                 kernel_address(self.edge_gradient), self.force_offsets, self.tangent_offsets, go, *el.q_map(),
+        bound = (kernel_address(self.force), kernel_address(self.tangent), _address(self.geometric),
+                 _address(self.gradient), _address(self.edge_gradient), self.force_offsets, self.tangent_offsets,
+                 self.geometric_offsets, *el.q_map(),
                  el.component_columns(), el.nz, el.nqp, self.nconst, self.edge_gradients, el.weights)
         return lambda threads, *args: jit.over_threads(tensor_loop, threads, *bound, *args)
 

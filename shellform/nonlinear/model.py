@@ -113,6 +113,7 @@ class SheetModel:
         beta = assumed_membrane.stabilisation(self.thickness, self.cell_coords, mesh.comm) if tied else 1.0
         self.beta = np.full(self.num_cells, beta)
         self.tying = assumed_membrane.tyings(self.cell_coords) if tied else np.zeros((0, 3, 27))
+        self.kernels.require(tied, "ironing" in self.effects)  # the kernels these two call, compiled once
         self.cell_size = float(mesh.comm.allreduce(np.sqrt(area.min()) if area.size else np.inf, op=MPI.MIN))
         el = self.kernels.element
         self.nqp = el.nqp
