@@ -22,9 +22,9 @@ $(STAMP): pyproject.toml scripts/find-python.sh
 	$(PY) -m pip install -q -e '.[wheel,test]'
 	$(PY) -c "import shellform; shellform.check_install()"
 ifneq ($(WARM),0)
-	@echo "shellform: compiling the kernels once (a short cup; WARM=0 skips it; docs/performance.md, issue 44)"
-	$(VENV)/bin/shellform run demos/numisheet93_aluminium.toml -o $(VENV)/warm-up --set mesh.n=6 \
-	    --set tools.stroke=0.5 --set output.png=false --set output.vtx=false --set output.fld=false >/dev/null
+	@echo "shellform: compiling the kernels once, so that a first run starts at once (a short cup; WARM=0 skips it)"
+	$(VENV)/bin/shellform run demos/numisheet93_aluminium.toml -o $(VENV)/warm-up -q --set mesh.n=6 \
+	    --set tools.stroke=0.5 --set output.png=false --set output.vtx=false --set output.fld=false
 	rm -rf $(VENV)/warm-up
 endif
 	@touch $(STAMP)
