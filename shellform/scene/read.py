@@ -11,9 +11,10 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, LOAD_STEP_KEYS, SQUARE_TOOL_KEYS,
-                                    STROKE_STEP_KEYS, Drawbead, EdgeMoment, Probe, Geometry, Loads, Material,
-                                    MeshSpec, Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
+from shellform.scene.schema import (LOAD_STEP_KEYS, STROKE_STEP_KEYS, TOOL_SHAPES, Drawbead, EdgeMoment, Probe,
+                                    Geometry, Loads, Material, MeshSpec, Output, PointLoad, Process, Scene, Solver,
+                                    Surface, ToolsSpec)
+from shellform.tools import kinds as tool_kinds
 
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
@@ -107,16 +108,13 @@ def from_dict(data: dict) -> Scene:
         kwargs["output"].probe = probes
     if "supports" in data:
         kwargs["supports"] = _supports(data["supports"])
-    if isinstance(tools, dict) and tools.get("shape") == "round":
-        for key in SQUARE_TOOL_KEYS:
+    if "tools" in kwargs:  # the keys of the other kinds of tools are not this kind's
+        shape = kwargs["tools"].shape
+        if shape not in TOOL_SHAPES:
+            raise InputError("tools.shape", f"must be one of {TOOL_SHAPES}, got {shape!r}")
+        for key, message in tool_kinds.foreign_keys(shape).items():
             if key in tools:
-                raise InputError(f"tools.{key}", "is a key of square tools: round tools take punch_radius and "
-                                 "die_radius")
-    if isinstance(tools, dict):
-        for key in ANALYTIC_TOOL_KEYS if tools.get("shape") == "cad" else CAD_TOOL_KEYS:
-            if key in tools:
-                raise InputError(f"tools.{key}", "is a key of analytic tools: shape = 'cad' takes punch_file, die_file "
-                                 "and their placements" if tools.get("shape") == "cad" else "is a key of shape = 'cad'")
+                raise InputError(f"tools.{key}", message)
     process = data.get("process")
     if isinstance(process, dict):
         for key in LOAD_STEP_KEYS if "tools" in data else STROKE_STEP_KEYS:
@@ -179,11 +177,8 @@ def to_dict(s: Scene) -> dict:
     if s.tools is not None:
         data["tools"]["drawbead"] = [asdict(b) for b in s.tools.drawbead]
     data["output"]["probe"] = [asdict(p) for p in s.output.probe]
-    if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
-        for key in SQUARE_TOOL_KEYS:
-            del data["tools"][key]
-    if s.tools is not None:  # the keys of the other kind of tools are not the scene's
-        for key in ANALYTIC_TOOL_KEYS if s.tools.shape == "cad" else CAD_TOOL_KEYS:
+    if s.tools is not None:  # the keys of the other kinds of tools are not the scene's (a round tool's
+        for key in tool_kinds.foreign_keys(s.tools.shape):  # half-width is set from its radius: ToolsSpec)
             data["tools"].pop(key, None)
     for key in LOAD_STEP_KEYS if s.tools is not None else STROKE_STEP_KEYS:  # the other kind of scene's steps
         del data["process"][key]

@@ -3,7 +3,7 @@ condition holds) and ``keys_of_effects`` (a key that takes a meaning only with a
 its default without it)."""
 
 from shellform import effects as registry
-from shellform.errors import InputError
+from shellform.errors import require  # noqa: F401  (the scene checks' rule, shared with the tool kinds)
 from shellform.scene.schema import Scene
 
 
@@ -24,9 +24,3 @@ def keys_of_effects(s: Scene, section: str) -> None:
             value, default = getattr(getattr(s, table), name), getattr(type(getattr(s, table))(), name)
             require(value == default, key, f"{value!r} takes a meaning only with the effect {e.name!r}: switch it "
                     f"on, or leave the default {default!r}")
-
-
-def require(cond, name, message):
-    """Raise InputError(name, message) unless cond."""
-    if not cond:
-        raise InputError(name, message)

@@ -5,21 +5,21 @@ supports, the loads and the physical effects to simulate (shellform.effects: wha
 switches on and needs). Its effects select the solver (``Scene.route``): the linear shell, the
 nonlinear elastic-plastic sheet stepped through the load factors of [process]
 (``Scene.nonlinear``; ``Scene.hill79()`` is its material), or the sheet drawn by the rigid tools
-of [tools] (``Scene.tools``, shellform.contact.tools).
+of [tools] (``Scene.tools``; its kinds: shellform.tools.kinds).
 
 A Scene is checked when it is made (shellform.scene.checks, shellform.scene.machine); a changed
 scene is a new one, made by ``Scene.changed`` and checked again. See docs/scenes.md for every key.
 """
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, make_dataclass
 
 from shellform import effects as registry
 from shellform.material import SheetMaterial, criteria
 from shellform.mesh import outline
+from shellform.tools import kinds as tool_kinds
 
-__all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS",
-           "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS", "HOLDERS",
+__all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SPREADS", "HOLDERS",
            "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS", "ANISOTROPY_LISTS",
@@ -29,15 +29,7 @@ __all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SQUARE_TOOL_KEY
 # [process]: a sheet scene steps its load factor, a tool scene the punch's travel in mm
 LOAD_STEP_KEYS = ("initial_step", "min_step", "max_step")
 STROKE_STEP_KEYS = ("initial_step_mm", "min_step_mm", "max_step_mm")
-TOOL_SHAPES = ("square", "round", "cad")
-SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
-# the analytic tools' keys, which shape = "cad" does not take (its punch and die are files)
-ANALYTIC_TOOL_KEYS = (*SQUARE_TOOL_KEYS, "punch_profile_radius", "die_profile_radius", "punch_radius", "die_radius",
-                      "punch_gap")
-CAD_TOOL_KEYS = ("punch_file", "die_file", "punch_translation", "die_translation", "punch_rotation", "die_rotation",
-                 "punch_direction", "punch_normals", "die_normals",
-                 "holder_half_width", "holder_corner_radius")
-TOOL_NORMALS = ("outward", "inward")  # which way a CAD tool's faces' normals point: to the sheet, or away
+TOOL_SHAPES = tool_kinds.SHAPES  # tools.shape: the registered kinds of tools (shellform.tools.kinds)
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
 HOLDERS = ("force", "gap")  # the blank holder presses with a force, or is held at a gap over the die
 
@@ -201,49 +193,36 @@ class Drawbead:
     uplift: float = 0.0  # N/mm, lifting the sheet off the die (the holder takes it)
 
 
-@dataclass
-class ToolsSpec:
-    """Rigid tools of cup deep drawing (shellform.contact.tools): square (NUMISHEET'93) or round.
-    A round punch is the square one with plan corner radius = half-width = punch_radius (its
-    plan is a circle), a round die the same with die_radius. "cad": punch and die are the
-    surfaces of CAD files (shellform.contact.surface_tool), the holder the flat one over the
-    rounded square (holder_half_width, holder_corner_radius) and outside it."""
+def _tool_field(default):
+    """A dataclass field of a kind's key (shellform.tools.kinds: FIELDS), a list copied per scene."""
+    if isinstance(default, list):
+        return field(default_factory=lambda: list(default))
+    return field(default=default)
 
-    shape: str = "square"  # "square", "round" or "cad"
-    punch_radius: float = 0.0  # round: the punch's radius (0: unset)
-    die_radius: float = 0.0  # round: the die opening's radius (0: unset)
-    punch_half_width: float = 35.0  # 70 mm square punch
-    punch_corner_radius: float = 10.0  # plan corner radius
-    punch_profile_radius: float = 8.0  # nose radius
-    die_half_width: float = 37.0  # 74 mm die opening
-    die_corner_radius: float = 12.0
-    die_profile_radius: float = 5.0  # die shoulder radius
-    punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
-    punch_file: str = ""  # cad: the punch's STEP, IGES or BREP file (or an .stl, .msh surface mesh), relative to the scene's folder
-    die_file: str = ""  # cad: the die's
-    # cad: mm, moving the file's frame into the scene's
-    punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    die_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    # cad: degrees, turning the file's frame about the scene's x, then y, then z (before the translation)
-    punch_rotation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    die_rotation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    punch_direction: list[float] = field(default_factory=lambda: [0.0, 0.0, -1.0])  # cad: the way the punch travels
-    punch_normals: str = "outward"  # cad: "outward" (the faces' normals point to the sheet) or "inward"
-    die_normals: str = "outward"
-    holder_half_width: float = 0.0  # cad: the holder's inner edge, a rounded square (where the die's flat top begins)
-    holder_corner_radius: float = 0.0
-    holder: str = "force"  # "force": the holder presses with blank_holder_force; "gap": its face is held at holder_gap
-    holder_gap: float = 0.0  # mm, holder = "gap": the distance between the holder's face and the die's top (>= t)
-    blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
-    friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
-    stroke: float = 30.0  # punch travel, mm
-    holder_spread: str = "area"  # how the closed holder spreads its force: "area" or "rigid" (contact/holder.py)
-    drawbead: list[Drawbead] = field(default_factory=list, metadata={"items": "tables"})  # [[tools.drawbead]]
 
-    def __post_init__(self):
-        if self.shape == "round":  # circles: corner radius = half-width = radius
-            self.punch_half_width = self.punch_corner_radius = self.punch_radius
-            self.die_half_width = self.die_corner_radius = self.die_radius
+def _complete_tools(self):
+    """The keys its kind derives from others (a round tool's half-width from its radius)."""
+    if self.shape in tool_kinds.KINDS:
+        tool_kinds.kind(self.shape).complete(self)
+
+
+# Rigid tools of cup deep drawing: tools.shape names their kind (shellform.tools.kinds: square,
+# round, cad), whose keys (FIELDS) come first, then the keys every kind takes.
+ToolsSpec = make_dataclass("ToolsSpec", [
+    ("shape", str, field(default="square")),  # the kind of tools, one of TOOL_SHAPES
+    *[(name, type(default) if not isinstance(default, list) else list[float], _tool_field(default))
+      for name, default, _ in tool_kinds.fields()],
+    # "force": the holder presses with blank_holder_force; "gap": its face is held at holder_gap
+    ("holder", str, field(default="force")),
+    ("holder_gap", float, field(default=0.0)),  # mm, holder = "gap": the face's distance from the die's top (>= t)
+    ("blank_holder_force", float, field(default=19600.0)),  # N, on the whole blank (a quarter model carries a quarter)
+    ("friction", float, field(default=0.0)),  # Coulomb coefficient (> 0 needs the effect 'friction')
+    ("stroke", float, field(default=30.0)),  # punch travel, mm
+    ("holder_spread", str, field(default="area")),  # how the closed holder spreads its force: "area" or "rigid"
+    ("drawbead", list[Drawbead], field(default_factory=list, metadata={"items": "tables"})),  # [[tools.drawbead]]
+], namespace={"__post_init__": _complete_tools, "__doc__": """Rigid tools of cup deep drawing: tools.shape
+    names their kind (shellform.tools.kinds), whose keys come first (each kind's FIELDS), then
+    the holder's, the force, friction, stroke and drawbeads every kind takes."""}, module=__name__)
 
 
 @dataclass
