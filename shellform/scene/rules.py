@@ -4,15 +4,12 @@ its default without it)."""
 
 from shellform import effects as registry
 from shellform.errors import require  # noqa: F401  (the scene checks' rule, shared with the tool kinds)
-from shellform.scene.schema import Scene
-
 
 def sheet_effects() -> tuple[str, ...]:
     """The effects that select the nonlinear sheet."""
     return tuple(n for n, e in registry.EFFECTS.items() if e.route == registry.SHEET)
 
-
-def keys_of_effects(s: Scene, section: str) -> None:
+def keys_of_effects(s, section: str) -> None:
     """The keys of `section` that take a meaning only with an effect (shellform.effects, Effect.keys)
     keep their defaults unless that effect is on. (A whole table, as [tools] of 'contact', is
     checked with its table.)"""

@@ -7,15 +7,15 @@ nonlinear elastic-plastic sheet stepped through the load factors of [process]
 (``Scene.nonlinear``; ``Scene.hill79()`` is its material), or the sheet drawn by the rigid tools
 of [tools] (``Scene.tools``; its kinds: shellform.tools.kinds).
 
-A Scene is checked when it is made (shellform.scene.checks, shellform.scene.machine); a changed
-scene is a new one, made by ``Scene.changed`` and checked again. See docs/scenes.md for every key.
+The Scene that holds these sections is read and checked in shellform.scene.read (the checks:
+shellform.scene.checks, shellform.scene.machine); a changed scene is a new one, made by
+``Scene.changed`` and checked again. See docs/scenes.md for every key.
 """
 
 import math
 from dataclasses import dataclass, field, fields, make_dataclass
 
-from shellform import effects as registry
-from shellform.material import SheetMaterial, criteria
+from shellform.material import criteria
 from shellform.mesh import outline
 from shellform.tools import kinds as tool_kinds
 
@@ -24,7 +24,7 @@ __all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SPREADS", "HOLD
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS", "ANISOTROPY_LISTS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
-           "Drawbead", "ToolsSpec", "Probe", "Output", "Scene", "bounds"]
+           "Drawbead", "ToolsSpec", "Probe", "Output", "bounds"]
 
 # [process]: a sheet scene steps its load factor, a tool scene the punch's travel in mm
 LOAD_STEP_KEYS = ("initial_step", "min_step", "max_step")
@@ -245,111 +245,7 @@ class Output:
     probe: list[Probe] = field(default_factory=list, metadata={"items": "tables"})  # [[output.probe]]
 
 
-@dataclass
-class Scene:
-    title: str = "shellform scene"
-    effects: tuple[str, ...] = ("bending",)
-    geometry: Geometry = field(default_factory=Geometry)
-    surface: Surface = field(default_factory=Surface)
-    mesh: MeshSpec = field(default_factory=MeshSpec)
-    material: Material = field(default_factory=Material)
-    supports: dict[str, str] = field(default_factory=dict)  # boundary group -> support; unnamed: free
-    loads: Loads = field(default_factory=Loads)
-    solver: Solver = field(default_factory=Solver)
-    process: Process = field(default_factory=Process)
-    output: Output = field(default_factory=Output)
-    tools: ToolsSpec | None = None  # None: no [tools] table, no tools
-
-    def __post_init__(self):
-        from shellform.scene.checks import validate
-
-        validate(self)
-
-    def changed(self, changes: dict) -> "Scene":
-        """A new scene with `changes` {"section.key": value, "effects": [...], ...} applied at once,
-        read and checked as a scene file is: a bad value raises InputError naming its field.
-        This scene is left as it is."""
-        from shellform.scene.read import changed
-
-        return changed(self, changes)
-
-    @property
-    def kappa0(self) -> tuple[float, float]:
-        return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
-
-    def curvature(self):
-        """What the forms take as kappa0 with 'shallow_curvature': the ReferenceSurface of
-        surface.z0, or the principal curvatures diag(1/R1, 1/R2) as an array; None if flat."""
-        import numpy as np
-
-        from shellform.forms.reference_surface import ReferenceSurface
-
-        if "shallow_curvature" not in self.effects:
-            return None
-        if self.surface.z0:
-            return ReferenceSurface(self.surface.z0)
-        return np.diag(self.kappa0).astype(np.float64)
-
-    def pressure_field(self):
-        """How the pressure spreads (forms.loads.PressureField): its shape over the plan and, per
-        unit surface area, the curved surface it is measured on; None for a uniform pressure per
-        unit plan area (or on a flat sheet, where the two are the same)."""
-        import numpy as np
-
-        from shellform.forms.loads import PressureField
-        from shellform.forms.reference_surface import ReferenceSurface
-
-        surface = None
-        if self.loads.pressure_per == "surface" and self.surface.z0:
-            surface = ReferenceSurface(self.surface.z0)
-        elif self.loads.pressure_per == "surface" and any(k != 0 for k in self.kappa0):
-            surface = tuple(float(v) for v in np.diag(self.kappa0).ravel())
-        if not self.loads.pressure_shape and surface is None:
-            return None
-        return PressureField(self.loads.pressure_shape, surface)
-
-    @property
-    def symmetry_copies(self) -> int:
-        """How many copies of the meshed region make the whole blank (4 for a quarter)."""
-        g = self.geometry
-        if g.shape in ("rectangle", "circle"):
-            return {"full": 1, "half": 2, "quarter": 4}[g.region]
-        return 2 ** sum(v == "symmetry" for v in self.supports.values())
-
-    @property
-    def route(self) -> str:
-        """The solver its effects select (shellform.effects.route): linear shell, nonlinear sheet or tools."""
-        return registry.route(self.effects)
-
-    @property
-    def nonlinear(self) -> bool:
-        """Whether its effects select the nonlinear sheet (alone or drawn by the tools)."""
-        return self.route != registry.LINEAR
-
-    def hill79(self):
-        """The scene's shellform.material.SheetMaterial (its yield function, Hill 1979 by default):
-        elastic (hardening "none") unless the effect 'plasticity' is on. Its own validation names
-        the field (material.yield_stress, material.r0, ...)."""
-        mat = self.material
-        if "plasticity" not in self.effects:
-            return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
-        unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
-        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n > 1): unset there
-        n = unset(mat.n) if mat.hardening == "power" else mat.n
-        given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
-        given.update({k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)})
-        table = None
-        if mat.hardening == "table" and mat.flow_curve:
-            from shellform.material.flow_curve import read_csv
-
-            table = read_csv(mat.flow_curve)
-        return SheetMaterial(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
-                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction,
-                             unset(mat.Q), unset(mat.beta), unset(mat.swift_weight), table,
-                             mat.extrapolation or None)
-
-
-def bounds(s: Scene) -> tuple[float, float, float, float]:
+def bounds(s) -> tuple[float, float, float, float]:
     """x_min, x_max, y_min, y_max of the meshed region (a rectangle or circle is centred at the
     origin; a polygon is where its vertices are; a file's region is known once it is read)."""
     if s.geometry.shape in ("circle", "polygon"):

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from shellform.scene.rules import keys_of_effects, require
-from shellform.scene.schema import HOLDERS, SIDES, SPREADS, TOOL_SHAPES, Scene
+from shellform.scene.schema import HOLDERS, SIDES, SPREADS, TOOL_SHAPES
 from shellform.tools import kinds as tool_kinds
 from shellform.tools.analytic import rounded_square_sdf
 
@@ -36,7 +36,7 @@ def _validate_drawbead(bead, name: str, flat: float, corner: float) -> None:
             f"{samples[int(np.argmin(distance))].tolist()} lies within it")
 
 
-def validate_tools(s: Scene) -> None:
+def validate_tools(s) -> None:
     """The [tools] table and the effects 'contact' and 'friction' (after the material: the
     clearance is checked against the thickness)."""
     t = s.tools
@@ -80,7 +80,7 @@ def validate_tools(s: Scene) -> None:
                 f"the tools hold the blank: its outer edges must be 'free', got {v!r}")
 
 
-def _validate_holder(s: Scene, t) -> None:
+def _validate_holder(s, t) -> None:
     """The holder's mode: pressing with blank_holder_force, or held at holder_gap over the die's top
     (at least the sheet's thickness; the flange that thickens into the gap is ironed, which needs
     the effect 'ironing')."""
