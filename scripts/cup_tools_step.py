@@ -1,5 +1,5 @@
 """The square cup's punch and die as CAD solids (gmsh, OpenCASCADE), written as STEP files: the
-analytic tools of shellform/contact/tools.py built from the same dimensions, for a scene's
+analytic tools of shellform/tools/analytic.py built from the same dimensions, for a scene's
 [tools] shape = "cad" (docs/tools.md).
 
     python scripts/cup_tools_step.py SCENE.toml OUT_FOLDER

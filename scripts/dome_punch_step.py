@@ -1,5 +1,5 @@
 """A hemispherical punch as a CAD solid (gmsh, OpenCASCADE), written as a STEP file: the punch
-of demos/dome_cup.toml, a part no analytic tool of shellform/contact/tools.py describes.
+of demos/dome_cup.toml, a part no analytic tool of shellform/tools/analytic.py describes.
 
     python scripts/dome_punch_step.py OUT_FOLDER [RADIUS]
 
@@ -8,7 +8,7 @@ the same radius, its tip at z = 0 (the scene places it with punch_translation [0
 sphere is turned a quarter turn about x before the union, so that the poles of its
 parametrisation lie on its equator at (0, +-R, R), where the sheet does not reach for strokes
 below R: at a pole the surface's parameters degenerate and the closest-point Newton of
-shellform/contact/surface_tool.py loses its footing.
+shellform/tools/surface_tool.py loses its footing.
 """
 
 import math

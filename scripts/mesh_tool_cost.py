@@ -4,7 +4,7 @@
     python scripts/mesh_tool_cost.py PER_TURN [MODULE.py ...]
 
 The NUMISHEET'93 aluminium cup's punch meshed by gmsh at PER_TURN triangles a turn
-(scripts/cup_tools_stl.py) and read as MeshTool (of shellform.contact.mesh_tool and of each
+(scripts/cup_tools_stl.py) and read as MeshTool (of shellform.tools.mesh_tool and of each
 MODULE.py given, another version of mesh_tool.py), at 2,000 random points within 3 mm of the
 analytic punch, CPU ms:
 
@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from shellform import scene
-from shellform.contact import mesh_tool
-from shellform.contact.tools import square_cup_tools
+from shellform.tools import mesh_tool
+from shellform.tools.square import square_cup_tools
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cup_tools_step import punch  # noqa: E402

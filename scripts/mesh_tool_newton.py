@@ -25,7 +25,8 @@ import numpy as np
 import shellform  # noqa: F401  (before dolfinx)
 from shellform import scene
 from shellform.contact import problem as drawing
-from shellform.contact.mesh_tool import MeshTool, read_surface_mesh
+from shellform.tools import cad as cad_kind
+from shellform.tools.mesh_tool import MeshTool, read_surface_mesh
 from shellform.errors import InputError
 from shellform.results.cup import draw_in, peak_thinning
 
@@ -87,7 +88,7 @@ with tempfile.TemporaryDirectory() as folder:
                          "tools.holder_half_width": HOLDER[0], "tools.holder_corner_radius": HOLDER[1]})
         sizes = [len(read_surface_mesh(files / f"{k}.stl")[1]) for k in ("punch", "die")]
         run(s, f"Nagata, {per_turn:g} a turn ({sizes[0]} + {sizes[1]} triangles)")
-        nagata = drawing.cad_cup_tools
+        nagata = cad_kind.tools
 
         def faceted(spec, thickness):
             tools = nagata(spec, thickness)
@@ -96,8 +97,8 @@ with tempfile.TemporaryDirectory() as folder:
             tools["die"].tool = flat_facets(spec.die_file, spec.die_normals, "tools.die_file")
             return tools
 
-        drawing.cad_cup_tools = faceted
+        cad_kind.tools = faceted
         try:
             run(s, f"faceted, {per_turn:g} a turn")
         finally:
-            drawing.cad_cup_tools = nagata
+            cad_kind.tools = nagata

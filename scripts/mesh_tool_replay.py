@@ -8,8 +8,8 @@ meshed by gmsh at PER_TURN triangles a turn (scripts/cup_tools_stl.py, as
 scripts/mesh_tool_newton.py does) and read as MeshTool, recording every call of their gap and
 shape (the points, the offset, dz). Then replays the calls on fresh tools, in the order of the
 run: the analytic tools of demos/numisheet93_aluminium.toml, the MeshTools of
-shellform.contact.mesh_tool and of each MODULE.py given (another version of mesh_tool.py, e.g.
-`git show REV:shellform/contact/mesh_tool.py > old.py`). Prints for each the CPU seconds of all
+shellform.tools.mesh_tool and of each MODULE.py given (another version of mesh_tool.py, e.g.
+`git show REV:shellform/tools/mesh_tool.py > old.py`). Prints for each the CPU seconds of all
 gap and of all shape calls, per call in ms and per Newton iteration of the run, the points
 answered each way (MeshTool.counts) and the largest differences of gap, normal and H from the
 first MeshTools' (ties: points whose gap is the same and whose normal is another closest
@@ -26,10 +26,10 @@ import numpy as np
 
 import shellform  # noqa: F401  (before dolfinx)
 from shellform import scene
-from shellform.contact import mesh_tool
-from shellform.contact.cad_tools import cad_cup_tools
+from shellform.tools import mesh_tool
+from shellform.tools.cad import cad_cup_tools
 from shellform.contact.problem import DrawingProblem
-from shellform.contact.tools import square_cup_tools
+from shellform.tools.square import square_cup_tools
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cup_tools_step import die, punch  # noqa: E402

@@ -21,8 +21,8 @@ import time
 import numpy as np
 
 from shellform import scene
-from shellform.contact.cad_tools import cad_cup_tools
-from shellform.contact.tools import square_cup_tools
+from shellform.tools.cad import cad_cup_tools
+from shellform.tools.square import square_cup_tools
 
 points = int(sys.argv[1]) if len(sys.argv) > 1 else 2000
 analytic_scene, cad_scene = (scene.load(f"demos/{name}.toml") for name in

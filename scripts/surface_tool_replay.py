@@ -6,8 +6,8 @@ the analytic tools' on the same calls (docs/tools.md, "Cost").
 Draws demos/numisheet93_aluminium_cad.toml with mesh.n = N by STROKE mm, recording every call
 of its punch's and die's gap and shape (the points, the offset, dz). Then replays the calls on
 fresh tools, in the order of the run: the analytic tools of demos/numisheet93_aluminium.toml,
-the STEP tools of shellform.contact.surface_tool and of each MODULE.py given (another version
-of surface_tool.py, e.g. `git show REV:shellform/contact/surface_tool.py > old.py`). Prints
+the STEP tools of shellform.tools.surface_tool and of each MODULE.py given (another version
+of surface_tool.py, e.g. `git show REV:shellform/tools/surface_tool.py > old.py`). Prints
 for each the CPU seconds of all gap and of all shape calls, per call in ms and per Newton
 iteration of the run, and the largest differences of gap, normal and H from the first STEP
 tools' (ties: points whose gap is the same and whose normal is another closest point's, at
@@ -24,9 +24,9 @@ import numpy as np
 
 import shellform  # noqa: F401  (before dolfinx)
 from shellform import scene
-from shellform.contact import surface_tool
+from shellform.tools import surface_tool
 from shellform.contact.problem import DrawingProblem
-from shellform.contact.tools import square_cup_tools
+from shellform.tools.square import square_cup_tools
 
 n, stroke = int(sys.argv[1]), float(sys.argv[2])
 modules = [("STEP", surface_tool)]
@@ -69,11 +69,11 @@ sets = [("analytic", square_cup_tools(analytic_scene.tools, t))]
 
 
 def cup_tools(module):
-    """The cup's tools of `module`: shellform.contact.surface_tool or another version of
+    """The cup's tools of `module`: shellform.tools.surface_tool or another version of
     surface_tool.py (its SurfaceTool placed by cad_tools), or of cad_tools.py."""
     if hasattr(module, "cad_cup_tools"):
         return module.cad_cup_tools(s.tools, t)
-    from shellform.contact import cad_tools
+    from shellform.tools import cad as cad_tools
 
     current = cad_tools.SurfaceTool
     cad_tools.SurfaceTool = module.SurfaceTool

@@ -13,7 +13,7 @@ import pytest
 from mpi4py import MPI
 
 from shellform import scene
-from shellform.contact.frames import from_frames, nodal_frames, rotate_cell_arrays
+from shellform.nonlinear.frames import from_frames, nodal_frames, rotate_cell_arrays
 from shellform.contact.problem import DrawingProblem
 from shellform.assembly.sheet_element import BS
 from shellform.contact.semi_inverse import FREE, SemiInverseDriver

@@ -7,7 +7,7 @@ import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 import numpy as np
 import pytest
 
-from shellform.contact.frames import from_frames
+from shellform.nonlinear.frames import from_frames
 from shellform.contact.problem import HOLDER, DrawingProblem
 from shellform.assembly.sheet_element import BS
 

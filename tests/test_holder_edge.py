@@ -1,4 +1,4 @@
-"""The blank holder's inner edge (shellform/contact/holder_edge.py): a rounded square, or an
+"""The blank holder's inner edge (shellform/tools/holder_edge.py): a rounded square, or an
 outline read from a die's flat top; tested apart from assembly, then read from CAD and STL dies."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
@@ -6,7 +6,7 @@ import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 import numpy as np
 import pytest
 
-from shellform.contact.holder_edge import OutlineEdge, RoundedSquareEdge, closed_loops
+from shellform.tools.holder_edge import OutlineEdge, RoundedSquareEdge, closed_loops
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 RNG = np.random.default_rng(3)
@@ -84,8 +84,8 @@ def test_the_numisheet_dies_flat_top_opening_is_its_rounded_square(name):
     """The NUMISHEET'93 die (STEP and STL): its flat top's inner loop is the rounded square
     (37 + 8, 12 + 8) where the holder begins: within 4e-4 mm (STEP, the sampling's sagitta) and
     0.03 mm (STL, 24 triangles a turn)."""
-    from shellform.contact.mesh_tool import MeshTool
-    from shellform.contact.surface_tool import SurfaceTool
+    from shellform.tools.mesh_tool import MeshTool
+    from shellform.tools.surface_tool import SurfaceTool
 
     kind = MeshTool if name.endswith(".stl") else SurfaceTool
     die = kind.from_file(ROOT / "demos" / "meshes" / "numisheet93" / name)
@@ -103,7 +103,7 @@ def test_the_cross_dies_opening_is_read_for_the_holder():
     at (22, 22) rounded with 14 mm about (36, 36); the flat top begins 5 mm further, on the arc of
     radius 9 about (36, 36): on the diagonal at 36 - 9 / sqrt(2), the holder's edge."""
     from shellform import scene
-    from shellform.contact.cad_tools import cad_cup_tools
+    from shellform.tools.cad import cad_cup_tools
 
     s = scene.load(ROOT / "demos" / "cross_cup.toml")
     tools = cad_cup_tools(s.tools, s.material.thickness)

@@ -168,7 +168,7 @@ def test_sheet_model_checks_its_thickness():
     assert err.value.field == "material.thickness"
 
 
-# -- [tools]: the square cup's rigid tools (shellform/contact/tools.py) ------------------------
+# -- [tools]: the square cup's rigid tools (shellform/tools/analytic.py) ------------------------
 CONTACT = SHEET + ["contact"]
 
 
@@ -246,7 +246,7 @@ def test_tools_error_messages():
 
 
 def test_square_cup_scene():
-    from shellform.contact.tools import square_cup_tools
+    from shellform.tools.square import square_cup_tools
 
     s = scene.from_dict(cup(effects=CONTACT + ["friction"], tools={"friction": 0.144, "stroke": 15}))
     assert s.nonlinear and s.tools.friction == 0.144 and s.tools.stroke == 15.0

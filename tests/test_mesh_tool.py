@@ -1,4 +1,4 @@
-"""Tools from surface meshes (shellform/contact/mesh_tool.py): Nagata patches of a triangulated
+"""Tools from surface meshes (shellform/tools/mesh_tool.py): Nagata patches of a triangulated
 sphere against the exact sphere at two mesh sizes (the errors fall at the patches' order), the
 NUMISHEET'93 punch meshed by gmsh and written as STL against the analytic punch, the reading of
 STL and .msh files and its errors, and the scene's dispatch of .stl files to a MeshTool."""
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from shellform import scene
-from shellform.contact.cad_tools import cad_cup_tools
-from shellform.contact.mesh_tool import MeshTool, nagata_patches, read_surface_mesh
-from shellform.contact.tools import square_cup_tools
+from shellform.tools.cad import cad_cup_tools
+from shellform.tools.mesh_tool import MeshTool, nagata_patches, read_surface_mesh
+from shellform.tools.square import square_cup_tools
 from shellform.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -317,7 +317,7 @@ def test_a_tool_meshed_without_the_blanks_symmetry_is_named():
 
     from mpi4py import MPI
 
-    from shellform.contact.cad_tools import ToolSymmetryWarning, check_mirrors
+    from shellform.tools.cad import ToolSymmetryWarning, check_mirrors
     from shellform.mesh import blank
 
     planes = np.eye(3)[:2]  # x = 0 and y = 0

@@ -1,5 +1,5 @@
 """A tool placed by a rotation and a translation and moved along any axis
-(shellform/contact/placement.py): the mapping tested apart from assembly, then in the scene."""
+(shellform/tools/placement.py): the mapping tested apart from assembly, then in the scene."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from shellform.contact.placement import Placed, rotation
-from shellform.contact.tools import Punch
+from shellform.tools.placement import Placed, rotation
+from shellform.tools.analytic import Punch
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 

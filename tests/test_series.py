@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from shellform import run, scene
-from shellform.contact.tools import Die, Punch, rounded_square_sdf, surface_mesh
+from shellform.tools.analytic import Die, Punch, rounded_square_sdf
+from shellform.tools.protocol import surface_mesh
 from shellform.results.vtu import PVDSeries
 from shellform.studies.common import mpiexec
 

@@ -1,4 +1,4 @@
-"""Tools from CAD surfaces (shellform/contact/surface_tool.py): the NUMISHEET'93 aluminium cup's
+"""Tools from CAD surfaces (shellform/tools/surface_tool.py): the NUMISHEET'93 aluminium cup's
 punch and die built in gmsh (OpenCASCADE) from the dimensions of demos/numisheet93_aluminium.toml,
 written to STEP and read back, against the analytic tools of the same scene (tools.py): gap,
 normal and shape operator at random points near every region of their surfaces, and on the
@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from shellform import scene
-from shellform.contact.surface_tool import SurfaceTool
-from shellform.contact.tools import square_cup_tools
+from shellform.tools.surface_tool import SurfaceTool
+from shellform.tools.square import square_cup_tools
 from shellform.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]

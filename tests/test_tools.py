@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from shellform.contact.tools import (BlankHolder, Die, Punch, rounded_square_hessian, rounded_square_sdf,
-                                     square_cup_tools)
-from shellform.contact.holder_edge import RoundedSquareEdge
+from shellform.tools.analytic import BlankHolder, Die, Punch, rounded_square_hessian, rounded_square_sdf
+from shellform.tools.square import square_cup_tools
+from shellform.tools.holder_edge import RoundedSquareEdge
 from shellform.scene import ToolsSpec
 
 H = 0.04  # sampling spacing of the brute-force surfaces (mm)

@@ -30,7 +30,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
-from shellform.contact.frames import nodal_frames
+from shellform.nonlinear.frames import nodal_frames
 from shellform.nonlinear.parts import Change, Part
 from shellform.results.log import say
 

@@ -32,7 +32,7 @@ import numpy as np
 from dolfinx import fem, la
 
 from shellform.assembly.sheet_element import BS
-from shellform.contact.frames import add_tangent_slot_stiffness, subtract_nodal_forces
+from shellform.nonlinear.frames import add_tangent_slot_stiffness, subtract_nodal_forces
 from shellform.nonlinear.parts import Part
 
 

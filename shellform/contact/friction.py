@@ -43,7 +43,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
-from shellform.contact.frames import add_tangent_slot_stiffness, subtract_nodal_forces
+from shellform.nonlinear.frames import add_tangent_slot_stiffness, subtract_nodal_forces
 from shellform.nonlinear.parts import Change, Part
 from shellform.results.log import say
 

@@ -16,13 +16,12 @@ from shellform import supports as named_supports
 from shellform.assembly.sheet_element import BS
 from shellform.contact.drawbead import DrawbeadLine
 from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
-from shellform.contact.cad_tools import cad_cup_tools, check_mirrors, check_start
 from shellform.contact.pinch_edge import edge_load
-from shellform.contact.tools import square_cup_tools
 from shellform.mesh import blank, outline
 from shellform.nonlinear.model import SheetModel
 from shellform.nonlinear.problem import scene_controls
 from shellform.scene import Scene
+from shellform.tools import kinds as tool_kinds
 
 PUNCH, DIE, HOLDER = 0, 1, 2  # the open holder is the third tool of the contact set
 GAP_HOLDER = 2  # a holder at a gap is the third rigid tool
@@ -44,11 +43,11 @@ class DrawingProblem:
         model = SheetModel(rect.mesh, material, s.material.thickness, s.effects, pr.thickness_points)
         bcs = named_supports.boundary_conditions(model.V, model.components, rect, s.supports,
                                                  fixed=named_supports.sheet_fixed_components)
-        tools = (cad_cup_tools if t.shape == "cad" else square_cup_tools)(t, s.material.thickness)
-        if t.shape == "cad":
-            check_start(tools, rect.mesh.geometry.x, s.material.thickness / 2, comm, 1e-2 * s.material.thickness)
-            planes = [outline.MIRROR_NORMALS[g] for g in outline.symmetry_lines(s.geometry)]
-            check_mirrors(tools, rect.mesh.geometry.x, np.array(planes), comm)
+        kind = tool_kinds.kind(t.shape)
+        tools = kind.tools(t, s.material.thickness)
+        planes = [outline.MIRROR_NORMALS[g] for g in outline.symmetry_lines(s.geometry)]
+        kind.check_placement(tools, rect.mesh.geometry.x, s.material.thickness / 2, planes, comm,
+                             1e-2 * s.material.thickness)
         symmetry = s.symmetry_copies
         controls = scene_controls(s)
         mu = t.friction if "friction" in s.effects else 0.0

@@ -79,6 +79,7 @@ from shellform.results.log import Progress, say
 from shellform.results.summary import DrawingSummary
 from shellform.results.tables import write_csv, write_json
 from shellform.scene import Scene
+from shellform.tools import kinds as tool_kinds
 
 
 # a resume that changes one of these starts its steps afresh (not as the checkpoint had them)
@@ -255,7 +256,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     for name, line in lines.items():
         write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
     cup.plot_thickness(outdir / "thickness.png", lines, f"{s.title}: stroke {p.stroke:.1f} mm")
-    rim = cup.write_rim(outdir, p, s.title) if s.tools.shape == "round" else None
+    rim = cup.write_rim(outdir, p, s.title) if tool_kinds.kind(s.tools.shape).RIM else None
     cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
     if s.output.png:
         cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")

@@ -28,7 +28,7 @@ cache folder is keyed by the sources of shellform/material, this registry among 
 
 import importlib
 
-from shellform.material import CRITERION_
+from shellform.material.layout import CRITERION_
 from shellform import _jit as jit
 
 REGISTRY = ("hill79", "hill48", "yld2000")  # modules of shellform.material; the id of each is its place here

@@ -21,7 +21,7 @@ elastic (law 0): no yield; returns (inf, 0).
 import math
 
 
-from shellform.material import (A_, B_, C_, E_, H_, LAW_, LAW_POWER, LAW_SWIFT, LAW_SWIFT_VOCE, LAW_TABLE,
+from shellform.material.layout import (A_, B_, C_, E_, H_, LAW_, LAW_POWER, LAW_SWIFT, LAW_SWIFT_VOCE, LAW_TABLE,
                                 LAW_VOCE, TABLE_)
 from shellform import _jit as jit
 

@@ -27,7 +27,7 @@ r0 = r45 = r90 = r gives Hill 1979 with m = 2 (the paper's normal anisotropy).
 
 import math
 
-from shellform.material import PAR_, number, require
+from shellform.material.layout import PAR_, number, require
 from shellform import _jit as jit
 
 NAME = "hill48"

@@ -26,7 +26,7 @@ below m eps^2 / 2 ~ 1e-24 (below rounding) for m >= 2.
 import math
 
 
-from shellform.material import PAR_, number, require
+from shellform.material.layout import PAR_, number, require
 from shellform import _jit as jit
 
 NAME = "hill79"

@@ -55,7 +55,7 @@ import math
 import numpy as np
 
 from shellform import _jit as jit
-from shellform.material import E_, NU_
+from shellform.material.layout import E_, NU_
 
 
 def through_thickness_modulus(material: np.ndarray) -> float:

@@ -28,7 +28,7 @@ sheet through any rigid rotation (docs/material.md).
 import math
 
 
-from shellform.material import COS_, E_, LAW_, LAW_ELASTIC, NU_, ROTATED_, SIN_
+from shellform.material.layout import COS_, E_, LAW_, LAW_ELASTIC, NU_, ROTATED_, SIN_
 from shellform.material.criteria import yield_function
 from shellform.material.hardening import flow_stress
 from shellform import _jit as jit

@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from shellform.material import A_, B_, C_, LAW_, LAW_ELASTIC, LAW_SWIFT
+from shellform.material.layout import A_, B_, C_, LAW_, LAW_ELASTIC, LAW_SWIFT
 from shellform.material.hardening import flow_stress
 from shellform.material.plane_stress import return_map
 

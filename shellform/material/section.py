@@ -16,7 +16,7 @@ section exactly.
 import numpy as np
 
 from shellform.errors import InputError
-from shellform.material import E_, NU_
+from shellform.material.layout import E_, NU_
 from shellform.material import hencky
 from shellform.material.plane_stress import return_core, thickness_strain
 from shellform import _jit as jit

@@ -45,7 +45,8 @@ import math
 
 import numpy as np
 
-from shellform.material import PAR_, number, require, yld2000_fit
+from shellform.material import yld2000_fit
+from shellform.material.layout import PAR_, number, require
 from shellform import _jit as jit
 
 NAME = "yld2000"

@@ -47,7 +47,7 @@ import math
 
 import numpy as np
 
-from shellform.material import number, require
+from shellform.material.layout import number, require
 
 KEYS = ("fit_angles", "fit_r", "fit_sigma")  # the lists; with sigma_b (required) and r_b (optional)
 DIRECTIONAL = ("r0", "r45", "r90", "sigma0", "sigma45", "sigma90")  # yld2000.fit's keys, refused beside the lists

@@ -31,7 +31,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from shellform.assembly.sheet_element import BS
-from shellform.contact.frames import from_frames, rotate_cell_arrays
+from shellform.nonlinear.frames import from_frames, rotate_cell_arrays
 from shellform.nonlinear.free_rows import FreeRowsLU, lu_solver
 from shellform.nonlinear.parts import Constraints
 

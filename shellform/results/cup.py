@@ -22,6 +22,9 @@ from mpi4py import MPI
 
 from shellform.results import fields
 from shellform.results.fields import offscreen_backend
+from shellform.tools import kinds as tool_kinds
+from shellform.tools import square
+from shellform.tools.protocol import surface_mesh
 
 
 def _gather(comm, *arrays):
@@ -42,7 +45,7 @@ def draw_in(p) -> dict:
     corner = int(np.argmax(X[:, 0] + X[:, 1]))
     out = {"DX": float(X0[0] - x0[0]), "DY": float(X1[1] - x1[1]),
            "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
-    if p.scene.tools.shape == "round":
+    if tool_kinds.kind(p.scene.tools.shape).RIM:
         out.update(rim_draw_in(rim(p)))
     return out
 
@@ -114,21 +117,14 @@ def write_rim(outdir: Path, p, title: str) -> dict:
     return out
 
 
-LINES = {  # the thickness lines of a cup by its tools' shape: name -> nodes on it
-    "square": {"diagonal": lambda X, tol: np.abs(X[:, 0] - X[:, 1]) < tol,
-               "transverse": lambda X, tol: np.abs(X[:, 1]) < tol},
-    "round": {"0deg": lambda X, tol: np.abs(X[:, 1]) < tol, "90deg": lambda X, tol: np.abs(X[:, 0]) < tol},
-}
-LINES["cad"] = LINES["square"]  # a cup drawn by CAD tools: the square cup's lines
-
-
 def thickness_lines(p) -> dict[str, list[dict]]:
-    """Thickness strain at the nodes along the cup's lines (LINES), by initial distance."""
+    """Thickness strain at the nodes along the cup's lines (its kind of tools' LINES:
+    shellform.tools.kinds), by initial distance."""
     X, _, e33 = p.nodal_values()
     X, e33 = _gather(p.model.mesh.comm, X, e33)
     tol = 1e-6 * p.blank_size()
     lines = {}
-    for name, line in LINES[p.scene.tools.shape].items():
+    for name, line in tool_kinds.kind(p.scene.tools.shape).LINES.items():
         on = line(X, tol)
         r = np.hypot(X[on, 0], X[on, 1])
         lines[name] = [{"initial_position_mm": float(r[i]), "thickness_strain": float(e33[on][i])}
@@ -210,7 +206,7 @@ class CupSeries:
     the point fields displacement, thickness_strain, contact_state (DrawingProblem.CONTACT_STATES)
     and contact_pressure, and the cell fields equivalent_plastic_strain, major_strain,
     minor_strain and, where the forming-limit view is on, fld_margin; and punch.pvd, die.pvd,
-    blank_holder.pvd, each tool's surface at its position at the report (tools.surface_mesh
+    blank_holder.pvd, each tool's surface at its position at the report (protocol.surface_mesh
     over the blank's plan extent). Rank 0 gathers the sheet and writes it with its nodes and
     cells in the mesh's input order, so that the files do not depend on the number of ranks.
     """
@@ -260,8 +256,6 @@ class CupSeries:
             self._write_vtu(stroke, values)
 
     def _write_vtu(self, stroke, values):
-        from shellform.contact.tools import surface_mesh
-
         p = self.p
         comm = p.model.mesh.comm
         _, x, e33 = p.nodal_values()
@@ -281,7 +275,7 @@ class CupSeries:
         self.series["cup"].write(stroke, *whole)
         x0, x1, y0, y1 = p.blank_bounds()
         t = p.scene.tools
-        span = t.stroke + max(t.punch_profile_radius, t.die_profile_radius)  # the walls, as deep as the stroke
+        span = tool_kinds.kind(t.shape).picture_depth(t)  # the walls, as deep as the stroke
         for name, (tool, dz, above) in placements.items():
             z = dz * tool.axis[2]  # the height it has moved by
             z_range = (z - span, z + span)
@@ -383,7 +377,7 @@ def profile(X, u, comm, diagonal=False):
     on the line y = 0 (or x = y), by initial distance from the centre, gathered on every rank."""
     n = len(u)
     x = X[:n] + u
-    on = LINES["square"]["diagonal" if diagonal else "transverse"](X[:n], 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
+    on = square.LINES["diagonal" if diagonal else "transverse"](X[:n], 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
     r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
     rows, = _gather(comm, np.column_stack([np.hypot(X[:n, 0], X[:n, 1])[on], r, x[on, 2]]))
     return rows[np.argsort(rows[:, 0])]

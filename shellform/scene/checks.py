@@ -1,4 +1,4 @@
-"""The checks of a scene's values across fields, run when a Scene is made (``validate``): every
+"""The checks of a scene's values across fields, run when a Scene is read (``validate``, from shellform.scene.read): every
 bad value raises shellform.errors.InputError naming its field, e.g.
 ``material.thickness: must be > 0, got -1.0``, before any computation. The effects are checked
 by their registry (shellform.effects.check), what depends on the machine (files, memory) by
@@ -19,12 +19,12 @@ from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
                                     DIAGONALS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE, STROKE_STEP_KEYS,
                                     YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
-                                    NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, Scene, bounds)
+                                    NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, bounds)
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
 
-def validate(s: Scene) -> None:
+def validate(s) -> None:
     """Raise InputError naming the first bad field of s."""
     _validate_finite(s)
     registry.check(s.effects)
@@ -71,7 +71,7 @@ def validate(s: Scene) -> None:
             f"anything is solved), got {n}")
 
 
-def _validate_finite(s: Scene) -> None:
+def _validate_finite(s) -> None:
     """Every number of the scene is finite (surface.R1 and R2 may be inf: flat)."""
     def numbers(value, name):
         if isinstance(value, list):
@@ -91,7 +91,7 @@ def _validate_finite(s: Scene) -> None:
                 require(math.isfinite(v), name, f"must be finite, got {v}")
 
 
-def _validate_geometry(s: Scene) -> None:
+def _validate_geometry(s) -> None:
     g, m = s.geometry, s.mesh
     require(g.shape in outline.SHAPES, "geometry.shape", f"must be one of {outline.SHAPES}, got {g.shape!r}")
     own = {"rectangle": (), "circle": ("radius",), "polygon": ("vertices", "edges"), "file": ("file",)}
@@ -128,7 +128,7 @@ def _validate_geometry(s: Scene) -> None:
     machine.check_file(s)
 
 
-def _validate_material(s: Scene) -> None:
+def _validate_material(s) -> None:
     mat = s.material
     require(math.isfinite(mat.E) and mat.E > 0, "material.E", f"must be > 0, got {mat.E}")
     require(-1.0 < mat.nu < 0.5, "material.nu", f"must lie in (-1, 0.5), got {mat.nu}")
@@ -187,7 +187,7 @@ def _validate_material(s: Scene) -> None:
         fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n
 
 
-def _validate_probes(s: Scene) -> None:
+def _validate_probes(s) -> None:
     """Probes: a nonlinear sheet scene's, each named once, at finite coordinates within the blank's
     bounds (that a vertex lies there is checked on the mesh, before stepping)."""
     names = set()
@@ -229,7 +229,7 @@ def _plausible_stiffness(material) -> None:
             f"2000: are E and the stresses in the same unit (MPa with lengths in mm)?"), stacklevel=2)
 
 
-def _check_plan_field(f, s: Scene, no_tools: str, key: str | None = None) -> None:
+def _check_plan_field(f, s, no_tools: str, key: str | None = None) -> None:
     """A field's text (forms.plan_field) is an expression of x and y, finite at a sample point,
     and the scene draws no tools (`no_tools` says why); errors name `key` (default f.FIELD)."""
     key = key or f.FIELD
@@ -243,7 +243,7 @@ def _check_plan_field(f, s: Scene, no_tools: str, key: str | None = None) -> Non
     require(math.isfinite(value), key, f"{f.quoted()} is not finite at (0.123, 0.456)")
 
 
-def _validate_loads(s: Scene) -> None:
+def _validate_loads(s) -> None:
     g, loads = s.geometry, s.loads
     require(math.isfinite(loads.pressure), "loads.pressure", "must be finite")
     require(loads.pressure_per in PRESSURE_PER, "loads.pressure_per",
@@ -274,7 +274,7 @@ def _validate_loads(s: Scene) -> None:
         require(g.shape == "rectangle", f"loads.moment[{i}]", "edge moments act on the sides of a rectangle")
 
 
-def _validate_process(s: Scene) -> None:
+def _validate_process(s) -> None:
     """Checked in every scene, though only nonlinear scenes step through a load path."""
     pr = s.process
     low = 2 if "plasticity" in s.effects else 1

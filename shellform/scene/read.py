@@ -1,19 +1,123 @@
-"""Reading a scene: TOML (``load``), a parsed TOML document (``from_dict``) and a changed scene
-(``changed``: the scene as a document, ``to_dict``, with the changes applied, read again). Each
-key's type is checked here against its default in the schema, naming the field; the values
-are checked when the Scene is made (shellform.scene.checks).
+"""A scene (``Scene``: the sections of shellform.scene.schema and the queries the solvers ask of
+them) and its reading: TOML (``load``), a parsed TOML document (``from_dict``) and a changed
+scene (``changed``: the scene as a document, ``to_dict``, with the changes applied, read again).
+Each key's type is checked here against its default in the schema, naming the field; the values
+are checked once the Scene is read (``from_dict`` runs shellform.scene.checks.validate), so a
+Scene made here is a checked one.
 """
 
 import copy
 import json
 import tomllib
-from dataclasses import asdict, fields
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
+from shellform import effects as registry
 from shellform.errors import InputError
-from shellform.scene.schema import (ANALYTIC_TOOL_KEYS, CAD_TOOL_KEYS, LOAD_STEP_KEYS, SQUARE_TOOL_KEYS,
-                                    STROKE_STEP_KEYS, Drawbead, EdgeMoment, Probe, Geometry, Loads, Material,
-                                    MeshSpec, Output, PointLoad, Process, Scene, Solver, Surface, ToolsSpec)
+from shellform.material import SheetMaterial
+from shellform.scene.checks import validate
+from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, LOAD_STEP_KEYS, STROKE_STEP_KEYS,
+                                    TOOL_SHAPES, Drawbead, EdgeMoment, Geometry, Loads, Material, MeshSpec, Output,
+                                    PointLoad, Probe, Process, Solver, Surface, ToolsSpec)
+from shellform.tools import kinds as tool_kinds
+
+@dataclass
+class Scene:
+    title: str = "shellform scene"
+    effects: tuple[str, ...] = ("bending",)
+    geometry: Geometry = field(default_factory=Geometry)
+    surface: Surface = field(default_factory=Surface)
+    mesh: MeshSpec = field(default_factory=MeshSpec)
+    material: Material = field(default_factory=Material)
+    supports: dict[str, str] = field(default_factory=dict)  # boundary group -> support; unnamed: free
+    loads: Loads = field(default_factory=Loads)
+    solver: Solver = field(default_factory=Solver)
+    process: Process = field(default_factory=Process)
+    output: Output = field(default_factory=Output)
+    tools: ToolsSpec | None = None  # None: no [tools] table, no tools
+
+    def changed(self, changes: dict) -> "Scene":
+        """A new scene with `changes` {"section.key": value, "effects": [...], ...} applied at once,
+        read and checked as a scene file is: a bad value raises InputError naming its field.
+        This scene is left as it is."""
+        return changed(self, changes)
+
+    @property
+    def kappa0(self) -> tuple[float, float]:
+        return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
+
+    def curvature(self):
+        """What the forms take as kappa0 with 'shallow_curvature': the ReferenceSurface of
+        surface.z0, or the principal curvatures diag(1/R1, 1/R2) as an array; None if flat."""
+        import numpy as np
+
+        from shellform.forms.reference_surface import ReferenceSurface
+
+        if "shallow_curvature" not in self.effects:
+            return None
+        if self.surface.z0:
+            return ReferenceSurface(self.surface.z0)
+        return np.diag(self.kappa0).astype(np.float64)
+
+    def pressure_field(self):
+        """How the pressure spreads (forms.loads.PressureField): its shape over the plan and, per
+        unit surface area, the curved surface it is measured on; None for a uniform pressure per
+        unit plan area (or on a flat sheet, where the two are the same)."""
+        import numpy as np
+
+        from shellform.forms.loads import PressureField
+        from shellform.forms.reference_surface import ReferenceSurface
+
+        surface = None
+        if self.loads.pressure_per == "surface" and self.surface.z0:
+            surface = ReferenceSurface(self.surface.z0)
+        elif self.loads.pressure_per == "surface" and any(k != 0 for k in self.kappa0):
+            surface = tuple(float(v) for v in np.diag(self.kappa0).ravel())
+        if not self.loads.pressure_shape and surface is None:
+            return None
+        return PressureField(self.loads.pressure_shape, surface)
+
+    @property
+    def symmetry_copies(self) -> int:
+        """How many copies of the meshed region make the whole blank (4 for a quarter)."""
+        g = self.geometry
+        if g.shape in ("rectangle", "circle"):
+            return {"full": 1, "half": 2, "quarter": 4}[g.region]
+        return 2 ** sum(v == "symmetry" for v in self.supports.values())
+
+    @property
+    def route(self) -> str:
+        """The solver its effects select (shellform.effects.route): linear shell, nonlinear sheet or tools."""
+        return registry.route(self.effects)
+
+    @property
+    def nonlinear(self) -> bool:
+        """Whether its effects select the nonlinear sheet (alone or drawn by the tools)."""
+        return self.route != registry.LINEAR
+
+    def hill79(self):
+        """The scene's shellform.material.SheetMaterial (its yield function, Hill 1979 by default):
+        elastic (hardening "none") unless the effect 'plasticity' is on. Its own validation names
+        the field (material.yield_stress, material.r0, ...)."""
+        mat = self.material
+        if "plasticity" not in self.effects:
+            return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
+        unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
+        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n > 1): unset there
+        n = unset(mat.n) if mat.hardening == "power" else mat.n
+        given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
+        given.update({k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)})
+        table = None
+        if mat.hardening == "table" and mat.flow_curve:
+            from shellform.material.flow_curve import read_csv
+
+            table = read_csv(mat.flow_curve)
+        return SheetMaterial(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
+                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction,
+                             unset(mat.Q), unset(mat.beta), unset(mat.swift_weight), table,
+                             mat.extrapolation or None)
+
+
 
 _SECTIONS = {
     "geometry": Geometry, "surface": Surface, "mesh": MeshSpec, "material": Material,
@@ -107,16 +211,13 @@ def from_dict(data: dict) -> Scene:
         kwargs["output"].probe = probes
     if "supports" in data:
         kwargs["supports"] = _supports(data["supports"])
-    if isinstance(tools, dict) and tools.get("shape") == "round":
-        for key in SQUARE_TOOL_KEYS:
+    if "tools" in kwargs:  # the keys of the other kinds of tools are not this kind's
+        shape = kwargs["tools"].shape
+        if shape not in TOOL_SHAPES:
+            raise InputError("tools.shape", f"must be one of {TOOL_SHAPES}, got {shape!r}")
+        for key, message in tool_kinds.foreign_keys(shape).items():
             if key in tools:
-                raise InputError(f"tools.{key}", "is a key of square tools: round tools take punch_radius and "
-                                 "die_radius")
-    if isinstance(tools, dict):
-        for key in ANALYTIC_TOOL_KEYS if tools.get("shape") == "cad" else CAD_TOOL_KEYS:
-            if key in tools:
-                raise InputError(f"tools.{key}", "is a key of analytic tools: shape = 'cad' takes punch_file, die_file "
-                                 "and their placements" if tools.get("shape") == "cad" else "is a key of shape = 'cad'")
+                raise InputError(f"tools.{key}", message)
     process = data.get("process")
     if isinstance(process, dict):
         for key in LOAD_STEP_KEYS if "tools" in data else STROKE_STEP_KEYS:
@@ -140,7 +241,9 @@ def from_dict(data: dict) -> Scene:
         kwargs["effects"] = tuple(effects)
     if "title" in data:
         kwargs["title"] = str(data["title"])
-    return Scene(**kwargs)
+    s = Scene(**kwargs)
+    validate(s)
+    return s
 
 
 def load(path: str | Path) -> Scene:
@@ -179,11 +282,8 @@ def to_dict(s: Scene) -> dict:
     if s.tools is not None:
         data["tools"]["drawbead"] = [asdict(b) for b in s.tools.drawbead]
     data["output"]["probe"] = [asdict(p) for p in s.output.probe]
-    if s.tools is not None and s.tools.shape == "round":  # set from the radii (ToolsSpec)
-        for key in SQUARE_TOOL_KEYS:
-            del data["tools"][key]
-    if s.tools is not None:  # the keys of the other kind of tools are not the scene's
-        for key in ANALYTIC_TOOL_KEYS if s.tools.shape == "cad" else CAD_TOOL_KEYS:
+    if s.tools is not None:  # the keys of the other kinds of tools are not the scene's (a round tool's
+        for key in tool_kinds.foreign_keys(s.tools.shape):  # half-width is set from its radius: ToolsSpec)
             data["tools"].pop(key, None)
     for key in LOAD_STEP_KEYS if s.tools is not None else STROKE_STEP_KEYS:  # the other kind of scene's steps
         del data["process"][key]

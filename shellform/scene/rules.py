@@ -3,16 +3,13 @@ condition holds) and ``keys_of_effects`` (a key that takes a meaning only with a
 its default without it)."""
 
 from shellform import effects as registry
-from shellform.errors import InputError
-from shellform.scene.schema import Scene
-
+from shellform.errors import require  # noqa: F401  (the scene checks' rule, shared with the tool kinds)
 
 def sheet_effects() -> tuple[str, ...]:
     """The effects that select the nonlinear sheet."""
     return tuple(n for n, e in registry.EFFECTS.items() if e.route == registry.SHEET)
 
-
-def keys_of_effects(s: Scene, section: str) -> None:
+def keys_of_effects(s, section: str) -> None:
     """The keys of `section` that take a meaning only with an effect (shellform.effects, Effect.keys)
     keep their defaults unless that effect is on. (A whole table, as [tools] of 'contact', is
     checked with its table.)"""
@@ -24,9 +21,3 @@ def keys_of_effects(s: Scene, section: str) -> None:
             value, default = getattr(getattr(s, table), name), getattr(type(getattr(s, table))(), name)
             require(value == default, key, f"{value!r} takes a meaning only with the effect {e.name!r}: switch it "
                     f"on, or leave the default {default!r}")
-
-
-def require(cond, name, message):
-    """Raise InputError(name, message) unless cond."""
-    if not cond:
-        raise InputError(name, message)

@@ -5,39 +5,31 @@ supports, the loads and the physical effects to simulate (shellform.effects: wha
 switches on and needs). Its effects select the solver (``Scene.route``): the linear shell, the
 nonlinear elastic-plastic sheet stepped through the load factors of [process]
 (``Scene.nonlinear``; ``Scene.hill79()`` is its material), or the sheet drawn by the rigid tools
-of [tools] (``Scene.tools``, shellform.contact.tools).
+of [tools] (``Scene.tools``; its kinds: shellform.tools.kinds).
 
-A Scene is checked when it is made (shellform.scene.checks, shellform.scene.machine); a changed
-scene is a new one, made by ``Scene.changed`` and checked again. See docs/scenes.md for every key.
+The Scene that holds these sections is read and checked in shellform.scene.read (the checks:
+shellform.scene.checks, shellform.scene.machine); a changed scene is a new one, made by
+``Scene.changed`` and checked again. See docs/scenes.md for every key.
 """
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, make_dataclass
 
-from shellform import effects as registry
-from shellform.material import SheetMaterial, criteria
+from shellform.material import criteria
 from shellform.mesh import outline
+from shellform.tools import kinds as tool_kinds
 
-__all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SQUARE_TOOL_KEYS", "ANALYTIC_TOOL_KEYS",
-           "CAD_TOOL_KEYS", "TOOL_NORMALS", "SPREADS", "HOLDERS",
+__all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SPREADS", "HOLDERS",
            "SUPPORTS", "NONLINEAR_SUPPORTS", "SIDES", "MIRROR_SUPPORTS",
            "MAY_BE_INFINITE", "REGIONS", "CIRCLE_REGIONS", "MESH_KINDS", "DIAGONALS", "HARDENING", "CURVE_PARAMETERS",
            "YIELD_FUNCTIONS", "YIELD_PARAMETERS", "ANISOTROPY_PARAMETERS", "ANISOTROPY_LISTS",
            "Geometry", "Surface", "MeshSpec", "Material", "PointLoad", "EdgeMoment", "Loads", "Solver", "Process",
-           "Drawbead", "ToolsSpec", "Probe", "Output", "Scene", "bounds"]
+           "Drawbead", "ToolsSpec", "Probe", "Output", "bounds"]
 
 # [process]: a sheet scene steps its load factor, a tool scene the punch's travel in mm
 LOAD_STEP_KEYS = ("initial_step", "min_step", "max_step")
 STROKE_STEP_KEYS = ("initial_step_mm", "min_step_mm", "max_step_mm")
-TOOL_SHAPES = ("square", "round", "cad")
-SQUARE_TOOL_KEYS = ("punch_half_width", "punch_corner_radius", "die_half_width", "die_corner_radius")
-# the analytic tools' keys, which shape = "cad" does not take (its punch and die are files)
-ANALYTIC_TOOL_KEYS = (*SQUARE_TOOL_KEYS, "punch_profile_radius", "die_profile_radius", "punch_radius", "die_radius",
-                      "punch_gap")
-CAD_TOOL_KEYS = ("punch_file", "die_file", "punch_translation", "die_translation", "punch_rotation", "die_rotation",
-                 "punch_direction", "punch_normals", "die_normals",
-                 "holder_half_width", "holder_corner_radius")
-TOOL_NORMALS = ("outward", "inward")  # which way a CAD tool's faces' normals point: to the sheet, or away
+TOOL_SHAPES = tool_kinds.SHAPES  # tools.shape: the registered kinds of tools (shellform.tools.kinds)
 SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
 HOLDERS = ("force", "gap")  # the blank holder presses with a force, or is held at a gap over the die
 
@@ -201,49 +193,36 @@ class Drawbead:
     uplift: float = 0.0  # N/mm, lifting the sheet off the die (the holder takes it)
 
 
-@dataclass
-class ToolsSpec:
-    """Rigid tools of cup deep drawing (shellform.contact.tools): square (NUMISHEET'93) or round.
-    A round punch is the square one with plan corner radius = half-width = punch_radius (its
-    plan is a circle), a round die the same with die_radius. "cad": punch and die are the
-    surfaces of CAD files (shellform.contact.surface_tool), the holder the flat one over the
-    rounded square (holder_half_width, holder_corner_radius) and outside it."""
+def _tool_field(default):
+    """A dataclass field of a kind's key (shellform.tools.kinds: FIELDS), a list copied per scene."""
+    if isinstance(default, list):
+        return field(default_factory=lambda: list(default))
+    return field(default=default)
 
-    shape: str = "square"  # "square", "round" or "cad"
-    punch_radius: float = 0.0  # round: the punch's radius (0: unset)
-    die_radius: float = 0.0  # round: the die opening's radius (0: unset)
-    punch_half_width: float = 35.0  # 70 mm square punch
-    punch_corner_radius: float = 10.0  # plan corner radius
-    punch_profile_radius: float = 8.0  # nose radius
-    die_half_width: float = 37.0  # 74 mm die opening
-    die_corner_radius: float = 12.0
-    die_profile_radius: float = 5.0  # die shoulder radius
-    punch_gap: float = 0.0  # initial gap between the punch face and the sheet (>= 0)
-    punch_file: str = ""  # cad: the punch's STEP, IGES or BREP file (or an .stl, .msh surface mesh), relative to the scene's folder
-    die_file: str = ""  # cad: the die's
-    # cad: mm, moving the file's frame into the scene's
-    punch_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    die_translation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    # cad: degrees, turning the file's frame about the scene's x, then y, then z (before the translation)
-    punch_rotation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    die_rotation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
-    punch_direction: list[float] = field(default_factory=lambda: [0.0, 0.0, -1.0])  # cad: the way the punch travels
-    punch_normals: str = "outward"  # cad: "outward" (the faces' normals point to the sheet) or "inward"
-    die_normals: str = "outward"
-    holder_half_width: float = 0.0  # cad: the holder's inner edge, a rounded square (where the die's flat top begins)
-    holder_corner_radius: float = 0.0
-    holder: str = "force"  # "force": the holder presses with blank_holder_force; "gap": its face is held at holder_gap
-    holder_gap: float = 0.0  # mm, holder = "gap": the distance between the holder's face and the die's top (>= t)
-    blank_holder_force: float = 19600.0  # N, on the whole blank (a quarter model carries a quarter)
-    friction: float = 0.0  # Coulomb coefficient (> 0 needs the effect 'friction')
-    stroke: float = 30.0  # punch travel, mm
-    holder_spread: str = "area"  # how the closed holder spreads its force: "area" or "rigid" (contact/holder.py)
-    drawbead: list[Drawbead] = field(default_factory=list, metadata={"items": "tables"})  # [[tools.drawbead]]
 
-    def __post_init__(self):
-        if self.shape == "round":  # circles: corner radius = half-width = radius
-            self.punch_half_width = self.punch_corner_radius = self.punch_radius
-            self.die_half_width = self.die_corner_radius = self.die_radius
+def _complete_tools(self):
+    """The keys its kind derives from others (a round tool's half-width from its radius)."""
+    if self.shape in tool_kinds.KINDS:
+        tool_kinds.kind(self.shape).complete(self)
+
+
+# Rigid tools of cup deep drawing: tools.shape names their kind (shellform.tools.kinds: square,
+# round, cad), whose keys (FIELDS) come first, then the keys every kind takes.
+ToolsSpec = make_dataclass("ToolsSpec", [
+    ("shape", str, field(default="square")),  # the kind of tools, one of TOOL_SHAPES
+    *[(name, type(default) if not isinstance(default, list) else list[float], _tool_field(default))
+      for name, default, _ in tool_kinds.fields()],
+    # "force": the holder presses with blank_holder_force; "gap": its face is held at holder_gap
+    ("holder", str, field(default="force")),
+    ("holder_gap", float, field(default=0.0)),  # mm, holder = "gap": the face's distance from the die's top (>= t)
+    ("blank_holder_force", float, field(default=19600.0)),  # N, on the whole blank (a quarter model carries a quarter)
+    ("friction", float, field(default=0.0)),  # Coulomb coefficient (> 0 needs the effect 'friction')
+    ("stroke", float, field(default=30.0)),  # punch travel, mm
+    ("holder_spread", str, field(default="area")),  # how the closed holder spreads its force: "area" or "rigid"
+    ("drawbead", list[Drawbead], field(default_factory=list, metadata={"items": "tables"})),  # [[tools.drawbead]]
+], namespace={"__post_init__": _complete_tools, "__doc__": """Rigid tools of cup deep drawing: tools.shape
+    names their kind (shellform.tools.kinds), whose keys come first (each kind's FIELDS), then
+    the holder's, the force, friction, stroke and drawbeads every kind takes."""}, module=__name__)
 
 
 @dataclass
@@ -266,111 +245,7 @@ class Output:
     probe: list[Probe] = field(default_factory=list, metadata={"items": "tables"})  # [[output.probe]]
 
 
-@dataclass
-class Scene:
-    title: str = "shellform scene"
-    effects: tuple[str, ...] = ("bending",)
-    geometry: Geometry = field(default_factory=Geometry)
-    surface: Surface = field(default_factory=Surface)
-    mesh: MeshSpec = field(default_factory=MeshSpec)
-    material: Material = field(default_factory=Material)
-    supports: dict[str, str] = field(default_factory=dict)  # boundary group -> support; unnamed: free
-    loads: Loads = field(default_factory=Loads)
-    solver: Solver = field(default_factory=Solver)
-    process: Process = field(default_factory=Process)
-    output: Output = field(default_factory=Output)
-    tools: ToolsSpec | None = None  # None: no [tools] table, no tools
-
-    def __post_init__(self):
-        from shellform.scene.checks import validate
-
-        validate(self)
-
-    def changed(self, changes: dict) -> "Scene":
-        """A new scene with `changes` {"section.key": value, "effects": [...], ...} applied at once,
-        read and checked as a scene file is: a bad value raises InputError naming its field.
-        This scene is left as it is."""
-        from shellform.scene.read import changed
-
-        return changed(self, changes)
-
-    @property
-    def kappa0(self) -> tuple[float, float]:
-        return (1.0 / self.surface.R1, 1.0 / self.surface.R2)
-
-    def curvature(self):
-        """What the forms take as kappa0 with 'shallow_curvature': the ReferenceSurface of
-        surface.z0, or the principal curvatures diag(1/R1, 1/R2) as an array; None if flat."""
-        import numpy as np
-
-        from shellform.forms.reference_surface import ReferenceSurface
-
-        if "shallow_curvature" not in self.effects:
-            return None
-        if self.surface.z0:
-            return ReferenceSurface(self.surface.z0)
-        return np.diag(self.kappa0).astype(np.float64)
-
-    def pressure_field(self):
-        """How the pressure spreads (forms.loads.PressureField): its shape over the plan and, per
-        unit surface area, the curved surface it is measured on; None for a uniform pressure per
-        unit plan area (or on a flat sheet, where the two are the same)."""
-        import numpy as np
-
-        from shellform.forms.loads import PressureField
-        from shellform.forms.reference_surface import ReferenceSurface
-
-        surface = None
-        if self.loads.pressure_per == "surface" and self.surface.z0:
-            surface = ReferenceSurface(self.surface.z0)
-        elif self.loads.pressure_per == "surface" and any(k != 0 for k in self.kappa0):
-            surface = tuple(float(v) for v in np.diag(self.kappa0).ravel())
-        if not self.loads.pressure_shape and surface is None:
-            return None
-        return PressureField(self.loads.pressure_shape, surface)
-
-    @property
-    def symmetry_copies(self) -> int:
-        """How many copies of the meshed region make the whole blank (4 for a quarter)."""
-        g = self.geometry
-        if g.shape in ("rectangle", "circle"):
-            return {"full": 1, "half": 2, "quarter": 4}[g.region]
-        return 2 ** sum(v == "symmetry" for v in self.supports.values())
-
-    @property
-    def route(self) -> str:
-        """The solver its effects select (shellform.effects.route): linear shell, nonlinear sheet or tools."""
-        return registry.route(self.effects)
-
-    @property
-    def nonlinear(self) -> bool:
-        """Whether its effects select the nonlinear sheet (alone or drawn by the tools)."""
-        return self.route != registry.LINEAR
-
-    def hill79(self):
-        """The scene's shellform.material.SheetMaterial (its yield function, Hill 1979 by default):
-        elastic (hardening "none") unless the effect 'plasticity' is on. Its own validation names
-        the field (material.yield_stress, material.r0, ...)."""
-        mat = self.material
-        if "plasticity" not in self.effects:
-            return SheetMaterial(mat.E, mat.nu, mat.r, mat.m)
-        unset = lambda v: v if v != 0.0 else None  # noqa: E731  0.0: not given
-        # n = 0 is a valid Swift exponent (perfect plasticity) but no power law (n > 1): unset there
-        n = unset(mat.n) if mat.hardening == "power" else mat.n
-        given = {k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0}
-        given.update({k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)})
-        table = None
-        if mat.hardening == "table" and mat.flow_curve:
-            from shellform.material.flow_curve import read_csv
-
-            table = read_csv(mat.flow_curve)
-        return SheetMaterial(mat.E, mat.nu, mat.r, mat.m, mat.hardening, unset(mat.yield_stress), n,
-                             unset(mat.K), unset(mat.eps0), mat.yield_function, given, mat.rolling_direction,
-                             unset(mat.Q), unset(mat.beta), unset(mat.swift_weight), table,
-                             mat.extrapolation or None)
-
-
-def bounds(s: Scene) -> tuple[float, float, float, float]:
+def bounds(s) -> tuple[float, float, float, float]:
     """x_min, x_max, y_min, y_max of the meshed region (a rectangle or circle is centred at the
     origin; a polygon is where its vertices are; a file's region is known once it is read)."""
     if s.geometry.shape in ("circle", "polygon"):

@@ -1,17 +1,57 @@
-"""The square cup's tools from a scene's [tools] with shape = "cad": the punch and the die as
-CAD surfaces (surface_tool.py) or surface meshes (.stl, .msh: mesh_tool.py, by the file's
-suffix), the blank holder the flat analytic one, and the checks of their placement around the
-blank at the start."""
+"""The kind of tools "cad": the punch and the die as CAD surfaces (surface_tool.py) or surface
+meshes (.stl, .msh: mesh_tool.py, by the file's suffix), placed in the scene by a rotation and
+a translation (placement.py), the blank holder the flat analytic one; the checks of their keys,
+and of their placement around the blank at the start."""
 
+import math
 from pathlib import Path
 
 import numpy as np
 
-from shellform.contact.holder_edge import OutlineEdge, RoundedSquareEdge, signed_area
-from shellform.contact.mesh_tool import MESH_SUFFIXES, MeshTool
-from shellform.contact.placement import UP, Placed, rotation
-from shellform.contact.surface_tool import SurfaceTool
-from shellform.errors import InputError
+from shellform.errors import InputError, require
+from shellform.mesh.outline import MIRROR_NORMALS
+from shellform.tools import square
+from shellform.tools.analytic import BlankHolder
+from shellform.tools.holder_edge import OutlineEdge, RoundedSquareEdge, signed_area
+from shellform.tools.mesh_tool import MESH_SUFFIXES, MeshTool
+from shellform.tools.placement import UP, Placed, rotation
+from shellform.tools.protocol import BinderPlan
+from shellform.tools.surface_tool import SurfaceTool
+
+NAME = "cad"
+
+FIELDS = (
+    ("punch_file", "", "the punch's STEP, IGES or BREP file (or an .stl, .msh surface mesh), relative to the scene's folder"),
+    ("die_file", "", "the die's"),
+    ("punch_translation", [0.0, 0.0, 0.0], "mm, moving the file's frame into the scene's"),
+    ("die_translation", [0.0, 0.0, 0.0], "mm"),
+    ("punch_rotation", [0.0, 0.0, 0.0], "degrees, turning the file's frame about the scene's x, then y, then z "
+     "(before the translation)"),
+    ("die_rotation", [0.0, 0.0, 0.0], "degrees"),
+    ("punch_direction", [0.0, 0.0, -1.0], "the way the punch travels"),
+    ("punch_normals", "outward", "'outward' (the faces' normals point to the sheet) or 'inward'"),
+    ("die_normals", "outward", "as punch_normals"),
+    ("holder_half_width", 0.0, "the holder's inner edge, a rounded square (where the die's flat top begins; "
+     "0: the die's own)"),
+    ("holder_corner_radius", 0.0, "its corner radius"),
+)
+NORMALS = ("outward", "inward")  # which way a CAD tool's faces' normals point: to the sheet, or away
+
+LINES = square.LINES  # a cup drawn by CAD tools: the square cup's lines
+RIM = False
+
+
+def refuse(key: str, owners: tuple) -> str:
+    return "is a key of analytic tools: shape = 'cad' takes punch_file, die_file and their placements"
+
+
+def complete(spec) -> None:
+    """Nothing derived."""
+
+
+def picture_depth(spec) -> float:
+    """The analytic tools' depth with their default profile radii (square.FIELDS): the stroke and 8 mm."""
+    return spec.stroke + max(spec.punch_profile_radius, spec.die_profile_radius)
 
 
 def cad_cup_tools(spec, thickness: float) -> dict:
@@ -24,8 +64,6 @@ def cad_cup_tools(spec, thickness: float) -> dict:
     or where holder_half_width is 0 the inner boundary of the die's flat top (die_opening). It
     pinches the flange onto the die's flat top, which check_start asks to lie on the sheet's
     lower surface there."""
-    from shellform.contact.tools import BlankHolder
-
     def placed(name, axis=UP):
         path = getattr(spec, f"{name}_file")
         tool = _tool(path).from_file(path, normals=getattr(spec, f"{name}_normals"), field=f"tools.{name}_file")
@@ -143,3 +181,59 @@ def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
     if off > tolerance:
         raise InputError("tools.die_translation", f"the die's flat top under the holder lies {off:.4g} mm off the "
                          "sheet's lower surface z = -t/2: the holder pinches the flange onto it")
+
+
+tools = cad_cup_tools
+
+
+def check_placement(tools: dict, x, half, planes, comm, tolerance: float) -> None:
+    """The tools around the blank's nodes x at the start (check_start) and their symmetry about
+    the blank's mirror planes (check_mirrors: a warning)."""
+    check_start(tools, x, half, comm, tolerance)
+    check_mirrors(tools, x, np.array(planes), comm)
+
+
+def check(s) -> BinderPlan:
+    """CAD tools: their files exist (what they hold is checked when they are read:
+    surface_tool.py, mesh_tool.py), their placements, the punch's travel and the holder's inner
+    edge; returns where the die's flat top begins (holder_half_width)."""
+    t = s.tools
+    for name in ("punch_file", "die_file"):
+        v = getattr(t, name)
+        require(bool(v), f"tools.{name}",
+                "shape = 'cad' needs the tool's STEP, IGES or BREP file (or .stl, .msh surface mesh)")
+        require(Path(v).is_file(), f"tools.{name}", f"no such file: {v}")
+    for name, what in (("punch_translation", "[x, y, z] (mm)"), ("die_translation", "[x, y, z] (mm)"),
+                       ("punch_rotation", "angles about x, y, z (degrees)"),
+                       ("die_rotation", "angles about x, y, z (degrees)"), ("punch_direction", "[x, y, z]")):
+        v = getattr(t, name)
+        require(len(v) == 3 and all(isinstance(c, (int, float)) and math.isfinite(c) for c in v), f"tools.{name}",
+                f"must be three finite numbers {what}, got {v}")
+    d = np.asarray(t.punch_direction, dtype=float)
+    require(np.linalg.norm(d) > 0, "tools.punch_direction", "must be a non-zero vector, the way the punch travels")
+    require(d[2] < 0, "tools.punch_direction", f"must point down into the die (a negative z component): the punch "
+                                               f"draws the sheet into the die below it, got {t.punch_direction}")
+    for name in ("punch_normals", "die_normals"):
+        require(getattr(t, name) in NORMALS, f"tools.{name}",
+                f"must be one of {NORMALS}, got {getattr(t, name)!r}")
+    require(math.isfinite(t.holder_half_width) and t.holder_half_width >= 0, "tools.holder_half_width",
+            f"must be >= 0: the holder's inner edge (where the die's flat top begins), 0 for the die's own, got "
+            f"{t.holder_half_width}")
+    require(math.isfinite(t.holder_corner_radius) and 0 <= t.holder_corner_radius <= t.holder_half_width,
+            "tools.holder_corner_radius", f"must lie in [0, holder_half_width], got {t.holder_corner_radius}")
+    _check_punch_travel(s, t)
+    return BinderPlan(t.holder_half_width, t.holder_corner_radius, "holder_half_width")
+
+
+def _check_punch_travel(s, t) -> None:
+    """A punch travelling aslant keeps the blank's mirror symmetry only within the mirror planes:
+    along x = 0 (the `left` edge) no x component, along y = 0 (`bottom`) no y component
+    (outline.MIRROR_NORMALS), along any other symmetry line none in the plane."""
+    d = np.asarray(t.punch_direction, dtype=float)
+    for group, support in s.supports.items():
+        if support != "symmetry":
+            continue
+        across = np.array([MIRROR_NORMALS[group]] if group in MIRROR_NORMALS else list(MIRROR_NORMALS.values()))
+        require(not np.any(across @ d), "tools.punch_direction",
+                f"{t.punch_direction} leaves the mirror plane of the symmetry line {group!r}: a punch travelling "
+                "aslant needs the blank modelled without that symmetry")

@@ -95,12 +95,12 @@ from pathlib import Path
 
 import numpy as np
 
-from shellform.contact.cad_files import probe
-from shellform.contact.faces import CurveRevolutions, Cylinders, Planes, Revolutions
-from shellform.contact.faces import cross as faces_cross
-from shellform.contact.faces import within as faces_within
-from shellform.contact.holder_edge import closed_loops
-from shellform.contact.surface_geometry import distance_hessian
+from shellform.tools.cad_files import probe
+from shellform.tools.faces import CurveRevolutions, Cylinders, Planes, Revolutions
+from shellform.tools.faces import cross as faces_cross
+from shellform.tools.faces import within as faces_within
+from shellform.tools.holder_edge import closed_loops
+from shellform.tools.surface_geometry import distance_hessian
 from shellform.errors import InputError
 
 LOCAL_ITERATIONS = 8  # Newton iterations of the local projection before the candidates' projections take over

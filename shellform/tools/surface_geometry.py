@@ -16,7 +16,7 @@ degenerate parametrisation) its pseudo-inverse is taken.
 
 import numpy as np
 
-from shellform.contact.faces import shape_operators
+from shellform.tools.faces import shape_operators
 
 
 def distance_hessian(J, S, n, d):

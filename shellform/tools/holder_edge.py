@@ -22,7 +22,7 @@ length of the two segments, linear along a segment.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from shellform.contact.tools import rounded_square_hessian, rounded_square_sdf
+from shellform.tools.analytic import rounded_square_hessian, rounded_square_sdf
 
 
 def signed_area(points) -> float:

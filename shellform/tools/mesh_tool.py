@@ -133,8 +133,8 @@ from pathlib import Path
 import numpy as np
 
 from shellform._jit import njit
-from shellform.contact.holder_edge import closed_loops
-from shellform.contact.surface_geometry import distance_hessian
+from shellform.tools.holder_edge import closed_loops
+from shellform.tools.surface_geometry import distance_hessian
 from shellform.errors import InputError
 
 MESH_SUFFIXES = (".stl", ".msh")  # any case

@@ -1,0 +1,15 @@
+"""Rigid tools: surfaces with a signed gap, a normal and a shape operator at points, a travel
+axis (protocol.py), and the kinds of tools a scene names (kinds.py: square, round, cad).
+
+    protocol      the Tool and Binder protocols; a tool's surface mesh for output
+    kinds         the registry of kinds: scene keys, checks, factory, output
+    square, round, cad    the kinds
+    analytic      the analytic punch, die and blank holder (signed distances of rounded squares)
+    holder_edge   the holder's inner edge in plan: a rounded square or a CAD die's opening
+    placement     a tool turned, moved and travelling along its axis
+    surface_tool, faces, cad_files   a tool from a CAD file's faces (gmsh's OCC kernel)
+    mesh_tool     a tool from a surface mesh (.stl, .msh: Nagata patches)
+    surface_geometry   the Hessian of the distance to a parametrised surface
+
+Below scene, contact, results and nonlinear: it imports none of them.
+"""
