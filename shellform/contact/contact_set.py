@@ -22,6 +22,14 @@ increment (no chattering). A pass may end before it converges where the set will
 once Newton's steps are below `early_step` penetrations (a step that long judges the set on an
 iterate still moving; after such passes fail, they end only near convergence, early_step 1).
 Newton's steps are bounded by `trust` thicknesses of nodal move (largest_move).
+
+A node's faces lie its half thickness h_i from its mid-surface. Where two tools face each other
+across the sheet closer than its thickness, a part bounds the thickness there (bound_by: the
+ironing, with the clearance c_i between the tools through the node); the contact sees the faces
+at min(h_i, c_i / 2). The sheet thicker than the clearance is the bound's business (its penalty's
+overclosure, the nodes' recovered thickness against the cells' bounded mean): seen at h_i, a node
+on one face would penetrate the other by 2 h_i - c_i, join it when released, and lie on either
+face a different mid-surface apart; at c_i / 2 it lies in the clearance's middle on either face.
 """
 
 from dataclasses import dataclass
@@ -60,6 +68,7 @@ class ContactSet(Part):
         self.die = len(self.tools) - 1 if die is None else int(die)
         self.holder = holder
         self.holder_tool = len(self.tools)  # the open holder's index
+        self.bound = None  # a part that bounds the sheet's thickness between two tools (bound_by)
         n = nodes.n_owned
         self.tool = np.full(n, FREE, dtype=np.int8)
         self.pressure = np.zeros(n)  # the tool face's normal force (the die's on a pinched node)
@@ -82,11 +91,27 @@ class ContactSet(Part):
         self.comm = driver.model.mesh.comm
         self._initial_set()
 
+    def bound_by(self, part) -> None:
+        """Where two tools face each other across the sheet closer than its thickness, `part`
+        (the ironing) bounds the thickness: its ``half_thickness(gaps, h)`` is the half thickness
+        the sheet's faces lie at there (module docstring)."""
+        self.bound = part
+
     # -- geometry ------------------------------------------------------------------------------
-    def gaps(self, x, lam):
+    def gaps(self, x, lam, bounded: bool = True):
         """Gap and normal of every owned node to every tool at load factor lam, the open holder
-        last (an infinite gap when it is closed or has no force)."""
+        last (an infinite gap when it is closed or has no force). The sheet's faces lie a half
+        thickness h_i from the mid-surface; with `bounded`, where a part bounds the thickness
+        between two tools (bound_by), at the bounded one."""
         h = self.nodes.half_thickness
+        gaps = self._gaps(x, h, lam)
+        if bounded and self.bound is not None:
+            hb = self.bound.half_thickness(gaps, h)
+            if np.any(hb < h):
+                gaps = self._gaps(x, hb, lam)
+        return gaps
+
+    def _gaps(self, x, h, lam):
         gaps = [tool.gap(x, h, lam * dz) for tool, dz in zip(self.tools, self.travel)]
         if self.holder is not None:
             gaps.append(self.holder.face_gap(x, h))

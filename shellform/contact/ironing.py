@@ -28,6 +28,13 @@ them; where one is inclined to the other (the die's shoulder over the punch's wa
 has a component along the sheet that resists the draw. Each tool's force on the sheet includes
 its face's share (face_force). Friction on the faces' squeeze is not modelled: the friction part
 sees the normal force of the tool a node is on (docs/contact.md, "Ironing").
+
+The node itself lies on one face or on neither (the contact set's). Where the faces press, the
+sheet's thickness exceeds the clearance (by the penalty's overclosure, and by the nodes'
+recovered thickness against the cells' bounded mean), so the contact sees the faces of a node
+between faces at the half clearance, min(h_i, c_i / 2) (half_thickness, ContactSet.bound_by): on
+either face the node then lies in the clearance's middle and touches the other face, which
+neither joins it nor moves the node when it switches.
 """
 
 import numpy as np
@@ -38,6 +45,27 @@ from shellform.nonlinear.parts import Change, Part
 
 FACING = -0.5  # two tools face each other where n_a . n_b is below this (60 degrees from opposite)
 BAND = 0.25  # a node is between faces while its other face lies within this many thicknesses of B
+
+
+def between_faces(gaps, h: np.ndarray):
+    """(c, pair, normals) of the nodes from the tools' gaps and normals `gaps` (ContactSet.gaps,
+    at half thickness h): c_i the tightest clearance 2 h_i + g_a,i + g_b,i over the pairs of
+    facing tools whose faces lie within BAND thicknesses of the node's faces (inf where none),
+    the pair (a, b) (FREE, FREE where none) and their normals (nodes, 2, 3). Through the node,
+    c_i is the distance between the two surfaces, whatever h_i."""
+    clearance = np.full(h.shape[0], np.inf)
+    pair = np.full((h.shape[0], 2), FREE, dtype=np.int8)
+    normals = np.zeros((h.shape[0], 2, 3))
+    for a, (ga, na) in enumerate(gaps):
+        for b, (gb, nb) in enumerate(gaps[a + 1:], start=a + 1):
+            near = np.isfinite(ga) & np.isfinite(gb) & (ga <= BAND * 2.0 * h) & (gb <= BAND * 2.0 * h)
+            near &= np.einsum("ij,ij->i", na, nb) < FACING
+            cab = 2.0 * h + ga + gb
+            tighter = near & (cab < clearance)
+            clearance[tighter] = cab[tighter]
+            pair[tighter] = (a, b)
+            normals[tighter, 0], normals[tighter, 1] = na[tighter], nb[tighter]
+    return clearance, pair, normals
 
 
 class Ironing(Part):
@@ -58,24 +86,17 @@ class Ironing(Part):
     def _nodal(self, lam: float) -> np.ndarray:
         """The owned nodes' clearances c_i at the current positions (inf where a node is not
         between faces); sets the two tools whose faces it lies between and their normals."""
-        c = self.contact
         x = self.nodes.positions()
-        h = self.nodes.half_thickness
-        gaps = c.gaps(x, lam)
-        clearance = np.full(x.shape[0], np.inf)
-        pair = np.full((x.shape[0], 2), FREE, dtype=np.int8)
-        normals = np.zeros((x.shape[0], 2, 3))
-        for a, (ga, na) in enumerate(gaps):
-            for b, (gb, nb) in enumerate(gaps[a + 1:], start=a + 1):
-                near = np.isfinite(ga) & np.isfinite(gb) & (ga <= BAND * 2.0 * h) & (gb <= BAND * 2.0 * h)
-                near &= np.einsum("ij,ij->i", na, nb) < FACING
-                cab = 2.0 * h + ga + gb
-                tighter = near & (cab < clearance)
-                clearance[tighter] = cab[tighter]
-                pair[tighter] = (a, b)
-                normals[tighter, 0], normals[tighter, 1] = na[tighter], nb[tighter]
-        self.between, self.pair, self.normals = np.isfinite(clearance), pair, normals
+        gaps = self.contact.gaps(x, lam, bounded=False)
+        clearance, self.pair, self.normals = between_faces(gaps, self.nodes.half_thickness)
+        self.between = np.isfinite(clearance)
         return clearance
+
+    def half_thickness(self, gaps, h: np.ndarray) -> np.ndarray:
+        """The half thickness at which the sheet's faces lie for the contact (ContactSet.
+        bound_by): min(h_i, c_i / 2) at a node between faces, h_i elsewhere; `gaps` the tools'
+        gaps at h (module docstring)."""
+        return np.minimum(h, 0.5 * between_faces(gaps, h)[0])
 
     def _squeeze(self, lam: float, decide: bool) -> int:
         """The cells' clearances at the current positions, the mean of their vertices', and the

@@ -62,6 +62,8 @@ class SemiInverseDriver(Driver):
         if self.holder is not None:
             self.holder.compose(self.contact, self.friction)
         self.ironing = Ironing(model, nodes, self.contact) if ironing else None
+        if self.ironing is not None:
+            self.contact.bound_by(self.ironing)  # between two tools the sheet's faces lie at the bounded thickness
         parts = [p for p in (nodes, self.drawbeads, self.contact, self.holder, self.ironing, self.friction)
                  if p is not None]
         super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,
