@@ -91,6 +91,10 @@ def test_numisheet_cost_short(tmp_path):
             assert abs(float(p["error"])) + 1e-3 <= float(p["tolerance"]) + 1e-12
             assert float(p["cpu_s"]) <= rows["n 4"]["cpu_s"]
     assert (tmp_path / "numisheet_cost_error_time.png").stat().st_size > 0
+    table = (tmp_path / "numisheet_cost.md").read_text()
+    assert all(f"| {name} | " in table for name, _ in runs)
+    every = next(line for line in table.splitlines() if line.startswith("| all | "))
+    assert every.count(" s)") == 3  # a run within each tolerance, named with its CPU seconds
 
 
 @pytest.mark.slow

@@ -23,7 +23,8 @@ its wall time alone on one core, whatever else runs on the machine beside it.
 
 Writes numisheet_cost.csv (per run: counts, CPU and wall seconds, every answer and its error),
 numisheet_cost_picks.csv (per answer and for all at once, and per tolerance 1, 2 and 5 %: the
-cheapest run within it, or why none is) and numisheet_cost_error_time.png (each answer's |e|
+cheapest run within it, or why none is), numisheet_cost_reference.csv, numisheet_cost.md (the
+three as the tables docs/cost.md shows) and numisheet_cost_error_time.png (each answer's |e|
 against CPU seconds, and the worst |e| of each run with the cheapest-for-its-accuracy runs, the
 Pareto front, joined).
 """
@@ -151,10 +152,34 @@ def table(out: Path, runs_, ref: dict) -> list[dict]:
     write_csv(Path(out) / "numisheet_cost_reference.csv",
               [{"answer": q, "value": v, "uncertainty": u, "relative_uncertainty": u / abs(v), "source": how}
                for q, (v, u, how) in ref.items()], ["answer", "value", "uncertainty", "relative_uncertainty", "source"])
-    write_csv(Path(out) / "numisheet_cost_picks.csv", picks(rows, ref),
-              ["answer", "tolerance", "case", "cpu_s", "error", "verdict"])
+    chosen = picks(rows, ref)
+    write_csv(Path(out) / "numisheet_cost_picks.csv", chosen, ["answer", "tolerance", "case", "cpu_s", "error", "verdict"])
+    (Path(out) / "numisheet_cost.md").write_text(markdown(rows, ref, chosen))
     plot(Path(out) / "numisheet_cost_error_time.png", rows, ref)
     return rows
+
+
+def markdown(rows: list[dict], ref: dict, chosen: list[dict]) -> str:
+    """The reference, the runs (errors in per cent of the reference) and the picks, as tables."""
+    qs = list(ref)
+    pct = lambda v: f"{100 * v:+.2f}"  # noqa: E731
+    text = ["| answer | reference q* | uncertainty u | u / q* | source |", "|---|---|---|---|---|"]
+    text += [f"| {q} | {v:.5g} | {u:.3g} | {100 * u / abs(v):.2f} % | {how} |" for q, (v, u, how) in ref.items()]
+    text += ["", "| run | cells | increments, iterations, cut-backs | CPU s | " + " | ".join(qs) + " | worst |",
+             "|---|---|---|---|" + "---|" * (len(qs) + 1)]
+    for r in rows:
+        errors = " | ".join(pct(r[f"error_{q}"]) if f"error_{q}" in r else "" for q in qs)
+        worst = f"{100 * r['worst_error']:.2f}" if r["finished"] else f"stopped at {r['stroke_mm']:.1f} mm"
+        text.append(f"| {r['case']} | {r['cells']:,} | {r['increments']}, {r['newton_iterations']}, {r['cutbacks']} "
+                    f"| {r['cpu_s']:.0f} | {errors} | {worst} |")
+    text += ["", "(errors in % of the reference; worst: the largest |error| of the run)", "",
+             "| answer | within 1 % | within 2 % | within 5 % |", "|---|---|---|---|"]
+    for q in (*qs, "all"):
+        cells = []
+        for p in (c for c in chosen if c["answer"] == q):
+            cells.append(f"{p['case']} ({p['cpu_s']:.0f} s)" if p["verdict"] == "within" else p["verdict"])
+        text.append(f"| {q} | " + " | ".join(cells) + " |")
+    return "\n".join(text) + "\n"
 
 
 def picks(rows: list[dict], ref: dict, tolerances=TOLERANCES) -> list[dict]:
