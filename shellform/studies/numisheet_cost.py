@@ -19,7 +19,8 @@ tolerance tol where |e| + u / |q*| <= tol, so that no run is credited with more 
 the reference can vouch for, and a tolerance below u / |q*| is *not decidable*.
 
 The cost is CPU seconds (summary.json cpu_time_s): every run has one thread, so its CPU time is
-its wall time alone on one core, whatever else runs on the machine beside it.
+its wall time alone on one core, whatever else runs on the machine beside it; a short draw
+first compiles the kernels, so that no run's cost holds a compile.
 
 Writes numisheet_cost.csv (per run: counts, CPU and wall seconds, every answer and its error),
 numisheet_cost_picks.csv (per answer and for all at once, and per tolerance 1, 2 and 5 %: the
@@ -33,6 +34,7 @@ import csv
 import json
 import math
 import os
+import shutil
 from pathlib import Path
 
 from shellform import scene
@@ -103,12 +105,16 @@ def run(out: Path, levels=LEVELS, varied=VARIED, graded: bool = True, stroke=Non
 
 def draw_all(out: Path, runs_, fresh: bool = True, threads: int = 1) -> None:
     """Draw the runs one after the other on `threads` threads each (fresh=False keeps those
-    already on disk)."""
+    already on disk), after a short draw that compiles the kernels (a first run's compile time is
+    not the cost of its accuracy; it is not kept)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     saved = os.environ.get("SHELLFORM_THREADS")
     os.environ["SHELLFORM_THREADS"] = str(threads)
     try:
+        warm = out / "warm-up"
+        draw("warm-up", variant(4, SCENE, tools__stroke=0.25), out)
+        shutil.rmtree(warm)
         for name, s in runs_:
             if fresh or not (folder(out, name) / "summary.json").exists():
                 say(f"numisheet-cost: {name}")
