@@ -247,8 +247,8 @@ def test_scene_b_killed_in_a_finished_folder_then_resumed_reports_nothing_of_a(t
 
 @pytest.mark.timeout(120)
 def test_a_resume_names_what_differs_and_records_what_changed(tmp_path, whole):
-    """Another material (what defines the state) is refused, naming the field; a longer stroke,
-    another holder force and friction (how to continue) are taken, and the summary records them."""
+    """Another material (what defines the state) is refused, naming the field; a longer stroke
+    and other steps (how to continue) are taken, and the summary records them."""
     out = tmp_path / "out"
     shutil.copytree(whole[0], out)
     other = cup()
@@ -257,10 +257,10 @@ def test_a_resume_names_what_differs_and_records_what_changed(tmp_path, whole):
         contact_run.run(other, out, resume=True)
     assert err.value.field == "resume" and "material.thickness" in str(err.value)
     longer = cup()
-    longer.tools.stroke, longer.tools.blank_holder_force = 1.1, 0.9 * longer.tools.blank_holder_force
+    longer.tools.stroke, longer.process.max_step_mm = 1.1, 0.05
     summary = contact_run.run(longer, out, resume=True)
     changed = summary["resumed"]["changed"]
-    assert set(changed) == {"tools.stroke", "tools.blank_holder_force"}
+    assert set(changed) == {"tools.stroke", "process.max_step_mm"}
     assert changed["tools.stroke"] == {"checkpoint": 1.0, "now": 1.1}
     assert summary["stroke_mm"] == pytest.approx(1.1)
 
@@ -331,3 +331,33 @@ def test_a_checkpoint_resumes_on_another_number_of_ranks(tmp_path, whole):
         assert summary["resumed_from_stroke_mm"] == pytest.approx(0.5)
         assert summary["increments"] == whole[1]["increments"]
         assert_same_end(summary, whole[1], rel=1e-6)
+
+
+def _files(folder: Path, names) -> dict:
+    return {name: (folder / name).read_bytes() for name in names if (folder / name).exists()}
+
+
+@pytest.mark.timeout(120)
+def test_another_holder_force_or_friction_is_refused_on_a_resume(tmp_path, whole):
+    """Scene B (another title, holder force and friction) resumed in scene A's finished folder:
+    refused naming tools.blank_holder_force and tools.friction, nothing written (today: exit 0,
+    A's forces and draw-in under B's title). The same from a checkpoint half-way (0.5 mm): the
+    holder and friction act from the first increment, so a run with other ones is another run."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    before = _files(out, sorted(p.name for p in out.iterdir() if p.is_file()))
+    b = cup()
+    b.title, b.tools.blank_holder_force, b.tools.friction = "scene B", 0.5 * b.tools.blank_holder_force, 0.05
+    with pytest.raises(InputError) as err:
+        contact_run.run(b, out, resume=True)
+    assert err.value.field == "tools.blank_holder_force"
+    assert "tools.friction" in str(err.value) and "checkpoint" in str(err.value)
+    assert _files(out, before) == before
+    (out / "checkpoint.npz").unlink()  # the resume takes checkpoint.previous.npz, at 0.5 mm
+    c = cup()
+    c.tools.friction = 0.05
+    with pytest.raises(InputError) as err:
+        contact_run.run(c, out, resume=True)
+    assert err.value.field == "tools.friction" and "0.5 mm" in str(err.value)
+
+

@@ -111,6 +111,7 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     if at > s.tools.stroke * (1 + 1e-12) + 1e-12:
         raise InputError("tools.stroke", f"{s.tools.stroke:g} mm is shorter than the stroke of the checkpoint "
                                          f"{saved.path}, {at:.6g} mm: resume with a stroke of at least that")
+    run_folder.check_process(changed, at, saved.path)
     for line in saved.damaged:
         p.driver.progress.note(f"shellform: resume: {line}; using {saved.path}")
     p.driver.resume(saved)
@@ -139,8 +140,9 @@ def _previous_neck(outdir: Path) -> dict | None:
 def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> DrawingSummary:
     """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
     continue from the last converged state in outdir (written at every report, at the end and
-    at a stop), with this scene's stroke, steps, friction and holder force (the summary's
-    "resumed" records what changed); without resume the folder is this run's alone
+    at a stop), with this scene's stroke and steps (the summary's "resumed" records what
+    changed; another holder force or friction is another run: run_folder.check_process);
+    without resume the folder is this run's alone
     (run_folder.start). scene_path: the scene's file, for run.json."""
     outdir = Path(outdir)
     run_folder.start(outdir, s, scene_path, resume, comm)

@@ -43,6 +43,10 @@ CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force
             "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
             "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
             "process.stop_at_neck", "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
+# of those, the process inputs that act on the sheet from its first increment: a resume may
+# change them only from a checkpoint before any increment; past it, a run with other ones is
+# another run (refused, naming them)
+PROCESS = ("tools.blank_holder_force", "tools.friction", "effects.friction")
 
 
 def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:
@@ -134,6 +138,19 @@ def compare(saved: dict, now: dict) -> tuple[list[str], dict]:
     changed = {k: {"checkpoint": before.get(k), "now": after.get(k)} for k in sorted(set(before) | set(after))
                if before.get(k) != after.get(k)}
     return differ, changed
+
+
+def check_process(changed: dict, at_mm: float, path) -> None:
+    """Refuse a resume from a checkpoint at at_mm > 0 whose process inputs (PROCESS) differ
+    from this scene's (changed: compare's second value): InputError naming the first of them,
+    and every one with its value in the checkpoint and now."""
+    fields = [k for k in PROCESS if k in changed]
+    if not fields or at_mm <= 0.0:
+        return
+    values = ", ".join(f"{k} {changed[k]['checkpoint']!r} there, {changed[k]['now']!r} now" for k in fields)
+    raise InputError(fields[0], f"the checkpoint {path} at {at_mm:.6g} mm was drawn with other process inputs "
+                                f"({values}); they act from the first increment, so this is another run: run it "
+                                "into another folder (without --resume)")
 
 
 def read_manifest(outdir: Path) -> dict | None:
