@@ -361,3 +361,52 @@ def test_another_holder_force_or_friction_is_refused_on_a_resume(tmp_path, whole
     assert err.value.field == "tools.friction" and "0.5 mm" in str(err.value)
 
 
+def fld_cup():
+    """cup() with the forming-limit view and the pictures: fld.csv, strain_path.csv, fld.png,
+    cup.png, cup_margin.png."""
+    return cup().changed({"output.fld": True, "output.png": True})
+
+
+@pytest.fixture(scope="module")
+def drawn(tmp_path_factory):
+    """fld_cup() run uninterrupted: (its folder, its summary)."""
+    out = tmp_path_factory.mktemp("drawn")
+    return out, contact_run.run(fld_cup(), out)
+
+
+RESULTS = ("fld.csv", "strain_path.csv", "thickness_diagonal.csv", "thickness_transverse.csv", "force_stroke.csv",
+           "reports.json")
+
+
+@pytest.mark.timeout(300)
+def test_a_resume_with_nothing_to_do_rewrites_the_same_results(tmp_path, drawn):
+    """A finished run resumed at its checkpoint's own stroke: the tables it writes again are
+    those it had (today: fld.csv with zero strains, min_margin 0.35 instead of 0.29 on the
+    paper's cup, strain_path.csv and summary.json's strain_path gone), and so is what
+    summary.json says of the drawn cup."""
+    out = tmp_path / "out"
+    shutil.copytree(drawn[0], out)
+    before = _files(out, RESULTS)
+    assert set(before) == set(RESULTS)
+    summary = contact_run.run(fld_cup(), out, resume=True)
+    assert summary["resumed_from_stroke_mm"] == pytest.approx(1.0)
+    assert _files(out, RESULTS) == before
+    keys = ("reports", "min_margin", "min_margin_at_initial_xy_mm", "strain_path", "min_thickness_strain",
+            "volume_change", "increments", "newton_iterations", "forming_limit", "stroke_mm")
+    assert {k: summary[k] for k in keys} == {k: drawn[1][k] for k in keys}
+
+
+@pytest.mark.timeout(400)
+def test_a_resume_keeps_the_strain_path(tmp_path, drawn):
+    """fld_cup() killed at a timed checkpoint between two increments (the third: checkpoints at
+    every increment), then resumed: strain_path.csv holds the uninterrupted run's whole path,
+    every point of it (today: the points from the resumed stroke on only)."""
+    scene = fld_cup().changed({"output.checkpoint_every": 1e-9})
+    killed_after_first_report(tmp_path, scene, saves=3)
+    saved = (tmp_path / "strain_path.csv").exists()
+    summary = contact_run.run(scene, tmp_path, resume=True)
+    assert not saved and 0 < summary["resumed_from_stroke_mm"] < 0.5
+    assert (tmp_path / "strain_path.csv").read_text() == (drawn[0] / "strain_path.csv").read_text()
+    assert summary["strain_path"] == drawn[1]["strain_path"]
+
+

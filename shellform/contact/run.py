@@ -37,8 +37,8 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              cup_margin.png the cup coloured by that margin (results/fld.py)
     strain_path.csv          ([output] fld) the major and minor true strains along the stroke
                              (every stroke/200 and at the reports) of the element whose margin is
-                             smallest at the end: its strain path (after a resume, from the
-                             resumed stroke); summary.json "strain_path":
+                             smallest at the end: its strain path (the checkpoint carries it:
+                             a resume continues it); summary.json "strain_path":
                              where it is and where it ends. With [process] stop_at_forming_limit
                              the stroke ends at the increment where the smallest margin reaches
                              0; summary.json "forming_limit_reached": the stroke interpolated to
@@ -150,6 +150,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
     p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     curve, reports, stopped, resumed, signum = [], [], None, None, 0
+    paths = watch = None  # what the run records along the stroke, in its checkpoints (driver.records)
+    if p.model.plastic and (s.output.fld or s.process.stop_at_forming_limit):
+        (curve_of_limits, _), _ = fld.curves(s.material)
+        paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
+        watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
+    p.driver.records += [r for r in (paths, watch) if r is not None]
     if resume:
         curve, reports, resumed = _resume(p, s, outdir, comm)
         run_folder.resumed(outdir, s, scene_path, comm)
@@ -158,11 +164,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if s.output.vtx or s.output.vtu else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
     saved_at = [time.monotonic()]  # when the last checkpoint was written
-    paths = watch = None
-    if p.model.plastic and (s.output.fld or s.process.stop_at_forming_limit):
-        (curve_of_limits, _), _ = fld.curves(s.material)
-        paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
-        watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
     necks = neck.NeckWatch(comm) if p.model.plastic else None
     if necks is not None and resumed:
         necks.carry(_previous_neck(outdir), p.stroke)
@@ -181,10 +182,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                       "free_under_closed_holder": p.free_under_holder(),
                       "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
-        every = s.output.checkpoint_every  # the last converged increment on disk at least this often
-        if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
-            checkpoint_now()
-        necked = False
+        necked = limit = False
         if necks is not None:
             before = necks.onset
             necked = necks.reached(p.stroke, p.model.membrane_stability(), p.model.thickness_strain(), centres)
@@ -194,8 +192,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             f = p.model.cell_fields()
             if paths is not None:
                 paths.record(p.stroke, f["major_strain"], f["minor_strain"])
-            if watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"]):
-                raise FormingLimitReached
+            limit = watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"])
+        every = s.output.checkpoint_every  # the increment, recorded, on disk at least this often
+        if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
+            checkpoint_now()
+        if limit:
+            raise FormingLimitReached
         if necked and s.process.stop_at_neck:
             raise neck.NeckReached
 
