@@ -410,3 +410,32 @@ def test_a_resume_keeps_the_strain_path(tmp_path, drawn):
     assert summary["strain_path"] == drawn[1]["strain_path"]
 
 
+@pytest.mark.timeout(300)
+def test_a_resume_does_not_write_through_links_in_out(tmp_path, drawn):
+    """Links planted in a finished run's folder with the names of its outputs (pictures,
+    tables, the summary, the VTU series and its folder), each to a file or folder elsewhere:
+    --resume removes them and writes its own files, and nothing where they pointed changes
+    (today: force_stroke.png, cup.png, fld.png and cup_margin.png written through)."""
+    out = tmp_path / "out"
+    shutil.copytree(drawn[0], out)
+    elsewhere = tmp_path / "elsewhere"
+    (elsewhere / "folder").mkdir(parents=True)
+    written = ("force_stroke.png", "cup.png", "fld.png", "cup_margin.png", "thickness.png", "summary.json",
+               "fld.csv", "strain_path.csv")
+    kept = ("history.json", "cup.pvd")  # a resume with nothing to do writes these not
+    for name in written + kept:
+        (out / name).unlink()
+        (elsewhere / f"{name}.kept").write_text("not shellform's\n")
+        (out / name).symlink_to(elsewhere / f"{name}.kept")
+    shutil.rmtree(out / "vtu")
+    (out / "vtu").symlink_to(elsewhere / "folder", target_is_directory=True)
+    contact_run.run(fld_cup(), out, resume=True)
+    for name in written + kept:
+        assert (elsewhere / f"{name}.kept").read_text() == "not shellform's\n", name
+        assert not (out / name).is_symlink(), name
+    for name in written:
+        assert (out / name).stat().st_size > 0, name
+    assert list((elsewhere / "folder").iterdir()) == []
+    assert not (out / "vtu").is_symlink()
+
+

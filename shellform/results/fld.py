@@ -26,6 +26,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.errors import InputError
+from shellform.results.tables import write_figure
 
 FIELD = "material.forming_limit_curve"
 
@@ -143,7 +144,7 @@ def plot(path, major, minor, curve, title: str, label: str, beside=None) -> None
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper center")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    write_figure(path, fig, dpi=120)
     plt.close(fig)
 
 
