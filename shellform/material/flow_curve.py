@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from shellform.errors import InputError
+from shellform.files import read_text_bounded
 
 EXTRAPOLATIONS = ("constant", "linear", "swift", "voce")
 FIELD = "material.flow_curve"
@@ -31,19 +32,14 @@ MAX_BYTES = 1_000_000  # a flow curve is a few hundred rows at most
 
 
 def read_csv(path, field: str = FIELD, columns: str = "plastic strain, true stress") -> np.ndarray:
-    """The rows of a .csv file (at most MAX_BYTES) of two numeric columns (here the flow
+    """The rows of a .csv file (a regular file of at most MAX_BYTES) of two numeric columns (here the flow
     curve's p, sigma; shellform.results.fld reads a forming-limit curve with it), an optional
     header line, '#' comments; InputError naming `field` where it cannot be read (no line of
     the file is echoed)."""
     path = Path(path)
     if path.suffix.lower() != ".csv":
         raise InputError(field, f"must be a .csv file, got {path.name!r}")
-    try:
-        if path.stat().st_size > MAX_BYTES:
-            raise InputError(field, f"{path.name} is larger than {MAX_BYTES // 1000} kB: no such table is")
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as err:
-        raise InputError(field, f"cannot read {str(path)!r}: {err}") from None
+    text = read_text_bounded(path, field, MAX_BYTES)  # a regular file, a bounded read (shellform/files.py)
     rows = []
     for k, row in enumerate(csv.reader(line for line in text.splitlines() if line.strip()
                                        and not line.lstrip().startswith("#"))):
