@@ -439,3 +439,30 @@ def test_a_resume_does_not_write_through_links_in_out(tmp_path, drawn):
     assert not (out / "vtu").is_symlink()
 
 
+@pytest.mark.timeout(200)
+@pytest.mark.parametrize("damage", ["reports.json", "force_stroke.csv", "rows cut", "global cut"])
+def test_a_damaged_file_of_a_resume_is_named_in_one_line(tmp_path, whole, damage):
+    """--resume in a finished folder whose reports.json is not JSON, whose force_stroke.csv has
+    a row that is not numbers, or whose checkpoints have their arrays cut (every per-node array
+    but the numbers half its rows; the tools' travel empty): exit 2 with one line naming the file (today:
+    JSONDecodeError, ValueError, IndexError tracebacks)."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    if damage == "reports.json":
+        (out / "reports.json").write_text('[{"stroke_mm": 0.5, ')
+    elif damage == "force_stroke.csv":
+        (out / "force_stroke.csv").write_text((out / "force_stroke.csv").read_text() + "13,abc\n")
+    else:
+        for name in ("checkpoint.npz", "checkpoint.previous.npz"):
+            with np.load(out / name) as data:
+                arrays = {k: data[k] for k in data.files}
+            for k in arrays:
+                if damage == "rows cut" and k.startswith("nodes.") and k != "nodes.index":
+                    arrays[k] = arrays[k][: len(arrays[k]) // 2]
+            if damage == "global cut":
+                arrays["global.contact_travel"] = arrays["global.contact_travel"][:0]
+            np.savez(out / name, **arrays)
+    with pytest.raises(InputError) as err:
+        contact_run.run(cup(), out, resume=True)
+    named = {"reports.json": "reports.json", "force_stroke.csv": "force_stroke.csv"}.get(damage, "checkpoint")
+    assert err.value.field == "resume" and named in str(err.value) and "damaged" in str(err.value)

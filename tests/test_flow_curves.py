@@ -189,3 +189,11 @@ def test_a_csv_that_is_no_regular_file_is_refused_within_seconds(tmp_path, capsy
     assert err[-1].startswith(f"shellform: input error: material.{key}: ") and "curve.csv" in err[-1], err
 
 
+@pytest.mark.parametrize("row", [(0.1, 1e308), (1e300, 400.0), (0.2, 2e5)])
+def test_a_flow_curve_past_its_range_names_the_row(row):
+    """Stresses of 1e308 MPa (today: a scipy ValueError from the Swift fit), a plastic strain of
+    1e300, or 200 GPa: InputError naming material.flow_curve and the row."""
+    t = np.array([(0.0, 200.0), (0.05, 300.0), row])
+    with pytest.raises(InputError) as err:
+        FlowCurve.from_table(t, "swift")
+    assert err.value.field == "material.flow_curve" and "row 3" in str(err.value)

@@ -97,8 +97,6 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
     or where it lies past this scene's stroke; the force-stroke rows and reports up to it, and
     what the summary records of the resume."""
-    import csv
-
     saved = checkpoint.read(outdir, comm)
     if not p.driver.fingerprint:
         p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
@@ -106,27 +104,51 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     if differ:
         raise InputError("resume", f"the checkpoint {saved.path} was written for another scene, mesh or code: "
                                    f"{', '.join(differ)} differ")
-    glob = saved.arrays
-    at = float(glob["global.lam"]) * abs(float(glob["global.contact_travel"][0]))
+    try:
+        at = float(saved.arrays["global.lam"]) * abs(float(saved.arrays["global.contact_travel"][0]))
+    except (KeyError, IndexError, TypeError, ValueError) as err:
+        raise InputError("resume", f"the checkpoint {saved.path} is damaged ({type(err).__name__}: {err})") from None
     if at > s.tools.stroke * (1 + 1e-12) + 1e-12:
         raise InputError("tools.stroke", f"{s.tools.stroke:g} mm is shorter than the stroke of the checkpoint "
                                          f"{saved.path}, {at:.6g} mm: resume with a stroke of at least that")
     run_folder.check_process(changed, at, saved.path)
     for line in saved.damaged:
         p.driver.progress.note(f"shellform: resume: {line}; using {saved.path}")
-    p.driver.resume(saved)
+    try:
+        p.driver.resume(saved)
+    except InputError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError) as err:  # arrays of the wrong kind or length
+        raise InputError("resume", f"the checkpoint {saved.path} is damaged ({type(err).__name__}: {err})") from None
     if set(changed) & STEPPING:  # other steps asked for: they start afresh
         p.driver.forget_steps()
-    upto = p.stroke + 1e-9
-    curve, reports = [], []
-    if (outdir / "force_stroke.csv").exists():
-        with open(outdir / "force_stroke.csv") as f:
-            curve = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f) if float(r["stroke_mm"]) <= upto]
-    if (outdir / "reports.json").exists():
-        reports = [r for r in json.loads((outdir / "reports.json").read_text()) if r["stroke_mm"] <= upto]
+    curve, reports = _taken_over(outdir, p.stroke + 1e-9)
     info = {"from_stroke_mm": p.stroke, "checkpoint": saved.path.name, "damaged": saved.damaged,
             "increments_before": len(p.driver.history), "changed": changed}
     return curve, reports, info
+
+
+def _taken_over(outdir: Path, upto: float) -> tuple[list, list]:
+    """The force-stroke rows and the reports (force_stroke.csv, reports.json) up to the stroke
+    `upto`, which a resume takes over; none where a file is missing. InputError("resume")
+    naming the file where it is damaged (not the table a run writes)."""
+    import csv
+
+    curve, reports, path = [], [], outdir / "force_stroke.csv"
+    try:
+        if path.exists():
+            with open(path, newline="") as f:
+                rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+            curve = [r for r in rows if r["stroke_mm"] <= upto]
+        path = outdir / "reports.json"
+        if path.exists():
+            reports = [r for r in json.loads(path.read_text()) if float(r["stroke_mm"]) <= upto]
+            for r in reports:
+                float(r["punch_force_kN"]), dict(r["draw_in_mm"])
+    except (OSError, UnicodeDecodeError, csv.Error, KeyError, IndexError, TypeError, ValueError) as err:
+        raise InputError("resume", f"{path} is damaged ({type(err).__name__}: {err}): the rows before the "
+                                   "checkpoint cannot be taken over; run the scene afresh") from None
+    return curve, reports
 
 
 def _previous_neck(outdir: Path) -> dict | None:

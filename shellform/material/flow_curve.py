@@ -29,6 +29,9 @@ from shellform.files import read_text_bounded
 EXTRAPOLATIONS = ("constant", "linear", "swift", "voce")
 FIELD = "material.flow_curve"
 MAX_BYTES = 1_000_000  # a flow curve is a few hundred rows at most
+# the table's range: stresses in MPa up to 1e5 (100 GPa, past any metal's flow stress; the fits
+# of the extrapolation and the return mapping overflow far above), plastic strains up to 100
+MAX_STRESS, MAX_STRAIN = 1e5, 100.0
 
 
 def read_csv(path, field: str = FIELD, columns: str = "plastic strain, true stress") -> np.ndarray:
@@ -82,6 +85,10 @@ class FlowCurve:
             raise InputError(FIELD, f"must start at plastic strain 0 (the initial yield stress), starts at {p[0]}")
         if s[0] <= 0.0:
             raise InputError(FIELD, f"the initial yield stress must be positive, got {s[0]}")
+        if s.max() > MAX_STRESS or p.max() > MAX_STRAIN:
+            row = int(np.argmax((s > MAX_STRESS) | (p > MAX_STRAIN)))
+            raise InputError(FIELD, f"row {row + 1} ({p[row]:g}, {s[row]:g}) is past the range of a flow curve: "
+                                    f"stresses up to {MAX_STRESS:g} MPa, plastic strains up to {MAX_STRAIN:g}")
         bad = np.flatnonzero(np.diff(p) <= 0.0)
         if bad.size:
             raise InputError(FIELD, f"the plastic strain must increase: row {bad[0] + 2} ({p[bad[0] + 1]}) "
