@@ -38,9 +38,9 @@ def write_atomically(path: Path, write, binary: bool = False) -> None:
     onto `path` and fsync the folder: readers see the old file or the new one, never a part."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.unlink(missing_ok=True)  # a kill's leftover, or a link: the new file is created, never opened through one
+    tmp.unlink(missing_ok=True)  # a kill's leftover, or a link: the file is created anew, not opened through one
     try:
-        with open(tmp, "xb" if binary else "x", **({} if binary else {"newline": ""})) as f:
+        with open(tmp, "wb" if binary else "w", **({} if binary else {"newline": ""})) as f:
             write(f)
             f.flush()
             os.fsync(f.fileno())
