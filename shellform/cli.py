@@ -81,7 +81,7 @@ def _parser() -> argparse.ArgumentParser:
     p_run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="settings", help=SET_HELP)
     p_run.add_argument("--resume", action="store_true",
                        help="a tool scene: continue from the last converged state in --out, on any number of ranks, "
-                            "with this scene's stroke (not shorter), steps, friction and holder force; "
+                            "with this scene's stroke (not shorter) and steps; "
                             "refused where anything else differs (docs/reliability.md)")
     p_run.add_argument("--threads", type=int, metavar="N", help=THREADS_HELP)
     p_run.add_argument("--trace", action="store_true",

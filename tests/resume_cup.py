@@ -22,17 +22,20 @@ class Killed(Exception):
     pass
 
 
-def killed_after_first_report(outdir) -> None:
-    """Run cup() into outdir and die as the first checkpoint is written."""
-    save = SemiInverseDriver.save_checkpoint
+def killed_after_first_report(outdir, scene=None, saves: int = 1) -> None:
+    """Run `scene` (cup()) into outdir and die as its checkpoint number `saves` (the first: at
+    the first report) is written."""
+    save, done = SemiInverseDriver.save_checkpoint, []
 
     def save_and_die(self, *args, **kwargs):
         save(self, *args, **kwargs)
-        raise Killed
+        done.append(1)
+        if len(done) >= saves:
+            raise Killed
 
     SemiInverseDriver.save_checkpoint = save_and_die
     try:
-        contact_run.run(cup(), outdir)
+        contact_run.run(scene or cup(), outdir)
     except Killed:
         pass
     finally:

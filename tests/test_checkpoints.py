@@ -247,8 +247,8 @@ def test_scene_b_killed_in_a_finished_folder_then_resumed_reports_nothing_of_a(t
 
 @pytest.mark.timeout(120)
 def test_a_resume_names_what_differs_and_records_what_changed(tmp_path, whole):
-    """Another material (what defines the state) is refused, naming the field; a longer stroke,
-    another holder force and friction (how to continue) are taken, and the summary records them."""
+    """Another material (what defines the state) is refused, naming the field; a longer stroke
+    and other steps (how to continue) are taken, and the summary records them."""
     out = tmp_path / "out"
     shutil.copytree(whole[0], out)
     other = cup()
@@ -257,10 +257,10 @@ def test_a_resume_names_what_differs_and_records_what_changed(tmp_path, whole):
         contact_run.run(other, out, resume=True)
     assert err.value.field == "resume" and "material.thickness" in str(err.value)
     longer = cup()
-    longer.tools.stroke, longer.tools.blank_holder_force = 1.1, 0.9 * longer.tools.blank_holder_force
+    longer.tools.stroke, longer.process.max_step_mm = 1.1, 0.05
     summary = contact_run.run(longer, out, resume=True)
     changed = summary["resumed"]["changed"]
-    assert set(changed) == {"tools.stroke", "tools.blank_holder_force"}
+    assert set(changed) == {"tools.stroke", "process.max_step_mm"}
     assert changed["tools.stroke"] == {"checkpoint": 1.0, "now": 1.1}
     assert summary["stroke_mm"] == pytest.approx(1.1)
 
@@ -331,3 +331,138 @@ def test_a_checkpoint_resumes_on_another_number_of_ranks(tmp_path, whole):
         assert summary["resumed_from_stroke_mm"] == pytest.approx(0.5)
         assert summary["increments"] == whole[1]["increments"]
         assert_same_end(summary, whole[1], rel=1e-6)
+
+
+def _files(folder: Path, names) -> dict:
+    return {name: (folder / name).read_bytes() for name in names if (folder / name).exists()}
+
+
+@pytest.mark.timeout(120)
+def test_another_holder_force_or_friction_is_refused_on_a_resume(tmp_path, whole):
+    """Scene B (another title, holder force and friction) resumed in scene A's finished folder:
+    refused naming tools.blank_holder_force and tools.friction, nothing written (today: exit 0,
+    A's forces and draw-in under B's title). The same from a checkpoint half-way (0.5 mm): the
+    holder and friction act from the first increment, so a run with other ones is another run."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    before = _files(out, sorted(p.name for p in out.iterdir() if p.is_file()))
+    b = cup()
+    b.title, b.tools.blank_holder_force, b.tools.friction = "scene B", 0.5 * b.tools.blank_holder_force, 0.05
+    with pytest.raises(InputError) as err:
+        contact_run.run(b, out, resume=True)
+    assert err.value.field == "tools.blank_holder_force"
+    assert "tools.friction" in str(err.value) and "checkpoint" in str(err.value)
+    assert _files(out, before) == before
+    (out / "checkpoint.npz").unlink()  # the resume takes checkpoint.previous.npz, at 0.5 mm
+    c = cup()
+    c.tools.friction = 0.05
+    with pytest.raises(InputError) as err:
+        contact_run.run(c, out, resume=True)
+    assert err.value.field == "tools.friction" and "0.5 mm" in str(err.value)
+
+
+def fld_cup():
+    """cup() with the forming-limit view and the pictures: fld.csv, strain_path.csv, fld.png,
+    cup.png, cup_margin.png."""
+    return cup().changed({"output.fld": True, "output.png": True})
+
+
+@pytest.fixture(scope="module")
+def drawn(tmp_path_factory):
+    """fld_cup() run uninterrupted: (its folder, its summary)."""
+    out = tmp_path_factory.mktemp("drawn")
+    return out, contact_run.run(fld_cup(), out)
+
+
+RESULTS = ("fld.csv", "strain_path.csv", "thickness_diagonal.csv", "thickness_transverse.csv", "force_stroke.csv",
+           "reports.json")
+
+
+@pytest.mark.timeout(300)
+def test_a_resume_with_nothing_to_do_rewrites_the_same_results(tmp_path, drawn):
+    """A finished run resumed at its checkpoint's own stroke: the tables it writes again are
+    those it had (today: fld.csv with zero strains, min_margin 0.35 instead of 0.29 on the
+    paper's cup, strain_path.csv and summary.json's strain_path gone), and so is what
+    summary.json says of the drawn cup."""
+    out = tmp_path / "out"
+    shutil.copytree(drawn[0], out)
+    before = _files(out, RESULTS)
+    assert set(before) == set(RESULTS)
+    summary = contact_run.run(fld_cup(), out, resume=True)
+    assert summary["resumed_from_stroke_mm"] == pytest.approx(1.0)
+    assert _files(out, RESULTS) == before
+    keys = ("reports", "min_margin", "min_margin_at_initial_xy_mm", "strain_path", "min_thickness_strain",
+            "volume_change", "increments", "newton_iterations", "forming_limit", "stroke_mm")
+    assert {k: summary[k] for k in keys} == {k: drawn[1][k] for k in keys}
+
+
+@pytest.mark.timeout(400)
+def test_a_resume_keeps_the_strain_path(tmp_path, drawn):
+    """fld_cup() killed at a timed checkpoint between two increments (the third: checkpoints at
+    every increment), then resumed: strain_path.csv holds the uninterrupted run's whole path,
+    every point of it (today: the points from the resumed stroke on only)."""
+    scene = fld_cup().changed({"output.checkpoint_every": 1e-9})
+    killed_after_first_report(tmp_path, scene, saves=3)
+    saved = (tmp_path / "strain_path.csv").exists()
+    summary = contact_run.run(scene, tmp_path, resume=True)
+    assert not saved and 0 < summary["resumed_from_stroke_mm"] < 0.5
+    assert (tmp_path / "strain_path.csv").read_text() == (drawn[0] / "strain_path.csv").read_text()
+    assert summary["strain_path"] == drawn[1]["strain_path"]
+
+
+@pytest.mark.timeout(300)
+def test_a_resume_does_not_write_through_links_in_out(tmp_path, drawn):
+    """Links planted in a finished run's folder with the names of its outputs (pictures,
+    tables, the summary, the VTU series and its folder), each to a file or folder elsewhere:
+    --resume removes them and writes its own files, and nothing where they pointed changes
+    (today: force_stroke.png, cup.png, fld.png and cup_margin.png written through)."""
+    out = tmp_path / "out"
+    shutil.copytree(drawn[0], out)
+    elsewhere = tmp_path / "elsewhere"
+    (elsewhere / "folder").mkdir(parents=True)
+    written = ("force_stroke.png", "cup.png", "fld.png", "cup_margin.png", "thickness.png", "summary.json",
+               "fld.csv", "strain_path.csv")
+    kept = ("history.json", "cup.pvd")  # a resume with nothing to do writes these not
+    for name in written + kept:
+        (out / name).unlink()
+        (elsewhere / f"{name}.kept").write_text("not shellform's\n")
+        (out / name).symlink_to(elsewhere / f"{name}.kept")
+    shutil.rmtree(out / "vtu")
+    (out / "vtu").symlink_to(elsewhere / "folder", target_is_directory=True)
+    contact_run.run(fld_cup(), out, resume=True)
+    for name in written + kept:
+        assert (elsewhere / f"{name}.kept").read_text() == "not shellform's\n", name
+        assert not (out / name).is_symlink(), name
+    for name in written:
+        assert (out / name).stat().st_size > 0, name
+    assert list((elsewhere / "folder").iterdir()) == []
+    assert not (out / "vtu").is_symlink()
+
+
+@pytest.mark.timeout(200)
+@pytest.mark.parametrize("damage", ["reports.json", "force_stroke.csv", "rows cut", "global cut"])
+def test_a_damaged_file_of_a_resume_is_named_in_one_line(tmp_path, whole, damage):
+    """--resume in a finished folder whose reports.json is not JSON, whose force_stroke.csv has
+    a row that is not numbers, or whose checkpoints have their arrays cut (every per-node array
+    but the numbers half its rows; the tools' travel empty): exit 2 with one line naming the file (today:
+    JSONDecodeError, ValueError, IndexError tracebacks)."""
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    if damage == "reports.json":
+        (out / "reports.json").write_text('[{"stroke_mm": 0.5, ')
+    elif damage == "force_stroke.csv":
+        (out / "force_stroke.csv").write_text((out / "force_stroke.csv").read_text() + "13,abc\n")
+    else:
+        for name in ("checkpoint.npz", "checkpoint.previous.npz"):
+            with np.load(out / name) as data:
+                arrays = {k: data[k] for k in data.files}
+            for k in arrays:
+                if damage == "rows cut" and k.startswith("nodes.") and k != "nodes.index":
+                    arrays[k] = arrays[k][: len(arrays[k]) // 2]
+            if damage == "global cut":
+                arrays["global.contact_travel"] = arrays["global.contact_travel"][:0]
+            np.savez(out / name, **arrays)
+    with pytest.raises(InputError) as err:
+        contact_run.run(cup(), out, resume=True)
+    named = {"reports.json": "reports.json", "force_stroke.csv": "force_stroke.csv"}.get(damage, "checkpoint")
+    assert err.value.field == "resume" and named in str(err.value) and "damaged" in str(err.value)

@@ -164,3 +164,20 @@ def test_the_rim_reaches_its_ends_to_round_off():
     d = cup.rim_draw_in(rows)
     assert d == {"rim_0deg": 2.0, "rim_45deg": pytest.approx(3.5), "rim_90deg": 5.0}
     assert np.isnan(cup.rim_draw_in(rows[1:])["rim_0deg"])
+
+
+def _refuse(constant):
+    raise ValueError(f"{constant} is not JSON")
+
+
+@pytest.mark.parametrize("n", [8, 10])
+def test_a_round_cup_summary_is_strict_json_with_the_rims_draw_in(tmp_path, n):
+    """The round cup at mesh.n 8 and 10 (their first rim node lies at about 1e-16 degrees, where
+    the draw-in at 0 degrees came out NaN) drawn 1 mm through `shellform run`: summary.json
+    parses as strict JSON, and rim_0deg, rim_45deg, rim_90deg are finite numbers, rim_0deg DX's."""
+    path = round_cup(tmp_path, 1.0, n, 1.0, 1.0, 1.0)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--set", "process.springback=false"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text(), parse_constant=_refuse)
+    last = summary["draw_in_mm"][-1]
+    assert all(isinstance(last[f"rim_{a}deg"], float) and np.isfinite(last[f"rim_{a}deg"]) for a in (0, 45, 90))
+    assert last["rim_0deg"] == pytest.approx(last["DX"], rel=1e-9)

@@ -152,3 +152,48 @@ def test_the_material_line_states_the_extrapolation():
     line = SheetMaterial(E, NU, hardening="table", flow_curve=table(swift), extrapolation="swift").describe()
     assert line.startswith("material: yield function hill79; r 1, m 2; hardening table; beyond p = 0.3")
     assert "Swift 565.32 (0.007117 + p)^0.2589 fitted to the last 7 points" in line
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("kind", ["/dev/zero", "a FIFO", "a folder", "too large"])
+@pytest.mark.parametrize("key", ["flow_curve", "forming_limit_curve"])
+def test_a_csv_that_is_no_regular_file_is_refused_within_seconds(tmp_path, capsys, kind, key):
+    """A scene's CSV named curve.csv but a link to /dev/zero (endless: read whole, it took 24 GB
+    before the OOM killer ended the run), a FIFO (no writer: the read waited forever), a folder
+    or a file past the 1 MB limit: `shellform check` exits 2 within seconds, naming the field."""
+    import os
+    import time
+
+    from shellform import cli
+
+    good = "".join(f"{float(p)!r},{float(s)!r}\n" for p, s in table(swift))
+    (tmp_path / "good.csv").write_text(good)
+    bad = tmp_path / "curve.csv"
+    if kind == "/dev/zero":
+        bad.symlink_to("/dev/zero")
+    elif kind == "a FIFO":
+        os.mkfifo(bad)
+    elif kind == "a folder":
+        bad.mkdir()
+    else:
+        bad.write_text("#" * 1_100_000 + "\n" + good)
+    curves = {"flow_curve": "good.csv", "forming_limit_curve": "good.csv", key: "curve.csv"}
+    (tmp_path / "sheet.toml").write_text(
+        f'effects = {SHEET!r}\n[material]\nE = 206000.0\nthickness = 0.8\nhardening = "table"\n'
+        f'flow_curve = "{curves["flow_curve"]}"\nextrapolation = "swift"\n'
+        f'forming_limit_curve = "{curves["forming_limit_curve"]}"\n'.replace("'", '"'))
+    t0 = time.monotonic()
+    rc = cli.main(["check", str(tmp_path / "sheet.toml")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and time.monotonic() - t0 < 10
+    assert err[-1].startswith(f"shellform: input error: material.{key}: ") and "curve.csv" in err[-1], err
+
+
+@pytest.mark.parametrize("row", [(0.1, 1e308), (1e300, 400.0), (0.2, 2e5)])
+def test_a_flow_curve_past_its_range_names_the_row(row):
+    """Stresses of 1e308 MPa (today: a scipy ValueError from the Swift fit), a plastic strain of
+    1e300, or 200 GPa: InputError naming material.flow_curve and the row."""
+    t = np.array([(0.0, 200.0), (0.05, 300.0), row])
+    with pytest.raises(InputError) as err:
+        FlowCurve.from_table(t, "swift")
+    assert err.value.field == "material.flow_curve" and "row 3" in str(err.value)

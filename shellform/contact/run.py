@@ -37,8 +37,8 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              cup_margin.png the cup coloured by that margin (results/fld.py)
     strain_path.csv          ([output] fld) the major and minor true strains along the stroke
                              (every stroke/200 and at the reports) of the element whose margin is
-                             smallest at the end: its strain path (after a resume, from the
-                             resumed stroke); summary.json "strain_path":
+                             smallest at the end: its strain path (the checkpoint carries it:
+                             a resume continues it); summary.json "strain_path":
                              where it is and where it ends. With [process] stop_at_forming_limit
                              the stroke ends at the increment where the smallest margin reaches
                              0; summary.json "forming_limit_reached": the stroke interpolated to
@@ -98,8 +98,6 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
     or where it lies past this scene's stroke; the force-stroke rows and reports up to it, and
     what the summary records of the resume."""
-    import csv
-
     saved = checkpoint.read(outdir, comm)
     if not p.driver.fingerprint:
         p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
@@ -107,26 +105,51 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     if differ:
         raise InputError("resume", f"the checkpoint {saved.path} was written for another scene, mesh or code: "
                                    f"{', '.join(differ)} differ")
-    glob = saved.arrays
-    at = float(glob["global.lam"]) * abs(float(glob["global.contact_travel"][0]))
+    try:
+        at = float(saved.arrays["global.lam"]) * abs(float(saved.arrays["global.contact_travel"][0]))
+    except (KeyError, IndexError, TypeError, ValueError) as err:
+        raise InputError("resume", f"the checkpoint {saved.path} is damaged ({type(err).__name__}: {err})") from None
     if at > s.tools.stroke * (1 + 1e-12) + 1e-12:
         raise InputError("tools.stroke", f"{s.tools.stroke:g} mm is shorter than the stroke of the checkpoint "
                                          f"{saved.path}, {at:.6g} mm: resume with a stroke of at least that")
+    run_folder.check_process(changed, at, saved.path)
     for line in saved.damaged:
         p.driver.progress.note(f"shellform: resume: {line}; using {saved.path}")
-    p.driver.resume(saved)
+    try:
+        p.driver.resume(saved)
+    except InputError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError) as err:  # arrays of the wrong kind or length
+        raise InputError("resume", f"the checkpoint {saved.path} is damaged ({type(err).__name__}: {err})") from None
     if set(changed) & STEPPING:  # other steps asked for: they start afresh
         p.driver.forget_steps()
-    upto = p.stroke + 1e-9
-    curve, reports = [], []
-    if (outdir / "force_stroke.csv").exists():
-        with open(outdir / "force_stroke.csv") as f:
-            curve = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f) if float(r["stroke_mm"]) <= upto]
-    if (outdir / "reports.json").exists():
-        reports = [r for r in json.loads((outdir / "reports.json").read_text()) if r["stroke_mm"] <= upto]
+    curve, reports = _taken_over(outdir, p.stroke + 1e-9)
     info = {"from_stroke_mm": p.stroke, "checkpoint": saved.path.name, "damaged": saved.damaged,
             "increments_before": len(p.driver.history), "changed": changed}
     return curve, reports, info
+
+
+def _taken_over(outdir: Path, upto: float) -> tuple[list, list]:
+    """The force-stroke rows and the reports (force_stroke.csv, reports.json) up to the stroke
+    `upto`, which a resume takes over; none where a file is missing. InputError("resume")
+    naming the file where it is damaged (not the table a run writes)."""
+    import csv
+
+    curve, reports, path = [], [], outdir / "force_stroke.csv"
+    try:
+        if path.exists():
+            with open(path, newline="") as f:
+                rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+            curve = [r for r in rows if r["stroke_mm"] <= upto]
+        path = outdir / "reports.json"
+        if path.exists():
+            reports = [r for r in json.loads(path.read_text()) if float(r["stroke_mm"]) <= upto]
+            for r in reports:
+                float(r["punch_force_kN"]), dict(r["draw_in_mm"])
+    except (OSError, UnicodeDecodeError, csv.Error, KeyError, IndexError, TypeError, ValueError) as err:
+        raise InputError("resume", f"{path} is damaged ({type(err).__name__}: {err}): the rows before the "
+                                   "checkpoint cannot be taken over; run the scene afresh") from None
+    return curve, reports
 
 
 def _previous_neck(outdir: Path) -> dict | None:
@@ -140,8 +163,9 @@ def _previous_neck(outdir: Path) -> dict | None:
 def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> DrawingSummary:
     """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
     continue from the last converged state in outdir (written at every report, at the end and
-    at a stop), with this scene's stroke, steps, friction and holder force (the summary's
-    "resumed" records what changed); without resume the folder is this run's alone
+    at a stop), with this scene's stroke and steps (the summary's "resumed" records what
+    changed; another holder force or friction is another run: run_folder.check_process);
+    without resume the folder is this run's alone
     (run_folder.start). scene_path: the scene's file, for run.json."""
     outdir = Path(outdir)
     run_folder.start(outdir, s, scene_path, resume, comm)
@@ -149,6 +173,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
     p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     curve, reports, stopped, resumed, signum = [], [], None, None, 0
+    paths = watch = None  # what the run records along the stroke, in its checkpoints (driver.records)
+    if p.model.plastic and (s.output.fld or s.process.stop_at_forming_limit):
+        (curve_of_limits, _), _ = fld.curves(s.material)
+        paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
+        watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
+    p.driver.records += [r for r in (paths, watch) if r is not None]
     if resume:
         curve, reports, resumed = _resume(p, s, outdir, comm)
         run_folder.resumed(outdir, s, scene_path, comm)
@@ -157,11 +187,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if s.output.vtx or s.output.vtu else None
     p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
     saved_at = [time.monotonic()]  # when the last checkpoint was written
-    paths = watch = None
-    if p.model.plastic and (s.output.fld or s.process.stop_at_forming_limit):
-        (curve_of_limits, _), _ = fld.curves(s.material)
-        paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
-        watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
     necks = neck.NeckWatch(comm) if p.model.plastic else None
     if necks is not None and resumed:
         necks.carry(_previous_neck(outdir), p.stroke)
@@ -180,10 +205,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                       "free_under_closed_holder": p.free_under_holder(),
                       "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                       "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
-        every = s.output.checkpoint_every  # the last converged increment on disk at least this often
-        if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
-            checkpoint_now()
-        necked = False
+        necked = limit = False
         if necks is not None:
             before = necks.onset
             necked = necks.reached(p.stroke, p.model.membrane_stability(), p.model.thickness_strain(), centres)
@@ -193,8 +215,12 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             f = p.model.cell_fields()
             if paths is not None:
                 paths.record(p.stroke, f["major_strain"], f["minor_strain"])
-            if watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"]):
-                raise FormingLimitReached
+            limit = watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"])
+        every = s.output.checkpoint_every  # the increment, recorded, on disk at least this often
+        if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
+            checkpoint_now()
+        if limit:
+            raise FormingLimitReached
         if necked and s.process.stop_at_neck:
             raise neck.NeckReached
 

@@ -24,26 +24,25 @@ from pathlib import Path
 import numpy as np
 
 from shellform.errors import InputError
+from shellform.files import read_text_bounded
 
 EXTRAPOLATIONS = ("constant", "linear", "swift", "voce")
 FIELD = "material.flow_curve"
 MAX_BYTES = 1_000_000  # a flow curve is a few hundred rows at most
+# the table's range: stresses in MPa up to 1e5 (100 GPa, past any metal's flow stress; the fits
+# of the extrapolation and the return mapping overflow far above), plastic strains up to 100
+MAX_STRESS, MAX_STRAIN = 1e5, 100.0
 
 
 def read_csv(path, field: str = FIELD, columns: str = "plastic strain, true stress") -> np.ndarray:
-    """The rows of a .csv file (at most MAX_BYTES) of two numeric columns (here the flow
+    """The rows of a .csv file (a regular file of at most MAX_BYTES) of two numeric columns (here the flow
     curve's p, sigma; shellform.results.fld reads a forming-limit curve with it), an optional
     header line, '#' comments; InputError naming `field` where it cannot be read (no line of
     the file is echoed)."""
     path = Path(path)
     if path.suffix.lower() != ".csv":
         raise InputError(field, f"must be a .csv file, got {path.name!r}")
-    try:
-        if path.stat().st_size > MAX_BYTES:
-            raise InputError(field, f"{path.name} is larger than {MAX_BYTES // 1000} kB: no such table is")
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as err:
-        raise InputError(field, f"cannot read {str(path)!r}: {err}") from None
+    text = read_text_bounded(path, field, MAX_BYTES)  # a regular file, a bounded read (shellform/files.py)
     rows = []
     for k, row in enumerate(csv.reader(line for line in text.splitlines() if line.strip()
                                        and not line.lstrip().startswith("#"))):
@@ -86,6 +85,10 @@ class FlowCurve:
             raise InputError(FIELD, f"must start at plastic strain 0 (the initial yield stress), starts at {p[0]}")
         if s[0] <= 0.0:
             raise InputError(FIELD, f"the initial yield stress must be positive, got {s[0]}")
+        if s.max() > MAX_STRESS or p.max() > MAX_STRAIN:
+            row = int(np.argmax((s > MAX_STRESS) | (p > MAX_STRAIN)))
+            raise InputError(FIELD, f"row {row + 1} ({p[row]:g}, {s[row]:g}) is past the range of a flow curve: "
+                                    f"stresses up to {MAX_STRESS:g} MPa, plastic strains up to {MAX_STRAIN:g}")
         bad = np.flatnonzero(np.diff(p) <= 0.0)
         if bad.size:
             raise InputError(FIELD, f"the plastic strain must increase: row {bad[0] + 2} ({p[bad[0] + 1]}) "

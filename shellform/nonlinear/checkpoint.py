@@ -143,6 +143,11 @@ def _read_file(path: Path) -> tuple[dict, dict]:
         arrays = {k: data[k] for k in data.files}  # reads (and CRC-checks) every member
     if int(arrays.get("format", 0)) != FORMAT:
         raise ValueError(f"format {int(arrays.get('format', 0))}, not {FORMAT}")
+    for group in ("nodes", "cells"):  # every array a row per numbered node or cell (not cut)
+        rows = arrays[f"{group}.index"].shape[:1] if f"{group}.index" in arrays else None
+        for k, v in arrays.items():
+            if k.startswith(group + ".") and (rows is None or v.shape[:1] != rows):
+                raise ValueError(f"{k} has {v.shape[:1] or 'no'} rows, its index {rows or 'none'}")
     meta = {k[len("meta."):]: json.loads(str(v)) for k, v in arrays.items() if k.startswith("meta.")}
     return meta, {k: v for k, v in arrays.items() if not k.startswith("meta.") and k != "format"}
 

@@ -74,6 +74,9 @@ class Driver(Newton):
         self.progress = Progress()  # a run sets its own (label, total, unit)
         self.stops = StopRequests(model.mesh.comm)  # Ctrl-C and SIGTERM while it steps (interrupt.py)
         self.fingerprint = {}  # what defines the run, written into its checkpoints (set by a run)
+        # what a run records along the way and a resume continues (a strain path, a watch): each
+        # owns its state, checkpoint() -> groups and restore(state), kept with the driver's
+        self.records = []
         self._numbering = None  # the checkpoints' global numbers of nodes and cells (numbering())
         self.q_n = self.q.x.array.copy()  # the carrier of the last converged increment
         self.lam = 0.0
@@ -262,7 +265,7 @@ class Driver(Newton):
             dlam, dlam_prev, q_prev = self._steps
             state["nodes"]["q_prev"] = self._owned_nodes(q_prev)
             state["global"].update({"next_dlam": np.array(dlam), "dlam_prev": np.array(dlam_prev)})
-        for part in self.parts:  # the parts' committed states
+        for part in [*self.parts, *self.records]:  # the parts' committed states, what the run recorded
             for group, values in part.checkpoint().items():
                 state[group].update(values)
         return state
@@ -278,10 +281,10 @@ class Driver(Newton):
         q = self._owned_nodes(self.q.x.array)
         if "q" not in state["nodes"] or state["nodes"]["q"].shape != q.shape:
             raise InputError("resume", "the checkpoint's carrier does not fit this model (another mesh)")
-        self.model.restore(state["cells"])
         q[...] = state["nodes"]["q"]
         self.q.x.scatter_forward()
         self.q_n = self.q.x.array.copy()
+        self.model.restore(state["cells"], self.q)
         glob = state["global"]
         self.lam = float(glob["lam"]) * lam_scale
         self._direction = 1.0 if self.lam > 0 else None
@@ -295,6 +298,8 @@ class Driver(Newton):
             self._resumed_steps = (float(glob["next_dlam"]) * lam_scale, float(glob["dlam_prev"]) * lam_scale, q_prev)
         for part in self.parts:
             part.restore(state, lam_scale)
+        for record in self.records:
+            record.restore(state)
 
     def numbering(self) -> checkpoint.Numbering:
         """The global numbers of this rank's nodes and cells in a checkpoint (made once)."""

@@ -247,8 +247,12 @@ class SheetModel:
         return {"ep": self.ep_n, "p": self.p_n, "thickness_stretch": self.stretch_n, "lever_before": self._lever_before,
                 "taper": self.taper}
 
-    def restore(self, data) -> None:
-        """The committed material state from a checkpoint() (refused if it does not fit)."""
+    def restore(self, data, q: fem.Function) -> None:
+        """The committed material state from a checkpoint() (refused if it does not fit), at the
+        converged carrier state q: the last evaluated state becomes the checkpoint's, evaluated
+        at q with the lever arm its increment was solved with, so that what is read from it
+        (cell_fields, thickness_strain, volume_change) is what the run had there; the next
+        increment's lever arm is the committed stretch."""
         pairs = (("ep", self.ep_n), ("p", self.p_n), ("thickness_stretch", self.stretch_n),
                  ("lever_before", self._lever_before), ("taper", self.taper))
         for key, target in pairs:
@@ -257,6 +261,8 @@ class SheetModel:
                                            "or effects)")
         for key, target in pairs:
             target[...] = data[key]
+        self.lever[...] = self._lever_before
+        self.evaluate(q, tangent=False)
         self.ep[...], self.p[...], self.stretch[...], self.lever[...] = self.ep_n, self.p_n, self.stretch_n, self.stretch_n
         self.stability_n[...] = np.nan  # not known until an increment converges
         self.state_version += 1

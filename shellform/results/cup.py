@@ -22,6 +22,7 @@ from mpi4py import MPI
 
 from shellform.results import fields
 from shellform.results.fields import offscreen_backend
+from shellform.results.tables import write_figure, write_screenshot
 from shellform.tools import kinds as tool_kinds
 from shellform.tools import square
 from shellform.tools.protocol import surface_mesh
@@ -112,7 +113,7 @@ def write_rim(outdir: Path, p, title: str) -> dict:
             a.grid(alpha=0.3)
         ax.set_title(f"{title}: the rim at stroke {p.stroke:.1f} mm", fontsize=10, parse_math=False)
         fig.tight_layout()
-        fig.savefig(outdir / "rim.png", dpi=120)
+        write_figure(outdir / "rim.png", fig, dpi=120)
         plt.close(fig)
     return out
 
@@ -154,7 +155,7 @@ def plot_thickness(path: Path, lines: dict[str, list[dict]], title: str) -> None
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    write_figure(path, fig, dpi=120)
     plt.close(fig)
 
 
@@ -322,7 +323,7 @@ def plot_force(path: Path, rows: list[dict], title: str, copies: int = 1) -> Non
     ax.set_title(title, fontsize=10, parse_math=False)  # a scene's title is text, never TeX
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    write_figure(path, fig, dpi=120)
     plt.close(fig)
 
 
@@ -368,7 +369,7 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None, mark: st
                             always_visible=True, shape_opacity=0.7)
     L = 2 * p.blank_size() if p.symmetry == 4 else p.blank_size()
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
-    pl.screenshot(str(path))
+    write_screenshot(path, pl)
     pl.close()
 
 
@@ -452,6 +453,6 @@ def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
             ax.legend(fontsize=8)
         fig.suptitle(f"{title}: springback", fontsize=10)
         fig.tight_layout()
-        fig.savefig(outdir / "springback.png", dpi=120)
+        write_figure(outdir / "springback.png", fig, dpi=120)
         plt.close(fig)
     return out

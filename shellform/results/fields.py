@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 from dolfinx import fem, io, plot
 
+from shellform.results.tables import write_screenshot
+
 
 def nodal_fields(q, components) -> list[fem.Function]:
     """The carrier split into named P1 functions: displacement (u, v, w) and slopes (w_x, w_y)."""
@@ -170,6 +172,6 @@ def write_png(path: Path, q, components, title: str = "", scale: float | None = 
     pl.add_mesh(warped, scalars="w", show_edges=True, cmap="viridis", scalar_bar_args={"title": "w"})
     pl.add_text(f"{title}  (displacement x {scale:.3g})", font_size=10)
     pl.view_isometric()
-    pl.screenshot(str(path))
+    write_screenshot(path, pl)
     pl.close()
     return Path(path)

@@ -26,6 +26,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.errors import InputError
+from shellform.results.tables import write_figure
 
 FIELD = "material.forming_limit_curve"
 
@@ -143,8 +144,11 @@ def plot(path, major, minor, curve, title: str, label: str, beside=None) -> None
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper center")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    write_figure(path, fig, dpi=120)
     plt.close(fig)
+
+
+LIMIT_KEYS = ("stroke_mm", "increment_stroke_mm", "margin")  # FormingLimitWatch.limit
 
 
 class FormingLimitWatch:
@@ -167,9 +171,24 @@ class FormingLimitWatch:
             if self.last is not None and self.last[1] > 0.0:
                 s0, m0 = self.last
                 at = s0 + (stroke - s0) * m0 / (m0 - least)
-            self.limit = {"stroke_mm": at, "increment_stroke_mm": stroke, "margin": least}
+            self.limit = dict(zip(LIMIT_KEYS, (at, stroke, least)))
         self.last = (stroke, least)
         return self.limit is not None
+
+    def checkpoint(self) -> dict:
+        """What a resume continues from: the last increment's (stroke, margin) and the limit
+        found (empty where none)."""
+        limit = self.limit or {}
+        return {"global": {"forming_limit.last": np.array(self.last or (), dtype=float),
+                           "forming_limit.limit": np.array([limit[k] for k in LIMIT_KEYS] if limit else (),
+                                                           dtype=float)}}
+
+    def restore(self, state: dict) -> None:
+        """Read back checkpoint() (nothing where the checkpoint has none: the watch starts afresh)."""
+        glob = state["global"]
+        last, limit = glob.get("forming_limit.last"), glob.get("forming_limit.limit")
+        self.last = tuple(float(v) for v in last) if last is not None and last.size == 2 else None
+        self.limit = dict(zip(LIMIT_KEYS, map(float, limit))) if limit is not None and limit.size == 3 else None
 
 
 class StrainPaths:
@@ -191,6 +210,26 @@ class StrainPaths:
         self.strokes.append(float(stroke))
         self.major.append(np.asarray(major, dtype=np.float32).copy())
         self.minor.append(np.asarray(minor, dtype=np.float32).copy())
+
+    def checkpoint(self) -> dict:
+        """The path so far, for a resume to continue: per owned cell its major and minor strains
+        at every record (cells, records), and the records' strokes."""
+        if not self.strokes:
+            return {"global": {"strain_path.strokes": np.zeros(0)}}
+        return {"global": {"strain_path.strokes": np.array(self.strokes)},
+                "cells": {"strain_path.major": np.stack(self.major, axis=1),
+                          "strain_path.minor": np.stack(self.minor, axis=1)}}
+
+    def restore(self, state: dict) -> None:
+        """Read back checkpoint() (this rank's cells); a checkpoint without a path (written with
+        the forming-limit view off) leaves it empty: the path starts at the resumed stroke."""
+        strokes = state["global"].get("strain_path.strokes")
+        if strokes is None or strokes.size == 0 or "strain_path.major" not in state["cells"]:
+            return
+        major, minor = state["cells"]["strain_path.major"], state["cells"]["strain_path.minor"]
+        self.strokes = [float(s) for s in strokes]
+        self.major = [np.array(major[:, j], dtype=np.float32) for j in range(len(self.strokes))]
+        self.minor = [np.array(minor[:, j], dtype=np.float32) for j in range(len(self.strokes))]
 
     def critical(self, centres) -> dict:
         """{"initial_xy_mm", "stroke_mm", "major", "minor", "margin"} of that element (centres:

@@ -8,7 +8,8 @@ start            run.json, the manifest of the run in the folder: the scene file
                  writes there (OUTPUTS: summaries, tables, pictures, fields, checkpoints), so that
                  nothing of an older run is mixed with its own, and it refuses a folder that
                  holds another scene's run (another scene file and another content), naming that
-                 run's title and scene file.
+                 run's title and scene file. A link with an output's name is removed first, by a
+                 fresh run and a resume alike (remove_links): never read or written through.
 fingerprint      what defines a run's state (scene content but for the knobs of how to continue,
                  the files it reads, the code version, the mesh), and how it continues.
 """
@@ -43,6 +44,10 @@ CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force
             "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
             "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
             "process.stop_at_neck", "output.vtx", "output.vtu", "output.png", "output.fld", "output.checkpoint_every")
+# of those, the process inputs that act on the sheet from its first increment: a resume may
+# change them only from a checkpoint before any increment; past it, a run with other ones is
+# another run (refused, naming them)
+PROCESS = ("tools.blank_holder_force", "tools.friction", "effects.friction")
 
 
 def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:
@@ -136,6 +141,19 @@ def compare(saved: dict, now: dict) -> tuple[list[str], dict]:
     return differ, changed
 
 
+def check_process(changed: dict, at_mm: float, path) -> None:
+    """Refuse a resume from a checkpoint at at_mm > 0 whose process inputs (PROCESS) differ
+    from this scene's (changed: compare's second value): InputError naming the first of them,
+    and every one with its value in the checkpoint and now."""
+    fields = [k for k in PROCESS if k in changed]
+    if not fields or at_mm <= 0.0:
+        return
+    values = ", ".join(f"{k} {changed[k]['checkpoint']!r} there, {changed[k]['now']!r} now" for k in fields)
+    raise InputError(fields[0], f"the checkpoint {path} at {at_mm:.6g} mm was drawn with other process inputs "
+                                f"({values}); they act from the first increment, so this is another run: run it "
+                                "into another folder (without --resume)")
+
+
 def read_manifest(outdir: Path) -> dict | None:
     try:
         return json.loads((Path(outdir) / MANIFEST).read_text())
@@ -149,6 +167,9 @@ def start(outdir: Path, s, scene_path=None, resume: bool = False, comm=MPI.COMM_
     nothing changes yet: the resume's checks come first, then resumed() updates run.json."""
     outdir = Path(outdir)
     check_writable(outdir, comm)
+    if comm.rank == 0:
+        remove_links(outdir)
+    comm.barrier()
     if resume:
         return None
     scene_path = str(Path(scene_path).resolve()) if scene_path else None
@@ -182,6 +203,22 @@ def resumed(outdir: Path, s, scene_path=None, comm=MPI.COMM_WORLD) -> None:
             "scene": str(Path(scene_path).resolve()) if scene_path else None, "scene_hash": scene_hash(s),
             "title": s.title, "code_version": code_version(), "started": old.get("started", now),
             "resumed": old.get("resumed", []) + [now]})
+
+
+def remove_links(outdir: Path) -> None:
+    """Remove every link in outdir with the name of an output (OUTPUTS, to a file or a folder
+    anywhere) and every link inside the output folders (vtu/, the .bp series): what a run
+    reads and writes there is its own, never what a link points to."""
+    outdir = Path(outdir)
+    for pattern in OUTPUTS:
+        for f in outdir.glob(pattern):
+            if f.is_symlink():
+                f.unlink(missing_ok=True)
+            elif f.is_dir():
+                for folder, dirs, files in os.walk(f):  # links to folders are listed, not followed
+                    for name in dirs + files:
+                        if os.path.islink(os.path.join(folder, name)):
+                            os.unlink(os.path.join(folder, name))
 
 
 def clear(outdir: Path) -> None:

@@ -3,6 +3,8 @@
 Every file is written whole or not at all (write_atomically): into a temporary file in the same
 folder, flushed and synced to the disk, then renamed over the final name, and the folder synced;
 a kill or a full disk during the write leaves the previous file as it was (docs/reliability.md).
+A rename replaces a link at the final name and never writes through it: pictures are written
+the same way (write_figure, write_screenshot).
 """
 
 import csv
@@ -36,6 +38,7 @@ def write_atomically(path: Path, write, binary: bool = False) -> None:
     onto `path` and fsync the folder: readers see the old file or the new one, never a part."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.unlink(missing_ok=True)  # a kill's leftover, or a link: the file is created anew, not opened through one
     try:
         with open(tmp, "wb" if binary else "w", **({} if binary else {"newline": ""})) as f:
             write(f)
@@ -46,6 +49,20 @@ def write_atomically(path: Path, write, binary: bool = False) -> None:
         tmp.unlink(missing_ok=True)
         raise
     sync_folder(path.parent)
+
+
+def write_figure(path: Path, fig, dpi: int = 120) -> None:
+    """A matplotlib figure as a PNG, written whole (write_atomically): a link at `path` is
+    replaced, never written through."""
+    write_atomically(path, lambda f: fig.savefig(f, format="png", dpi=dpi), binary=True)
+
+
+def write_screenshot(path: Path, plotter) -> None:
+    """A pyvista plotter's picture as a PNG, written as write_figure writes."""
+    from matplotlib import image
+
+    picture = plotter.screenshot(None, return_img=True)
+    write_atomically(path, lambda f: image.imsave(f, picture, format="png"), binary=True)
 
 
 def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:

@@ -7,7 +7,8 @@ their times.
 
 The writer is numpy only (no VTK needed to write); it runs on one process: the caller gathers
 the mesh (shellform.results.cup gathers the sheet to rank 0). A series whose index exists
-already (a resumed run) keeps the steps before the first time it writes.
+already (a resumed run) keeps the steps before the first time it writes. Each file is written
+whole (tables.write_atomically), never through a link.
 """
 
 import base64
@@ -15,6 +16,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
+
+from shellform.results.tables import write_atomically
 
 VTK_TRIANGLE = 5
 _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32", np.dtype(np.int64): "Int64",
@@ -53,7 +56,8 @@ def write_vtu(path: Path, points, triangles, point_data: dict | None = None, cel
               _array("connectivity", triangles.ravel()), _array("offsets", 3 * np.arange(1, m + 1, dtype=np.int64)),
               _array("types", np.full(m, VTK_TRIANGLE, dtype=np.uint8)), "</Cells>",
               "</Piece>", "</UnstructuredGrid>", "</VTKFile>", ""]
-    Path(path).write_text("\n".join(lines))
+    text = "\n".join(lines)
+    write_atomically(Path(path), lambda f: f.write(text))
 
 
 class PVDSeries:
@@ -82,6 +86,7 @@ class PVDSeries:
         write_vtu(self.folder / rel, points, triangles, point_data, cell_data)
         self.steps.append((float(time), rel))
         rows = "\n".join(f'    <DataSet timestep="{t!r}" group="" part="0" file="{f}"/>' for t, f in self.steps)
-        self.index.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
-                              f"{rows}\n  </Collection>\n</VTKFile>\n")
+        text = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+                f"{rows}\n  </Collection>\n</VTKFile>\n")
+        write_atomically(self.index, lambda f: f.write(text))
         return self.folder / rel
