@@ -39,8 +39,8 @@ from numba import types
 from numba.extending import intrinsic
 
 _PACKAGE = Path(__file__).resolve().parent
-_NUMBA_MODULES = ("_jit.py", "assembly", "material", "nonlinear/frames.py", "tools/faces.py", "tools/mesh_tool.py",
-                  "nonlinear/model.py", "nonlinear/assemble.py")
+_NUMBA_MODULES = ("_jit.py", "assembly", "material", "nonlinear/frames.py", "tools/face_kernels.py",
+                  "tools/mesh_patches.py", "nonlinear/model.py", "nonlinear/assemble.py")
 
 
 def _source_key() -> str:

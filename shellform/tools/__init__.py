@@ -7,8 +7,12 @@ axis (protocol.py), and the kinds of tools a scene names (kinds.py: square, roun
     analytic      the analytic punch, die and blank holder (signed distances of rounded squares)
     holder_edge   the holder's inner edge in plan: a rounded square or a CAD die's opening
     placement     a tool turned, moved and travelling along its axis
-    surface_tool, faces, cad_files   a tool from a CAD file's faces (gmsh's OCC kernel)
-    mesh_tool     a tool from a surface mesh (.stl, .msh: Nagata patches)
+    closest_point the closest-point engine both surface tools share: remembered points, the
+                  warm start, the search, the signed pass; each tool supplies its patches
+    surface_tool, cad_projections, cad_exact, cad_model, faces, cad_files   a tool from a CAD
+                  file's faces (gmsh's OCC kernel)
+    mesh_tool, mesh_patches, nagata, mesh_files   a tool from a surface mesh (.stl, .msh:
+                  Nagata patches)
     surface_geometry   the Hessian of the distance to a parametrised surface
 
 Below scene, contact, results and nonlinear: it imports none of them.
