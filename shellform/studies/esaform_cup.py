@@ -4,9 +4,10 @@
 
 The scene demos/esaform2021_cup.toml (AA6016-T4, 1 mm; the benchmark's tools, blank, Voce curve
 and friction; a force-controlled holder of 10 kN) with the effect ``ironing`` added and the
-stroke STROKE = 45 mm, long enough that the rim leaves the die's shoulder (the shoulder's
-radius is 10 mm; at 45 mm the rim stands 12.6 to 13.5 mm below the die's top on n = 12, so
-the flange has been drawn through and the height profile is final). Two yield functions, both
+stroke STROKE = 45 mm, long enough that the rim leaves the die's shoulder (the die's top is
+0.5 mm below the blank's plane, its shoulder's radius 10 mm; at 45 mm the rim's mid-surface
+stands 10.9 to 14.2 mm below the blank's plane on n = 12 and 16, between the punch and the
+die's wall, so the flange has been drawn through and the height profile is final). Two yield functions, both
 with the Voce curve as the rolling direction's uniaxial curve:
 
 - ``yld2000``: Yld2000-2d (a = 8) as the demo fits it by least squares to the TUAT r values and
@@ -19,14 +20,19 @@ face to the top of the rim. On the drawn sheet (the last step of cup.pvd: the de
 mid-surface x, the displacement u, so the initial position X = x - u, and the thickness
 strain e33, t = t0 exp(e33) at the nodes):
 
-    z_bottom = z_c - t_c |n_z(c)| / 2          c: the node nearest the blank's centre (X = Y = 0)
+    z_bottom = min_j (z_j - t_j |n_z(j)| / 2)  over every node j: where the cup stands
     z_top(i) = z_i + t_i |n_z(i)| / 2          i: a rim node, |X_i, Y_i| = the blank's radius
     h(theta_i) = z_top(i) - z_bottom,          theta_i = atan2(Y_i, X_i) (the initial angle)
 
 n is the unit normal of the deformed mid-surface at the node (the area-weighted mean of its
-triangles' normals): the top of an edge of thickness t whose mid-surface tilts by the angle
-arccos|n_z| from the horizontal is t |n_z| / 2 above its mid-surface (a vertical wall's top is
-its mid-surface's height; a flat flange's is t / 2 above it). h at the ANGLES 0, 15, ..., 90
+triangles' normals): the point of a face of thickness t whose mid-surface tilts by the angle
+arccos|n_z| from the horizontal lies t |n_z| / 2 above (top) or below (bottom) its mid-surface
+(a vertical wall's top is its mid-surface's height; a flat flange's is t / 2 above it). The
+cup stands on a table on the lowest point of its outer face: the punch pushes on the sheet's
+upper face, and the bottom under it need not stay flat on it (on the n = 6 mesh at 4 mm its
+centre hangs 0.48 mm below the punch's face; on the drawn-through cups of n = 12 the bottom's
+outer face is flat to 0.05 mm, lowest near the punch's nose). Springback is not drawn: the
+height is the loaded cup's. h at the ANGLES 0, 15, ..., 90
 degrees is interpolated linearly along theta between the rim's nodes. The mean height is the
 angle average over the quarter, (2 / pi) int_0^{pi/2} h dtheta, by the trapezoidal rule over
 the rim's nodes (the quarter's symmetry makes it the whole rim's). The ears' measures:
@@ -140,8 +146,8 @@ def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 
 def rim_and_bottom(points, triangles, displacement, thickness_strain, t0: float, radius: float,
                    tol: float = 1e-3) -> tuple[np.ndarray, float]:
-    """The rim's rows (theta_deg, z_top, z_mid, t, |n_z|) by angle, and z_bottom (the bottom's
-    outer face at the centre), from the deformed sheet as the module's docstring defines them:
+    """The rim's rows (theta_deg, z_top, z_mid, t, |n_z|) by angle, and z_bottom (the lowest
+    point of the sheet's outer face: where the cup stands), from the deformed sheet as the module's docstring defines them:
     the rim is the nodes whose initial radius is within tol of `radius`."""
     x = np.asarray(points, dtype=float)
     X = x - np.asarray(displacement, dtype=float)[:, :3]
@@ -153,8 +159,7 @@ def rim_and_bottom(points, triangles, displacement, thickness_strain, t0: float,
         raise ValueError(f"no node at the initial radius {radius} (the largest is {R.max():.6g})")
     theta = np.degrees(np.arctan2(X[on, 1], X[on, 0]))
     rows = np.column_stack([theta, x[on, 2] + 0.5 * t[on] * nz[on], x[on, 2], t[on], nz[on]])
-    c = int(np.argmin(R))
-    return rows[np.argsort(theta, kind="stable")], float(x[c, 2] - 0.5 * t[c] * nz[c])
+    return rows[np.argsort(theta, kind="stable")], float((x[:, 2] - 0.5 * t * nz).min())
 
 
 def heights(rim_rows: np.ndarray, z_bottom: float, angles=ANGLES) -> dict:
@@ -253,7 +258,7 @@ def markdown(rows: list[dict], ests: list[dict], ref: dict | None = None) -> str
         text.append(f"| {r['model']} n {r['n']} ({r['cells']} cells{end}) | "
                     + " | ".join(f"{r[f'h{a:g}']:.2f}" for a in ANGLES)
                     + f" | {r['mean']:.2f} | {r['d0']:.2f} | {r['d90']:.2f} |")
-    text += ["", "| run | error of h at 0, 15, ..., 90 | mean | d0 (folded) | d90 (folded) | ears at 0 and 90 "
+    text += ["", "| run | error of h at 0, 15, ..., 90 | mean | d0 (folded) | d90 (folded) | h(0), h(90) > h(45) "
              "| goals (mean 3 %, d 25 %) | increments, iterations, cut-backs | wall (s) |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         text.append(f"| {r['model']} n {r['n']} | " + ", ".join(f"{100 * r[f'err_h{a:g}']:+.1f}" for a in ANGLES)
