@@ -90,3 +90,34 @@ class PVDSeries:
                 f"{rows}\n  </Collection>\n</VTKFile>\n")
         write_atomically(self.index, lambda f: f.write(text))
         return self.folder / rel
+
+
+_DTYPES = {name: np.dtype(dt).newbyteorder("<") for dt, name in _TYPES.items()}
+
+
+def read_vtu(path: Path) -> tuple[np.ndarray, np.ndarray, dict, dict]:
+    """The inverse of write_vtu for the files it writes (base64 binary arrays with a UInt64
+    header, triangles only): (points (n, 3), triangles (m, 3), point_data, cell_data)."""
+
+    def values(el):
+        raw = base64.b64decode(el.text.strip())
+        size = int(np.frombuffer(raw[:8], dtype="<u8")[0])
+        a = np.frombuffer(raw[8:8 + size], dtype=_DTYPES[el.get("type")]).astype(_DTYPES[el.get("type")].newbyteorder("="))
+        k = int(el.get("NumberOfComponents", "1"))
+        return a.reshape(-1, k) if k > 1 else a
+
+    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    points = values(piece.find("Points/DataArray")).reshape(-1, 3)
+    cells = {el.get("Name"): values(el) for el in piece.find("Cells")}
+    triangles = cells["connectivity"].reshape(-1, 3)
+    point_data = {el.get("Name"): values(el) for el in piece.find("PointData")}
+    cell_data = {el.get("Name"): values(el) for el in piece.find("CellData")}
+    return points, triangles, point_data, cell_data
+
+
+def last_step(index: Path) -> tuple[float, Path]:
+    """The time and the VTU file of a PVD index's last step."""
+    root = ET.parse(index).getroot()
+    steps = [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
+    time, rel = max(steps, key=lambda s: s[0])
+    return time, Path(index).parent / rel

@@ -1,0 +1,341 @@
+"""The ESAFORM 2021 cup drawn through: its height profile against the benchmark's measured one.
+
+    shellform study esaform-cup --out docs/results/esaform_cup [--levels 12 16 20]
+
+The scene demos/esaform2021_cup.toml (AA6016-T4, 1 mm; the benchmark's tools, blank, Voce curve
+and friction; a force-controlled holder of 10 kN) with the effect ``ironing`` added and the
+stroke STROKE = 45 mm, long enough that the rim leaves the die's shoulder (the die's top is
+0.5 mm below the blank's plane, its shoulder's radius 10 mm; at 45 mm the rim's mid-surface
+stands 10.9 to 14.2 mm below the blank's plane on n = 12 and 16, between the punch and the
+die's wall, so the flange has been drawn through and the height profile is final). Two yield functions, both
+with the Voce curve as the rolling direction's uniaxial curve:
+
+- ``yld2000``: Yld2000-2d (a = 8) as the demo fits it by least squares to the TUAT r values and
+  yield stress ratios at 0, 15, ..., 90 degrees, sigma_b/sigma0 = 1, r_b = 1 assumed;
+- ``hill48``: Hill 1948 from r0 / r45 / r90 = 0.526 / 0.253 / 0.601 alone (its yield stresses
+  are then those the r values imply, not the measured ones).
+
+**Height.** As the benchmark measures a cup standing on its bottom: from the bottom's outer
+face to the top of the rim. On the drawn sheet (the last step of cup.pvd: the deformed
+mid-surface x, the displacement u, so the initial position X = x - u, and the thickness
+strain e33, t = t0 exp(e33) at the nodes):
+
+    z_bottom = min_j (z_j - t_j |n_z(j)| / 2)  over every node j: where the cup stands
+    z_top(i) = z_i + t_i |n_z(i)| / 2          i: a rim node, |X_i, Y_i| = the blank's radius
+    h(theta_i) = z_top(i) - z_bottom,          theta_i = atan2(Y_i, X_i) (the initial angle)
+
+n is the unit normal of the deformed mid-surface at the node (the area-weighted mean of its
+triangles' normals): the point of a face of thickness t whose mid-surface tilts by the angle
+arccos|n_z| from the horizontal lies t |n_z| / 2 above (top) or below (bottom) its mid-surface
+(a vertical wall's top is its mid-surface's height; a flat flange's is t / 2 above it). The
+cup stands on a table on the lowest point of its outer face: the punch pushes on the sheet's
+upper face, and the bottom under it need not stay flat on it (on the n = 6 mesh at 4 mm its
+centre hangs 0.48 mm below the punch's face; on the drawn-through cups of n = 12 the bottom's
+outer face is flat to 0.05 mm, lowest near the punch's nose). Springback is not drawn: the
+height is the loaded cup's. h at the ANGLES 0, 15, ..., 90
+degrees is interpolated linearly along theta between the rim's nodes. The mean height is the
+angle average over the quarter, (2 / pi) int_0^{pi/2} h dtheta, by the trapezoidal rule over
+the rim's nodes (the quarter's symmetry makes it the whole rim's). The ears' measures:
+d0 = h(0) - h(45) and d90 = h(90) - h(45).
+
+**The measured profile** (MEASURED): the 25 rows (angle in degrees, height in mm) of
+CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt in
+github.com/stefanSCS/PolyN, the paper's Fig. 91 digitised (docs/references.md, section 6). Its
+heights at the ANGLES are interpolated linearly, periodic in the angle, between its rows (the
+first quadrant's rows lie within 0.5 degrees of 0, 15, ..., 90). The measured mean is the
+whole circle's angle average (periodic trapezoidal rule over the 24 distinct rows: the row at
+359.95 degrees repeats the one at 0.48), 34.13 mm; the mean of all 25 rows, 34.15 mm, counts
+that row twice. The cup is not symmetric in its four quadrants (h(0) 34.52 against h(180)
+35.26 mm); the "folded" profile, the mean at theta, 180 - theta, 180 + theta and 360 - theta,
+is what a model with the sheet's orthotropic symmetry can match, and the table gives both.
+
+**Errors**: (model - measured) / measured for h at each angle and the mean height, and the same
+for d0 and d90 (relative to the measured difference). The goals (issue 45): the ears in the
+measured directions (the two highest of h(0), h(45), h(90) at 0 and 90 degrees), the mean
+height within 3 %, d0 and d90 within 25 %.
+
+**Meshes**: levels n (the demo's quarter disc with n elements along the radius); where three
+levels of a yield function finished, the Richardson estimate of each answer
+(shellform.studies.cup_convergence.richardson, h ~ cells^-1/2). A run already in out with the
+same scene (run.json's scene hash) and a summary is reused, not redrawn.
+
+Writes esaform_cup.csv (a row per run: counts, the stroke reached, h at the ANGLES, the mean,
+d0, d90, their errors), esaform_cup.md (the tables) and esaform_cup.png (h(theta) of each run
+over the measured profile). --quick: n = 6 to QUICK_STROKE (the plumbing only).
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from shellform.contact.run import run as run_cup
+from shellform.results import run_folder
+from shellform.results.log import say
+from shellform.results.tables import write_csv
+from shellform.results.vtu import last_step, read_vtu
+from shellform.studies.cup_convergence import richardson
+from shellform.studies.cup_hard import folder, variant
+
+SCENE = "esaform2021_cup.toml"
+STROKE = 45.0
+LEVELS = (12, 16, 20)
+QUICK_LEVELS = (6,)
+QUICK_STROKE = 4.0
+ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
+GOALS = {"mean": 0.03, "d0": 0.25, "d90": 0.25}
+MODELS = {  # name: (label, the scene's material changes)
+    "yld2000": ("Yld2000-2d, least squares (the demo)", {}),
+    "hill48": ("Hill 1948, r0 / r45 / r90", {
+        "material.yield_function": "hill48", "material.r0": 0.526, "material.r45": 0.253, "material.r90": 0.601,
+        "material.fit_angles": [], "material.fit_r": [], "material.fit_sigma": [],
+        "material.sigma_b": 0.0, "material.r_b": 0.0, "material.a": 0.0}),
+}
+# github.com/stefanSCS/PolyN, CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt:
+# (angle in degrees, measured cup height in mm)
+MEASURED = np.array([
+    (0.480331, 34.515), (14.8128, 33.8929), (30.3073, 33.5364), (45.0271, 33.131), (60.1343, 33.5434),
+    (75.2415, 34.2704), (89.9613, 34.9135), (105.068, 34.557), (120.176, 34.0117), (135.283, 33.5294),
+    (150.39, 34.3333), (165.11, 34.9414), (180.217, 35.256), (195.324, 34.6478), (210.044, 34.4871),
+    (224.764, 34.0467), (239.871, 33.7252), (255.365, 34.2284), (269.698, 34.7177), (285.192, 34.7038),
+    (299.912, 33.83), (315.019, 33.152), (330.127, 33.2009), (344.846, 33.9698), (359.954, 34.515)])
+
+
+def _periodic(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows over one period (the last repeats the first), sorted."""
+    a, h = rows[:-1, 0] % 360.0, rows[:-1, 1]
+    order = np.argsort(a)
+    return a[order], h[order]
+
+
+def measured_at(angles, rows: np.ndarray = MEASURED) -> np.ndarray:
+    a, h = _periodic(rows)
+    return np.interp(np.asarray(angles, dtype=float), a, h, period=360.0)
+
+
+def measured(rows: np.ndarray = MEASURED, angles=ANGLES) -> dict:
+    """The measured profile's answers: h at the angles (first quadrant) and folded (the mean of
+    the four quadrants' mirror angles), the whole circle's mean, d0 and d90 of both."""
+    a, h = _periodic(rows)
+    closed_a, closed_h = np.append(a, a[0] + 360.0), np.append(h, h[0])
+    mean = float(np.trapezoid(closed_h, closed_a) / 360.0)
+    first = measured_at(angles, rows)
+    th = np.asarray(angles, dtype=float)
+    folded = np.mean([measured_at(m, rows) for m in (th, 180.0 - th, 180.0 + th, 360.0 - th)], axis=0)
+    out = {"mean": mean}
+    for name, prof in (("first", first), ("folded", folded)):
+        out[name] = {f"h{t:g}": float(v) for t, v in zip(angles, prof)}
+        out[name]["d0"] = out[name]["h0"] - out[name]["h45"]
+        out[name]["d90"] = out[name]["h90"] - out[name]["h45"]
+    return out
+
+
+def vertex_normals(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Unit normals at the points: the area-weighted mean of their triangles' normals (the
+    triangles' orientation need not agree: each is turned to +z first, or to the first
+    triangle's side where it is vertical, so that a node's normals do not cancel)."""
+    p = points[triangles]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])  # length: twice the area
+    n[n[:, 2] < 0] *= -1.0
+    out = np.zeros_like(points)
+    for k in range(3):
+        np.add.at(out, triangles[:, k], n)
+    length = np.linalg.norm(out, axis=1)
+    return out / np.where(length > 0, length, 1.0)[:, None]
+
+
+def rim_and_bottom(points, triangles, displacement, thickness_strain, t0: float, radius: float,
+                   tol: float = 1e-3) -> tuple[np.ndarray, float]:
+    """The rim's rows (theta_deg, z_top, z_mid, t, |n_z|) by angle, and z_bottom (the lowest
+    point of the sheet's outer face: where the cup stands), from the deformed sheet as the module's docstring defines them:
+    the rim is the nodes whose initial radius is within tol of `radius`."""
+    x = np.asarray(points, dtype=float)
+    X = x - np.asarray(displacement, dtype=float)[:, :3]
+    t = t0 * np.exp(np.asarray(thickness_strain, dtype=float))
+    nz = np.abs(vertex_normals(x, np.asarray(triangles))[:, 2])
+    R = np.hypot(X[:, 0], X[:, 1])
+    on = R > radius - tol
+    if not on.any():
+        raise ValueError(f"no node at the initial radius {radius} (the largest is {R.max():.6g})")
+    theta = np.degrees(np.arctan2(X[on, 1], X[on, 0]))
+    rows = np.column_stack([theta, x[on, 2] + 0.5 * t[on] * nz[on], x[on, 2], t[on], nz[on]])
+    return rows[np.argsort(theta, kind="stable")], float((x[:, 2] - 0.5 * t * nz).min())
+
+
+def heights(rim_rows: np.ndarray, z_bottom: float, angles=ANGLES) -> dict:
+    """h at the angles (linear along theta between the rim's nodes; rim_rows: theta_deg, z_top
+    first), the quarter's mean height (trapezoidal over the nodes, over the span they cover),
+    d0 = h(0) - h(45) and d90 = h(90) - h(45)."""
+    th, h = rim_rows[:, 0], rim_rows[:, 1] - z_bottom
+    out = {f"h{a:g}": float(np.interp(a, th, h)) for a in angles}
+    out["mean"] = float(np.trapezoid(h, th) / (th[-1] - th[0]))
+    out["d0"] = out["h0"] - out["h45"]
+    out["d90"] = out["h90"] - out["h45"]
+    return out
+
+
+def scene_of(model: str, n: int, stroke: float = STROKE):
+    s = variant(n, SCENE, tools__stroke=stroke)
+    return s.changed({"effects": [*s.effects, "ironing"], **MODELS[model][1]})
+
+
+def run_name(model: str, n: int) -> str:
+    return f"{model} n {n}"
+
+
+def _finished_here(d: Path, s) -> bool:
+    m = run_folder.read_manifest(d)
+    return bool(m) and m.get("scene_hash") == run_folder.scene_hash(s) and (d / "summary.json").exists() \
+        and (d / "cup.pvd").exists()
+
+
+def row(model: str, n: int, out: Path) -> dict:
+    """A run's row: its counts from summary.json, the heights from cup.pvd's last step."""
+    s = scene_of(model, n)
+    d = folder(out, run_name(model, n))
+    summary = json.loads((d / "summary.json").read_text())
+    stroke, vtu = last_step(d / "cup.pvd")
+    points, triangles, pdata, _ = read_vtu(vtu)
+    rim, z_bottom = rim_and_bottom(points, triangles, pdata["displacement"], pdata["thickness_strain"],
+                                   s.material.thickness, s.geometry.radius)
+    r = {"model": model, "n": n, "cells": summary["cells"], "stroke_mm": stroke,
+         "finished": summary["stopped"] is None, "increments": summary["increments"],
+         "newton_iterations": summary["newton_iterations"], "cutbacks": summary["cutbacks"],
+         "wall_s": summary["wall_time_s"]["total"], "rim_nodes": len(rim), "z_bottom_mm": z_bottom,
+         "rim_nz_max": float(rim[:, 4].max()), "rim_t_min_mm": float(rim[:, 3].min()),
+         "rim_t_max_mm": float(rim[:, 3].max()), **heights(rim, z_bottom)}
+    write_csv(d / "rim_height.csv", [dict(zip(("angle_deg", "z_top_mm", "z_mid_mm", "thickness_mm", "abs_nz"), v))
+                                     for v in rim], ["angle_deg", "z_top_mm", "z_mid_mm", "thickness_mm", "abs_nz"])
+    return with_errors(r)
+
+
+def with_errors(r: dict, ref: dict | None = None) -> dict:
+    """r with its errors against the measured first-quadrant profile (and folded d0, d90) and
+    whether each goal is met."""
+    ref = ref or measured()
+    first, folded = ref["first"], ref["folded"]
+    for a in ANGLES:
+        r[f"err_h{a:g}"] = (r[f"h{a:g}"] - first[f"h{a:g}"]) / first[f"h{a:g}"]
+    r["err_mean"] = (r["mean"] - ref["mean"]) / ref["mean"]
+    for k in ("d0", "d90"):
+        r[f"err_{k}"] = (r[k] - first[k]) / first[k]
+        r[f"err_{k}_folded"] = (r[k] - folded[k]) / folded[k]
+    r["ears_right"] = bool(min(r["h0"], r["h90"]) > r["h45"])
+    r["goals_met"] = bool(r["ears_right"] and all(abs(r[f"err_{k}"]) <= g for k, g in GOALS.items()))
+    return r
+
+
+def estimates(rows: list[dict]) -> list[dict]:
+    """Per yield function with three finished levels, the Richardson estimate of each answer."""
+    out = []
+    for model in dict.fromkeys(r["model"] for r in rows):
+        done = [r for r in rows if r["model"] == model and r["finished"]]
+        if len(done) < 3:
+            continue
+        last = done[-3:]
+        for key in ("mean", "h0", "h45", "h90", "d0", "d90"):
+            e = richardson([r["cells"] ** -0.5 for r in last], [r[key] for r in last])
+            out.append({"model": model, "answer": key, "values": " ".join(f"{r[key]:.4f}" for r in last), **e})
+    return out
+
+
+def _pct(x) -> str:
+    return f"{100 * x:+.1f} %"
+
+
+def markdown(rows: list[dict], ests: list[dict], ref: dict | None = None) -> str:
+    ref = ref or measured()
+    first, folded = ref["first"], ref["folded"]
+    heads = " | ".join(f"h({a:g})" for a in ANGLES)
+    text = ["| run | " + heads + " | mean | d0 = h(0) - h(45) | d90 = h(90) - h(45) |",
+            "|---|" + "---|" * (len(ANGLES) + 3),
+            "| measured, first quadrant | " + " | ".join(f"{first[f'h{a:g}']:.2f}" for a in ANGLES)
+            + f" | {ref['mean']:.2f} (whole circle) | {first['d0']:.2f} | {first['d90']:.2f} |",
+            "| measured, four quadrants folded | " + " | ".join(f"{folded[f'h{a:g}']:.2f}" for a in ANGLES)
+            + f" | {ref['mean']:.2f} | {folded['d0']:.2f} | {folded['d90']:.2f} |"]
+    for r in rows:
+        end = "" if r["finished"] else f", stopped at {r['stroke_mm']:.1f} mm"
+        text.append(f"| {r['model']} n {r['n']} ({r['cells']} cells{end}) | "
+                    + " | ".join(f"{r[f'h{a:g}']:.2f}" for a in ANGLES)
+                    + f" | {r['mean']:.2f} | {r['d0']:.2f} | {r['d90']:.2f} |")
+    text += ["", "| run | error of h at 0, 15, ..., 90 | mean | d0 (folded) | d90 (folded) | h(0), h(90) > h(45) "
+             "| goals (mean 3 %, d 25 %) | increments, iterations, cut-backs | wall (s) |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        text.append(f"| {r['model']} n {r['n']} | " + ", ".join(f"{100 * r[f'err_h{a:g}']:+.1f}" for a in ANGLES)
+                    + f" % | {_pct(r['err_mean'])} | {_pct(r['err_d0'])} ({_pct(r['err_d0_folded'])}) "
+                    f"| {_pct(r['err_d90'])} ({_pct(r['err_d90_folded'])}) | {'yes' if r['ears_right'] else 'no'} "
+                    f"| {'met' if r['goals_met'] else 'missed'} | {r['increments']}, {r['newton_iterations']}, "
+                    f"{r['cutbacks']} | {r['wall_s']:.0f} |")
+    if ests:
+        text += ["", "| yield function | answer | values (3 finest) | p | estimate +- uncertainty |", "|---|---|---|---|---|"]
+        for e in ests:
+            p = "none" if not np.isfinite(e["p"]) else f"{e['p']:.2f}"
+            est = "none" if not np.isfinite(e["estimate"]) else f"{e['estimate']:.3f}"
+            text.append(f"| {e['model']} | {e['answer']} | {e['values']} | {p} | {est} +- {e['uncertainty']:.3f} |")
+    return "\n".join(text) + "\n"
+
+
+def plot(path: Path, rows: list[dict], out: Path) -> None:
+    """Each run's h(theta) at its rim nodes over the measured profile (first quadrant and
+    folded)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    a, h = _periodic(MEASURED)
+    first = a <= 90.5
+    ax.plot(a[first], h[first], "ks-", label="measured (Fig. 91, PolyN), 0 to 90 deg")
+    th = np.linspace(0.0, 90.0, 91)
+    folded = np.mean([measured_at(m) for m in (th, 180 - th, 180 + th, 360 - th)], axis=0)
+    ax.plot(th, folded, "k--", lw=1, label="measured, four quadrants folded")
+    for r in rows:
+        rim = np.loadtxt(folder(out, run_name(r["model"], r["n"])) / "rim_height.csv", delimiter=",", skiprows=1)
+        ax.plot(rim[:, 0], rim[:, 1] - r["z_bottom_mm"], "o-", ms=3,
+                label=f"{MODELS[r['model']][0]}, n {r['n']}" + ("" if r["finished"] else " (stopped)"))
+    ax.set_xlabel("angle to the rolling direction (degrees)")
+    ax.set_ylabel("cup height (mm): bottom's outer face to the rim's top")
+    ax.set_xticks(ANGLES)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title("ESAFORM 2021 cup, AA6016-T4: the height profile", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def run(out: Path, levels=LEVELS, models=tuple(MODELS), stroke=None) -> list[dict]:
+    """Draw each yield function on each level into out (a finished run of the same scene there
+    is reused), then the tables and the plot."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    stroke = stroke or (QUICK_STROKE if tuple(levels) == QUICK_LEVELS else STROKE)
+    for model in models:
+        for n in levels:
+            s, d = scene_of(model, n, stroke), folder(out, run_name(model, n))
+            if _finished_here(d, s):
+                say(f"esaform-cup: {run_name(model, n)}: reusing the run in {d}")
+                continue
+            say(f"esaform-cup: {run_name(model, n)}")
+            run_cup(s, d)
+    return tables(out, {m: levels for m in models})
+
+
+def tables(out: Path, levels: dict) -> list[dict]:
+    """The tables and the plot of the runs in out (levels: per yield function its levels; runs
+    missing there are left out)."""
+    out = Path(out)
+    rows = []
+    for model, ns in levels.items():
+        for n in ns:
+            if (folder(out, run_name(model, n)) / "summary.json").exists():
+                rows.append(row(model, n, out))
+    ests = estimates(rows)
+    write_csv(out / "esaform_cup.csv", rows, list(dict.fromkeys(k for r in rows for k in r)))
+    if ests:
+        write_csv(out / "esaform_cup_estimates.csv", ests, ["model", "answer", "values", "p", "estimate", "uncertainty"])
+    (out / "esaform_cup.md").write_text(markdown(rows, ests))
+    plot(out / "esaform_cup.png", rows, out)
+    return rows
+
