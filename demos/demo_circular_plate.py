@@ -71,6 +71,7 @@ import math
 import sys
 
 import shellform  # noqa: F401  (loads the DOLFINx runtime before dolfinx itself)
+from shellform.results import log
 from shellform.studies.common import deflection_table, observed_rates
 from shellform.studies.outlines import REFERENCE, disc_scene
 
@@ -94,6 +95,9 @@ print(f"closed form w D/(q a^4) = {reference}")
 # radius and refined `k` times (`shellform.studies.outlines.disc_scene`, also behind
 # `shellform study outlines`).
 
+# `deflection_table` logs one row per mesh; shellform prints nothing unless asked, and
+# `log.console()` asks.
+log.console()
 rows = deflection_table((disc_scene(args.support, args.base_n, k) for k in range(args.levels + 1)), reference)
 
 # ## Checks

@@ -36,7 +36,7 @@ def observed_rates(rows: list[dict], size="cells", error="rel_error") -> list[fl
 
 
 def deflection_table(scenes, reference: float, x: float = 0.0, y: float = 0.0) -> list[dict]:
-    """Solve each linear scene in turn (a sequence of meshes) and print one table row per mesh:
+    """Solve each linear scene in turn (a sequence of meshes) and log one table row per mesh:
     level, cells, w at (x, y), its error relative to `reference`, the observed rate, time."""
     from shellform import linear
 

@@ -241,9 +241,9 @@ def plot(path: Path, rows: list[dict], ref: dict) -> None:
     right.loglog([r["cpu_s"] for r in done], [r["worst_error"] for r in done], "o", color="grey")
     right.loglog([r["cpu_s"] for r in front], [r["worst_error"] for r in front], "-o", color="C3",
                  label="the cheapest run for its accuracy")
-    for r in done:
-        right.annotate(r["case"], (r["cpu_s"], r["worst_error"]), fontsize=7)
-    right.set_title("the worst |error| of a run", fontsize=10)
+    for r in front:
+        right.annotate(r["case"], (r["cpu_s"], r["worst_error"]), fontsize=7, xytext=(4, 4), textcoords="offset points")
+    right.set_title("the worst |error| of a run (grey: a cheaper run is as accurate)", fontsize=10)
     right.legend(fontsize=8)
     for ax in (left, right):
         for tol in TOLERANCES:
