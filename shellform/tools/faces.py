@@ -36,6 +36,25 @@ from shellform.tools.face_kernels import (  # noqa: F401  (cross, within, shape_
 MERIDIAN_SAMPLES = 1024  # points of a curve meridian whose angles about its fitted circle start Newton
 
 
+def _axis_frame(middle, size: float):
+    """A surface of revolution's axis and radial frame from gmsh's (u, v), X, J, S at a point
+    off the axis (rho > 1e-9 size): rho, the radial unit w = -X_uu / rho and the tangential
+    b = X_u / rho, the axis a = w x b, the centre A of the parallel through the point, and the
+    radial frame (w0, b0) at u = 0; None where the point is on the axis or (w, b, a) is not
+    orthonormal to round-off."""
+    (um, _), Xm, Jm, Sm = middle
+    rho = float(np.linalg.norm(Sm[0]))
+    if not rho > 1e-9 * size:
+        return None
+    w, b = -Sm[0] / rho, Jm[0] / rho
+    a = np.cross(w, b)
+    if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
+        return None
+    A = Xm + Sm[0]  # the centre of the parallel through Xm, on the axis
+    w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
+    return rho, w, b, a, A, w0, b0_
+
+
 class _Kind:
     """The faces of one kind: their indices in the tool (`index`), parameter bounds and
     tolerances, and each kind's parameters (arrays with the face first)."""
@@ -158,16 +177,11 @@ class Revolutions(_Kind):
         """middle: gmsh's (u, v), X, J, S at a point where the face is not on the axis (rho >
         0), from which the axis, the radial frame and the meridian circle are read: X_uu = -rho
         w, X_u = rho b, and the meridian's (rho, h)'' = -((rho, h) - c)."""
-        (um, vm), Xm, Jm, Sm = middle
-        rho = float(np.linalg.norm(Sm[0]))
-        if not rho > 1e-9 * self.size:
+        (_, vm), _, Jm, Sm = middle
+        axis = _axis_frame(middle, self.size)
+        if axis is None:
             return False
-        w, b = -Sm[0] / rho, Jm[0] / rho
-        a = np.cross(w, b)
-        A = Xm + Sm[0]  # the centre of the parallel through Xm, on the axis
-        w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
-        if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
-            return False
+        rho, w, b, a, A, w0, b0_ = axis
         p, dp, ddp = np.array([rho, 0.0]), Jm[1] @ np.array([w, a]).T, Sm[1] @ np.array([w, a]).T
         r = float(np.linalg.norm(ddp))
         if not r > 1e-9 * self.size:
@@ -216,16 +230,11 @@ class CurveRevolutions(_Kind):
         as for Revolutions); meridian: gmsh's X, J, S at (u_m, v) for the samples' v. Kept where
         the surface is the meridian turned about the axis by u at the samples, to round-off.
         The start's table from the meridian at MERIDIAN_SAMPLES values of v (evaluate)."""
-        (um, vm), Xm, Jm, Sm = middle
-        rho = float(np.linalg.norm(Sm[0]))
-        if not rho > 1e-9 * self.size:
+        um = middle[0][0]
+        axis = _axis_frame(middle, self.size)
+        if axis is None:
             return False
-        w, b = -Sm[0] / rho, Jm[0] / rho
-        a = np.cross(w, b)
-        if not _close(np.array([w, b, a]) @ np.array([w, b, a]).T, np.eye(3), 1e-12):
-            return False
-        A = Xm + Sm[0]
-        w0, b0_ = np.cos(um) * w - np.sin(um) * b, np.sin(um) * w + np.cos(um) * b
+        _, w, b, a, A, w0, b0_ = axis
         frame = np.array([w0, b0_, a])
         Xr, Jr, Sr = meridian
         wa = np.array([w, a])
