@@ -132,6 +132,7 @@ def check(s) -> str:
     from shellform import scene
     from shellform.scene import machine
 
+    machine.check_tool_files(s)  # the checks a run makes of the tools' files before computing
     if s.geometry.file:  # absolute: the printed scene reads the same file from any folder
         s = s.changed({"geometry.file": str(Path(s.geometry.file).resolve())})
     e = machine.estimate(s)
