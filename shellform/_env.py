@@ -1,4 +1,5 @@
-"""Load the DOLFINx runtime before anything imports dolfinx or petsc4py.
+"""Load the DOLFINx runtime before anything imports dolfinx or petsc4py (and turn PETSc's own
+signal handler off: shellform handles SIGINT and SIGTERM).
 
 The PyPI wheel ``dolfinx-solver-real`` ships MPI, PETSc and DOLFINx as one bundle whose shared
 libraries are put on the loader path by ``import dolfinx_solver``. A DOLFINx from conda or Debian
@@ -16,6 +17,12 @@ and MPI ranks.
 import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+# PETSc's own signal handler off: SIGTERM before the driver steps printed PETSc's "Caught signal
+# number 15" banner and ended in MPI_Abort (exit 15); shellform handles SIGINT and SIGTERM itself
+# (shellform.nonlinear.interrupt, shellform.cli). PETSc reads PETSC_OPTIONS when it initialises.
+if "-no_signal_handler" not in os.environ.get("PETSC_OPTIONS", "").split():
+    os.environ["PETSC_OPTIONS"] = (os.environ.get("PETSC_OPTIONS", "") + " -no_signal_handler").strip()
 
 try:
     import dolfinx_solver  # noqa: F401

@@ -21,6 +21,7 @@ import argparse
 import os
 import signal
 import sys
+import threading
 from pathlib import Path
 
 from shellform import __version__  # the package first: the DOLFINx runtime before any solver module
@@ -132,6 +133,7 @@ def check(s) -> str:
     from shellform import scene
     from shellform.scene import machine
 
+    machine.check_tool_files(s)  # the checks a run makes of the tools' files before computing
     if s.geometry.file:  # absolute: the printed scene reads the same file from any folder
         s = s.changed({"geometry.file": str(Path(s.geometry.file).resolve())})
     e = machine.estimate(s)
@@ -146,9 +148,11 @@ def main(argv=None) -> int:
 
     import logging
 
-    from shellform.nonlinear.interrupt import Interrupted
+    from shellform.nonlinear.interrupt import Interrupted, stop_now
     from shellform.results.log import RESULT, console, quiet, say  # every line below once per run, on rank 0
 
+    main_thread = threading.current_thread() is threading.main_thread()
+    saved = signal.signal(signal.SIGTERM, stop_now) if main_thread else None  # as Ctrl-C: one line, exit 143
     shown = console(RESULT if args.quiet else logging.DEBUG if args.verbose else logging.INFO)
     try:
         limit_threads(getattr(args, "threads", None))
@@ -181,11 +185,15 @@ def main(argv=None) -> int:
         say(f"shellform: {err}" + (f"; the last converged state: {err.checkpoint}" if err.checkpoint else ""),
             file=sys.stderr)
         return 128 + err.signal
-    except KeyboardInterrupt:  # before any increment converged, or a second Ctrl-C
-        say("shellform: interrupted; nothing newer than the last checkpoint was kept", file=sys.stderr)
-        return 128 + signal.SIGINT
+    except KeyboardInterrupt as err:  # before any increment converged, or a second Ctrl-C or SIGTERM
+        signum = getattr(err, "signal", signal.SIGINT)
+        say(f"shellform: interrupted ({signal.Signals(signum).name}); nothing newer than the last checkpoint was kept",
+            file=sys.stderr)
+        return 128 + signum
     finally:
         quiet(shown)
+        if main_thread:
+            signal.signal(signal.SIGTERM, saved)
     return 0
 
 

@@ -139,3 +139,33 @@ def test_quiet_prints_only_the_closing_line(tmp_path, capsys):
     assert cli.main([*args, "-o", str(tmp_path / "all")]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) > 1 and lines[0].startswith("increment") and lines[-1].startswith("shellform: ")
+
+
+NAN_STL = """solid t
+facet normal 0 0 1
+outer loop
+vertex 0 0 0
+vertex 1 0 0
+vertex 0 nan 0
+endloop
+endfacet
+endsolid t
+"""
+
+
+@pytest.mark.parametrize("kind", ["truncated step", "nan stl"])
+def test_check_refuses_the_tool_files_that_run_refuses(capsys, tmp_path, kind):
+    """`check` runs the tool files' checks that `run` runs before computing (one function:
+    shellform.tools.cad.read_tool_file): a STEP cut in half, an STL with a NaN vertex."""
+    if kind == "truncated step":
+        text = (DEMOS / "meshes" / "numisheet93" / "punch.step").read_bytes()
+        bad = tmp_path / "punch.step"
+        bad.write_bytes(text[: len(text) // 2])
+        demo = DEMOS / "numisheet93_aluminium_cad.toml"
+    else:
+        bad = tmp_path / "punch.stl"
+        bad.write_text(NAN_STL)
+        demo = DEMOS / "numisheet93_aluminium_stl.toml"
+    assert cli.main(["check", str(demo), "--set", f"tools.punch_file={json.dumps(str(bad))}"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("shellform: input error: tools.punch_file:"), err

@@ -440,3 +440,38 @@ def test_an_implausible_modulus_is_warned_about_naming_the_field():
         with warnings.catch_warnings():
             warnings.simplefilter("error", PlausibilityWarning)
             scene.load(DEMOS / name)
+
+
+@pytest.mark.parametrize("changes, match", [
+    ({"tools.punch_gap": 40.0}, r"tools\.punch_gap: the punch starts 40 mm above the sheet and travels 30 mm"),
+    ({"effects": ["bending", "membrane", "geometric_nonlinearity", "plasticity", "anisotropy", "finite_strain",
+                  "contact", "friction", "drawbeads"],
+      "tools.drawbead": [{"points": [[200.0, 0.0], [200.0, 75.0]], "restraint": 60.0}]},
+     r"tools\.drawbead\[0\]: lies wholly outside the blank"),
+    ({"mesh.n": 1}, r"mesh\.n: n = 1"),
+    ({"tools.friction": 10.0}, r"tools\.friction: 10 is no friction coefficient of sheet metal"),
+])
+def test_valid_but_useless_values_are_warned_about_naming_the_field(changes, match):
+    """A punch that never reaches the sheet (a gap larger than the stroke: zero force, exit 0), a
+    drawbead wholly outside the blank, one cell per side, a friction coefficient of 10: valid, so
+    warned about (PlausibilityWarning naming the field); the demo scene gives none."""
+    import warnings
+
+    from shellform.scene.checks import PlausibilityWarning
+
+    s = scene.load(DEMOS / "square_cup.toml")
+    with pytest.warns(PlausibilityWarning, match=match):
+        s.changed(changes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlausibilityWarning)
+        scene.load(DEMOS / "square_cup.toml")
+        scene.load(DEMOS / "square_cup_drawbeads.toml")
+
+
+def test_control_characters_in_a_title_are_escaped_in_the_closing_line():
+    """A title's control characters (an escape sequence, a carriage return) are printed escaped,
+    others as they are; summary.json keeps the title as given."""
+    from shellform.results.summary import Summary
+
+    line = Summary({"title": "cup\x1b[2J\r é", "cells": 8}, Path("out")).closing_line()
+    assert line == "shellform: cup\\x1b[2J\\r é: 8 cells; results in out"

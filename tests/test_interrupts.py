@@ -191,3 +191,22 @@ def test_a_resume_with_other_steps_starts_them_afresh(tmp_path):
     history = json.loads((out / "history.json").read_text())
     assert "process.initial_step_mm" in again["resumed"]["changed"]
     assert history[before]["dlam"] == pytest.approx(0.01, rel=1e-12) and again["stroke_mm"] == pytest.approx(1.0)
+
+
+@pytest.mark.timeout(300)
+def test_sigterm_before_stepping_exits_143_with_one_line(tmp_path):
+    """SIGTERM before the first increment (once the run has said its first line, PETSc running):
+    exit 143 and shellform's one line, not PETSc's "Caught signal" banner and exit 15
+    (PETSc's own signal handler is off: shellform._env)."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(STRIP)
+    cmd = [str(Path(sys.executable).parent / "shellform"), "run", str(scene), "--out", str(tmp_path / "out")]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc.stdout.readline()  # the material's line: the stack is imported, nothing stepped
+    proc.send_signal(signal.SIGTERM)
+    proc.stdout.read()
+    err = proc.stderr.read()
+    proc.wait(timeout=120)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "Caught signal" not in err and "Traceback" not in err, err
+    assert err.strip().splitlines()[-1].startswith("shellform: "), err

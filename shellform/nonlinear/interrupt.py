@@ -8,8 +8,9 @@ and raises ``Interrupted``, which a run turns into a summary marked as stopped b
 an exit status 128 + the signal's number. A second signal stops at once (KeyboardInterrupt),
 leaving the checkpoint written before it on disk.
 
-Outside a driver's stepping (meshing, compiling, writing results) the signals keep Python's own
-behaviour. Handlers can only be set in the main thread; elsewhere nothing is installed and no
+Outside a driver's stepping (meshing, compiling, writing results) SIGINT keeps Python's own
+behaviour (KeyboardInterrupt), and the command line makes SIGTERM do the same (``stop_now``);
+PETSc's own handler is off (shellform._env), so neither ends in PETSc's banner and MPI_Abort. Handlers can only be set in the main thread; elsewhere nothing is installed and no
 stop is ever requested.
 """
 
@@ -27,6 +28,20 @@ class Interrupted(RuntimeError):
     def __init__(self, signum: int, checkpoint=None):
         self.signal, self.checkpoint = signum, checkpoint
         super().__init__(f"stopped by the user ({signal.Signals(signum).name})")
+
+
+class Stop(KeyboardInterrupt):
+    """A signal that stops at once (``signal``: its number): SIGTERM outside a driver's
+    stepping (cli.main's handler), or a second SIGINT or SIGTERM while it steps."""
+
+    def __init__(self, signum: int):
+        self.signal = signum
+        super().__init__(signal.Signals(signum).name)
+
+
+def stop_now(signum, frame):
+    """A signal handler: stop at once (Stop), as Python does for SIGINT."""
+    raise Stop(signum)
 
 
 class StopRequests:
@@ -53,7 +68,7 @@ class StopRequests:
 
     def _record(self, signum, frame):
         if self.received:
-            raise KeyboardInterrupt  # the second request: stop now
+            raise Stop(signum)  # the second request: stop now
         self.received = signum
 
     def requested(self) -> int:

@@ -19,6 +19,11 @@ from pathlib import Path
 from shellform.results import neck
 
 
+def printable(text: str) -> str:
+    """text with its control characters escaped (\\x1b, \\r, ...), for a terminal; other characters as they are."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+
+
 class Summary(dict):
     """summary.json's content (the dict) and the output folder it was written to."""
 
@@ -27,7 +32,7 @@ class Summary(dict):
         self.outdir = Path(outdir)
 
     def closing_line(self) -> str:
-        return f"shellform: {self['title']}: {self['cells']} cells; results in {self.outdir}"
+        return f"shellform: {printable(self['title'])}: {self['cells']} cells; results in {self.outdir}"
 
     def stop_line(self) -> str | None:
         return f"shellform: the run stopped early: {self['stopped']}" if self.get("stopped") else None
@@ -42,7 +47,7 @@ class ShellSummary(Summary):
     """The linear shell: w at the centre."""
 
     def closing_line(self) -> str:
-        return (f"shellform: {self['title']}: {self['cells']} cells, w_center = {self['w_center']}, "
+        return (f"shellform: {printable(self['title'])}: {self['cells']} cells, w_center = {self['w_center']}, "
                 f"{self['wall_time_s']:.2f} s; results in {self.outdir}")
 
 
@@ -52,7 +57,7 @@ class SheetSummary(Summary):
     def closing_line(self) -> str:
         last = self["reports"][-1] if self["reports"] else {}
         necked = f", {neck.words(self['neck'], 'load_factor', 'initial_xy')}" if self.get("neck") else ""
-        return (f"shellform: {self['title']}: {self['cells']} cells, {self['increments']} increments, "
+        return (f"shellform: {printable(self['title'])}: {self['cells']} cells, {self['increments']} increments, "
                 f"load factor {last.get('load_factor')}, w = {last.get('w')}{necked}, {self['wall_time_s']:.2f} s; "
                 f"results in {self.outdir}")
 
@@ -66,7 +71,7 @@ class DrawingSummary(Summary):
         draw_in = ", ".join(f"{k} {v:.3f}" for k, v in last.items() if k != "stroke_mm")
         force = self["punch_force_kN"][-1]["force"] if self.get("punch_force_kN") else float("nan")
         necked = f", {neck.words(self['neck'])}" if self.get("neck") else ""
-        return (f"shellform: {self['title']}: {self['cells']} cells, stroke {self['stroke_mm']:.2f} mm, "
+        return (f"shellform: {printable(self['title'])}: {self['cells']} cells, stroke {self['stroke_mm']:.2f} mm, "
                 f"draw-in (mm) {draw_in}, punch force {force:.2f} kN, largest thinning (thickness strain) "
                 f"{self['min_thickness_strain']:.4f}{necked}, {self['wall_time_s']['total']:.1f} s; "
                 f"results in {self.outdir}")

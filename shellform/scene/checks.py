@@ -9,6 +9,8 @@ import math
 from dataclasses import fields
 from pathlib import Path
 
+import numpy as np
+
 from shellform import effects as registry
 from shellform.errors import InputError
 from shellform.material import yld2000_fit
@@ -65,6 +67,7 @@ def validate(s) -> None:
     _validate_probes(s)
     validate_tools(s)
     machine.check_size(s)  # first: a count too large for memory is named with the memory it needs
+    _plausible_values(s)
     n = s.process.thickness_points
     require(n <= MAX_THICKNESS_POINTS, "process.thickness_points",
             f"must be <= {MAX_THICKNESS_POINTS} (the Gauss rule costs n^3: 10,000 points take minutes before "
@@ -227,6 +230,47 @@ def _plausible_stiffness(material) -> None:
         warnings.warn(PlausibilityWarning(
             f"material.E: E / initial yield stress = {ratio:.3g}, where a sheet metal's lies between about 300 and "
             f"2000: are E and the stresses in the same unit (MPa with lengths in mm)?"), stacklevel=2)
+
+
+MAX_FRICTION = 1.0  # tools.friction above this is warned about: sheet metal on tools lies about 0.02 to 0.3
+
+
+def _warn(field: str, message: str) -> None:
+    import warnings
+
+    warnings.warn(PlausibilityWarning(f"{field}: {message}"), stacklevel=3)
+
+
+def _plausible_values(s) -> None:
+    """Warn (PlausibilityWarning, naming the field) about values that are valid but make a run
+    that computes nothing of use with exit 0: one cell per side (mesh.n = 1 but for a file
+    blank, whose own mesh n refines), a friction
+    coefficient above MAX_FRICTION, a punch whose gap to the sheet is at least its stroke (it
+    never touches the sheet: zero force), a drawbead wholly outside the blank (mirrored across
+    its symmetry lines: it holds nothing)."""
+    if s.mesh.n == 1 and s.geometry.shape != "file":  # a file's n refines its own mesh
+        _warn("mesh.n", "n = 1 makes one cell per side: no answer of such a mesh means anything (a cup needs n "
+              ">= 8)")
+    t = s.tools
+    if t is None:
+        return
+    if t.friction > MAX_FRICTION:
+        _warn("tools.friction", f"{t.friction:g} is no friction coefficient of sheet metal on tools (about 0.02 to "
+              "0.3): is it a percentage?")
+    if t.shape in ("square", "round") and t.punch_gap >= t.stroke:
+        _warn("tools.punch_gap", f"the punch starts {t.punch_gap:g} mm above the sheet and travels {t.stroke:g} mm "
+              "(tools.stroke): it never touches the sheet, and the force stays zero")
+    g = s.geometry
+    if g.shape not in ("rectangle", "circle"):
+        return
+    for i, bead in enumerate(t.drawbead):
+        p = np.abs(np.asarray(bead.points, dtype=float))  # the blank mirrored: |x|, |y|
+        along = np.linspace(0.0, 1.0, 21)[:, None, None]
+        q = (p[:-1] + along * (p[1:] - p[:-1])).reshape(-1, 2)
+        inside = (np.hypot(q[:, 0], q[:, 1]) <= g.radius if g.shape == "circle"
+                  else (q[:, 0] <= g.lx / 2) & (q[:, 1] <= g.ly / 2))
+        if not inside.any():
+            _warn(f"tools.drawbead[{i}]", f"lies wholly outside the blank {bead.points}: it holds nothing")
 
 
 def _check_plan_field(f, s, no_tools: str, key: str | None = None) -> None:

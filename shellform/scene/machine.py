@@ -20,6 +20,16 @@ def check_file(s) -> None:
     require(Path(s.geometry.file).is_file(), "geometry.file", f"no such file: {s.geometry.file}")
 
 
+def check_tool_files(s) -> None:
+    """What a run checks in the tools' files before computing (shellform.tools.cad.check_files:
+    a CAD file read by a child process, a surface mesh read whole), for `shellform check`; run
+    makes the same checks as it reads them. Not part of every scene's reading (a child process per file)."""
+    if s.tools is not None and s.tools.shape == "cad":
+        from shellform.tools import cad
+
+        cad.check_files(s.tools)
+
+
 def estimate(s) -> dict:
     """What the scene's mesh will cost on this machine, before it is built (the estimates of
     shellform/mesh/budget.py): {"cells", "layers" (points through a plastic section's

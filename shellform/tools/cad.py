@@ -102,6 +102,20 @@ def _tool(path):
     return MeshTool if Path(path).suffix.lower() in MESH_SUFFIXES else SurfaceTool
 
 
+def read_tool_file(path, field: str):
+    """A tool's file checked as a run checks it before reading it (the tool class's check_file,
+    which its from_file calls first: cad_files.probe for a CAD model, mesh_files.read_surface_mesh
+    for a surface mesh); `shellform check` calls it through check_files. InputError naming `field`."""
+    return _tool(path).check_file(Path(path), field)
+
+
+def check_files(spec) -> None:
+    """The punch's and the die's files checked as a run checks them (read_tool_file), before
+    anything is computed: `shellform check` refuses what `shellform run` refuses."""
+    for name in ("punch", "die"):
+        read_tool_file(getattr(spec, f"{name}_file"), f"tools.{name}_file")
+
+
 class ToolSymmetryWarning(UserWarning):
     """A tool is not mirror-symmetric about a symmetry line of the modelled blank."""
 

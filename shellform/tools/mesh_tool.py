@@ -150,11 +150,13 @@ class MeshTool(ClosestPointTool):
         """The Nagata patches of a triangle mesh (vertices (V, 3), triangles (T, 3))."""
         return cls(nagata_patches(vertices, triangles), translation, normals)
 
+    check_file = staticmethod(read_surface_mesh)  # the file read and checked (cad.read_tool_file)
+
     @classmethod
     def from_file(cls, path, translation=(0.0, 0.0, 0.0), normals: str = "outward",
                   field: str = "tools.file") -> "MeshTool":
         """The tool of an STL or ASCII gmsh .msh file (a bad file: InputError naming `field`)."""
-        vertices, triangles = read_surface_mesh(path, field)
+        vertices, triangles = cls.check_file(path, field)
         return cls.from_triangles(vertices, triangles, translation, normals)
 
     # -- the closest-point engine's hooks (closest_point.py) -----------------------------------

@@ -157,12 +157,14 @@ class SurfaceTool(CadProjections, ClosestPointTool):
                 gmsh.model.setCurrent(previous)
         return cls(name, translation, normals)
 
+    check_file = staticmethod(probe)  # the file's checks before it is read (cad.read_tool_file)
+
     @classmethod
     def from_file(cls, path, translation=(0.0, 0.0, 0.0), normals: str = "outward",
                   field: str = "tools.file") -> "SurfaceTool":
         """The tool of a STEP, IGES or BREP file (a bad file: InputError naming `field`)."""
         path = Path(path)
-        probe(path, field)
+        cls.check_file(path, field)
         gmsh, name, previous = cls._new_model()
         try:
             gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
