@@ -440,3 +440,17 @@ def test_shape_is_vectorised():
                 t.append(time.perf_counter() - t0)
             cost[f.__name__] = min(t)
         assert cost["shape"] < 10 * cost["gap"] + 0.05, cost
+
+
+def test_a_registry_refuses_a_module_that_misses_a_declaration_or_repeats_a_name():
+    """shellform.registry.checked, which the yield functions and the kinds of tools share."""
+    from types import SimpleNamespace
+
+    from shellform import registry
+
+    a, b = SimpleNamespace(__name__="a", NAME="a", f=1), SimpleNamespace(__name__="b", NAME="b", f=2)
+    assert registry.checked((a, b), ("NAME", "f"), "part") == {"a": a, "b": b}
+    with pytest.raises(TypeError, match="part c does not declare f"):
+        registry.checked((a, SimpleNamespace(__name__="c", NAME="c")), ("NAME", "f"), "part")
+    with pytest.raises(TypeError, match="a part's NAME is registered twice"):
+        registry.checked((a, SimpleNamespace(__name__="a2", NAME="a", f=3)), ("NAME", "f"), "part")

@@ -28,29 +28,17 @@ cache folder is keyed by the sources of shellform/material, this registry among 
 
 import importlib
 
-from shellform.material.layout import CRITERION_
 from shellform import _jit as jit
+from shellform import registry
+from shellform.material.layout import CRITERION_
 
 REGISTRY = ("hill79", "hill48", "yld2000")  # modules of shellform.material; the id of each is its place here
 
 DECLARES = ("NAME", "PARAMETERS", "PLANAR_ISOTROPIC", "parameters", "yield_function")
 
 
-def _checked(modules: tuple) -> dict:
-    """name -> module, in registry order; TypeError where a module misses a declaration or a
-    name is registered twice (an error of the code, not of a scene)."""
-    for m in modules:
-        missing = [d for d in DECLARES if not hasattr(m, d)]
-        if missing:
-            raise TypeError(f"yield function {m.__name__} does not declare {', '.join(missing)}")
-    names = [m.NAME for m in modules]
-    if len(set(names)) != len(names):
-        raise TypeError(f"a yield function's NAME is registered twice: {names}")
-    return {m.NAME: m for m in modules}
-
-
 MODULES = tuple(importlib.import_module(f"{__package__}.{name}") for name in REGISTRY)
-CRITERIA = _checked(MODULES)  # NAME -> module, in registry order
+CRITERIA = registry.checked(MODULES, DECLARES, "yield function")  # NAME -> module, in registry order
 
 
 def dispatch_source(modules: tuple) -> str:

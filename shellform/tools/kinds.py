@@ -30,6 +30,8 @@ kind of tools).
 
 import importlib
 
+from shellform import registry
+
 REGISTRY = ("square", "round", "cad")  # modules of shellform.tools
 
 DECLARES = ("NAME", "FIELDS", "refuse", "complete", "check", "tools", "check_placement", "LINES", "RIM",
@@ -37,23 +39,16 @@ DECLARES = ("NAME", "FIELDS", "refuse", "complete", "check", "tools", "check_pla
 
 
 def _checked(modules: tuple) -> dict:
-    """name -> module, in registry order; TypeError where a module misses a declaration, a name
-    is registered twice or two kinds give one key different defaults (errors of the code, not of
-    a scene)."""
-    for m in modules:
-        missing = [d for d in DECLARES if not hasattr(m, d)]
-        if missing:
-            raise TypeError(f"tool kind {m.__name__} does not declare {', '.join(missing)}")
-    names = [m.NAME for m in modules]
-    if len(set(names)) != len(names):
-        raise TypeError(f"a tool kind's NAME is registered twice: {names}")
+    """name -> module, in registry order (shellform.registry.checked); TypeError also where two
+    kinds give one key different defaults (errors of the code, not of a scene)."""
+    kinds = registry.checked(modules, DECLARES, "tool kind")
     defaults = {}
     for m in modules:
         for name, default, _ in m.FIELDS:
             if defaults.setdefault(name, default) != default:
                 raise TypeError(f"tool kind {m.NAME} gives tools.{name} the default {default!r}, another "
                                 f"{defaults[name]!r}")
-    return {m.NAME: m for m in modules}
+    return kinds
 
 
 MODULES = tuple(importlib.import_module(f"{__package__}.{name}") for name in REGISTRY)
