@@ -8,6 +8,7 @@ import json
 import logging
 import os
 import shutil
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -440,12 +441,15 @@ def test_a_resume_does_not_write_through_links_in_out(tmp_path, drawn):
 
 
 @pytest.mark.timeout(200)
-@pytest.mark.parametrize("damage", ["reports.json", "force_stroke.csv", "rows cut", "global cut"])
+@pytest.mark.parametrize("damage", ["reports.json", "force_stroke.csv", "rows cut", "global cut", "too large",
+                                    "a header that lies"])
 def test_a_damaged_file_of_a_resume_is_named_in_one_line(tmp_path, whole, damage):
     """--resume in a finished folder whose reports.json is not JSON, whose force_stroke.csv has
     a row that is not numbers, or whose checkpoints have their arrays cut (every per-node array
-    but the numbers half its rows; the tools' travel empty): exit 2 with one line naming the file (today:
-    JSONDecodeError, ValueError, IndexError tracebacks)."""
+    but the numbers half its rows; the tools' travel empty), hold an array larger than the
+    state of the run's mesh can be (a 1.6 GiB member took 5 GB of memory to load), or an array
+    whose .npy header claims 80 GB in a few bytes (numpy would allocate them before reading):
+    exit 2 with one line naming the file, and nothing too large is loaded."""
     out = tmp_path / "out"
     shutil.copytree(whole[0], out)
     if damage == "reports.json":
@@ -461,8 +465,20 @@ def test_a_damaged_file_of_a_resume_is_named_in_one_line(tmp_path, whole, damage
                     arrays[k] = arrays[k][: len(arrays[k]) // 2]
             if damage == "global cut":
                 arrays["global.contact_travel"] = arrays["global.contact_travel"][:0]
+            if damage == "too large":  # 2,000 times the cells' state, in each row
+                k = next(k for k in arrays if k.startswith("cells.") and k != "cells.index")
+                arrays[k] = np.zeros((len(arrays[k]), 2000) + arrays[k].shape[1:])
             np.savez(out / name, **arrays)
+            if damage == "a header that lies":
+                header = np.lib.format.header_data_from_array_1_0(np.zeros(1))
+                header["shape"] = (10**10,)
+                member = io.BytesIO()
+                np.lib.format.write_array_header_1_0(member, header)
+                with zipfile.ZipFile(out / name, "a") as z:
+                    z.writestr("nodes.lie.npy", member.getvalue() + bytes(8))
     with pytest.raises(InputError) as err:
         contact_run.run(cup(), out, resume=True)
     named = {"reports.json": "reports.json", "force_stroke.csv": "force_stroke.csv"}.get(damage, "checkpoint")
     assert err.value.field == "resume" and named in str(err.value) and "damaged" in str(err.value)
+    why = {"too large": "more than the state of this run's mesh can", "a header that lies": "claims 80,000,000,000 bytes"}
+    assert why.get(damage, "") in str(err.value)

@@ -468,6 +468,30 @@ def test_valid_but_useless_values_are_warned_about_naming_the_field(changes, mat
         scene.load(DEMOS / "square_cup_drawbeads.toml")
 
 
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("field", ["tools.drawbead", "process.report"])
+def test_sizes_that_cost_out_of_proportion_are_refused_naming_the_field(field):
+    """100,000 drawbead points (over 180 s for the first increment) and 20,000 report stations
+    (4.2 GB written in 5 minutes) are refused when the scene is read, naming the field; the
+    largest allowed pass."""
+    from shellform.scene.checks import MAX_REPORTS
+    from shellform.scene.tool_checks import MAX_DRAWBEAD_POINTS
+
+    s = scene.load(DEMOS / "square_cup_drawbeads.toml")
+
+    def asking(count):
+        if field == "process.report":
+            return {"process.report": [(i + 1) / (count + 1) for i in range(count)]}
+        line = [[50.0 + 5.0 * i / count, 75.0 * i / (count - 1)] for i in range(count)]  # 50 to 55 mm from the centre
+        return {"tools.drawbead": [{"points": line, "restraint": 40.0, "uplift": 10.0}]}
+
+    limit = MAX_REPORTS if field == "process.report" else MAX_DRAWBEAD_POINTS
+    with pytest.raises(InputError) as err:
+        s.changed(asking(100_000 if field == "tools.drawbead" else 20_000))
+    assert err.value.field == field and f"at most {limit:,}" in err.value.message
+    assert s.changed(asking(limit)) is not None
+
+
 def test_control_characters_in_a_title_are_escaped_in_the_closing_line():
     """A title's control characters (an escape sequence, a carriage return) are printed escaped,
     others as they are; summary.json keeps the title as given."""

@@ -159,3 +159,24 @@ def test_a_good_msh_file_still_runs(tmp_path, recwarn):
     w = linear.solve(s).value("w", 0.0, 0.0)
     assert not [r for r in recwarn.list if issubclass(r.category, quality.MeshQualityWarning)]
     assert w == pytest.approx(1 / 64, rel=5e-3)
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("sizes", ["points", "options"])
+def test_a_geo_whose_own_sizes_make_too_many_cells_is_refused_before_meshing(tmp_path, sizes):
+    """A .geo whose points ask for 1e-4 mm cells on a 100 mm square (or its Mesh.MeshSizeFactor)
+    meshed for over 400 s with no message: its own sizes are measured on its curves (a child
+    reading the file) and the cells they make are held against the machine's memory, like
+    mesh.n's, with an InputError naming geometry.file within seconds."""
+    geo = tmp_path / "fine.geo"
+    size = 1e-4 if sizes == "points" else 10.0
+    text = [f"Point({i + 1}) = {{{100 * dx}, {100 * dy}, 0, {size}}};" for i, (dx, dy) in enumerate(SQUARE[:4])]
+    text += [f"Line({i + 1}) = {{{i + 1}, {(i + 1) % 4 + 1}}};" for i in range(4)]
+    text += ["Curve Loop(1) = {1, 2, 3, 4};", "Plane Surface(1) = {1};"]
+    if sizes == "options":
+        text += ["Mesh.MeshSizeFactor = 1e-5;"]
+    geo.write_text("\n".join(text) + "\n")
+    with pytest.raises(InputError) as err:
+        file_scene(geo, supports={"boundary": "clamped"})
+    assert err.value.field == "geometry.file" and "its own mesh sizes" in err.value.message, str(err.value)
+    assert "GB" in err.value.message

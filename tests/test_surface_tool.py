@@ -500,3 +500,25 @@ def test_the_dome_cup_stretches_the_sheet_over_the_hemispherical_punch(tmp_path)
     x, y, z = s["where_current_xyz_mm"]
     assert np.hypot(x, y) < 1e-6 and z == pytest.approx(-4.0, abs=0.02)
     assert s["min_thickness_strain"] < -0.005 and s["punch_force_kN"][-1]["force"] > 0.5
+
+
+@pytest.mark.timeout(60)
+def test_a_cad_tool_of_too_many_faces_is_refused_before_its_setup(tmp_path):
+    """A STEP of 500 solids took 295 s to set up past the read check: a tool's file of more than
+    MAX_CAD_FACES faces (here 84 boxes, 504 faces) is refused by the child that reads it, naming
+    the field, before the tool samples its faces."""
+    import subprocess
+    import sys
+
+    from shellform.tools.cad_files import MAX_CAD_FACES
+
+    path = tmp_path / "boxes.step"
+    boxes = MAX_CAD_FACES // 6 + 1
+    write = ("import gmsh\ngmsh.initialize(readConfigFiles=False)\ngmsh.option.setNumber('General.Terminal', 0)\n"
+             f"for i in range({boxes}):\n    gmsh.model.occ.addBox((i % 10) * 3.0, (i // 10) * 3.0, 0, 2, 2, 2)\n"
+             f"gmsh.model.occ.synchronize()\ngmsh.write({str(path)!r})\ngmsh.finalize()\n")
+    subprocess.run([sys.executable, "-c", write], check=True, capture_output=True)
+    with pytest.raises(InputError) as err:
+        SurfaceTool.from_file(path, field="tools.die_file")
+    assert err.value.field == "tools.die_file"
+    assert f"holds {6 * boxes:,} faces; a tool may have at most {MAX_CAD_FACES}" in err.value.message

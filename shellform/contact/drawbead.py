@@ -100,18 +100,21 @@ class Drawbeads(Part):
         arr = self._shares.x.array.reshape(-1, BS)
         arr[:] = 0.0
         tri = x_local[self.dofs][:, :, :2]  # (cells, 3, 2)
+        lo, hi = tri.min(axis=1), tri.max(axis=1)  # the cells' boxes: a segment is clipped to those it meets
         for line in self.lines:
             pts = np.asarray(line.points, dtype=float)
             for P0, P1 in zip(pts[:-1], pts[1:]):
                 d = P1 - P0
                 length = float(np.hypot(*d))
                 normal = np.array([-d[1], d[0]]) / length
-                t0, t1, on_edge = _clip(P0, P1, tri)
-                cells = np.flatnonzero(t1 > t0)
-                if cells.size == 0:
+                near = np.flatnonzero(np.all((lo <= np.maximum(P0, P1)) & (hi >= np.minimum(P0, P1)), axis=1))
+                t0, t1, on_edge = _clip(P0, P1, tri[near])
+                inside = np.flatnonzero(t1 > t0)
+                if inside.size == 0:
                     continue
-                piece = (t1[cells] - t0[cells]) * length * np.where(on_edge[cells], 0.5, 1.0)
-                mid = P0 + 0.5 * (t0[cells] + t1[cells])[:, None] * d
+                t0, t1, on_edge, cells = t0[inside], t1[inside], on_edge[inside], near[inside]
+                piece = (t1 - t0) * length * np.where(on_edge, 0.5, 1.0)
+                mid = P0 + 0.5 * (t0 + t1)[:, None] * d
                 N = _barycentric(tri[cells], mid)  # the shape functions at the piece's middle
                 w = piece[:, None] * N  # (cells, 3): integral of N_i along the piece
                 nodes = self.dofs[cells]

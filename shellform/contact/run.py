@@ -71,6 +71,7 @@ from mpi4py import MPI
 from shellform.contact import springback
 from shellform.contact.problem import DrawingProblem
 from shellform.errors import InputError
+from shellform.mesh import budget
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
@@ -98,7 +99,8 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
     the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
     or where it lies past this scene's stroke; the force-stroke rows and reports up to it, and
     what the summary records of the resume."""
-    saved = checkpoint.read(outdir, comm)
+    cells = p.model.mesh.topology.index_map(2).size_global
+    saved = checkpoint.read(outdir, comm, budget.state_bytes(cells, s.process.thickness_points))
     if not p.driver.fingerprint:
         p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
     differ, changed = run_folder.compare(saved.meta.get("fingerprint") or {}, p.driver.fingerprint)

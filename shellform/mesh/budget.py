@@ -25,6 +25,12 @@ LAYER_BYTES_PER_CELL = 384
 RULE_BYTES_PER_POINT_SQUARED = 24
 
 
+def state_bytes(cells: int, layers: int = 0) -> float:
+    """The most a run's state on that many cells may take (its memory less the base): a
+    checkpoint larger than this is not the state of such a run (shellform.nonlinear.checkpoint)."""
+    return cells * (NONLINEAR_BYTES_PER_CELL + layers * LAYER_BYTES_PER_CELL)
+
+
 def structured_ny(lx: float, ly: float, region: str, n: int) -> int:
     """Divisions along y of the structured mesh with n along x (even on a full blank with even n,
     so that the centre is a vertex)."""

@@ -215,16 +215,17 @@ def _redirected(tokens, i) -> bool:
     return False
 
 
-def read_file(path, options: dict) -> tuple[tuple[str, ...], int, tuple[float, float]]:
-    """(boundary groups, triangles in its mesh (0: none yet), bounding-box width and height) of
-    a checked gmsh file, read by gmsh with these options in a child process stopped after
-    READ_SECONDS."""
+def read_file(path, options: dict) -> tuple[tuple[str, ...], int, tuple[float, float], float | None]:
+    """(boundary groups, triangles in its mesh (0: none yet), bounding-box width and height, the
+    median segment of its curves at the file's own mesh sizes (None where it holds a mesh)) of a
+    checked gmsh file, read by gmsh with these options in a child process (gmsh_reader.py)
+    stopped after READ_SECONDS."""
     script = Path(__file__).with_name("gmsh_reader.py")
     cmd = [sys.executable, "-P", str(script), str(path), json.dumps(options)]  # -P: not the script's folder on sys.path
     result = read_in_child(cmd, path, FIELD, _MARK, READ_SECONDS, "(a long loop, or a mesh made in the file?)")
     if result.get("empty"):
         raise InputError(FIELD, f"{path} holds no geometry and no mesh (an empty file?)")
-    return tuple(result["groups"]), int(result["triangles"]), tuple(result["size"])
+    return tuple(result["groups"]), int(result["triangles"]), tuple(result["size"]), result.get("segment")
 
 
 _MARK = "shellform-gmsh-read: "

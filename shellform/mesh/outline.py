@@ -63,20 +63,29 @@ def symmetry_lines(g) -> tuple[str, ...]:
 
 def file_cells(g, n: int, refine: int) -> int:
     """Triangles a file blank makes: those of its mesh (a .msh), or a gmsh estimate from its
-    bounding box at h = width / n (a .geo or CAD file), times 4^refine."""
+    bounding box at h = width / n or the file's own size where that is smaller (the median
+    segment gmsh makes of its curves: a .geo or CAD file), times 4^refine."""
     from shellform.mesh.budget import gmsh_cells
 
-    _, triangles, (width, height) = _read_file(g.file, gmsh_file.check(g.file))
+    _, triangles, (width, height), segment = _read_file(g.file, gmsh_file.check(g.file))
     if triangles:
         return triangles * 4**refine
-    return gmsh_cells(width * height, width / n, refine)
+    return gmsh_cells(width * height, min(width / n, segment or math.inf), refine)
+
+
+def file_own_size(g, n: int) -> float | None:
+    """The size a file blank's own mesh sizes give where they, not mesh.n, set its cells (a .geo
+    or CAD file whose curves gmsh meshes finer than width / n: their median segment); else None."""
+    _, triangles, (width, _), segment = _read_file(g.file, gmsh_file.check(g.file))
+    return segment if not triangles and segment is not None and segment < width / n else None
 
 
 @functools.lru_cache(maxsize=8)
 def _read_file(path, version) -> tuple[tuple[str, ...], int, tuple[float, float]]:
-    """(boundary groups, triangles in its mesh (0: none yet), bounding box width and height)
-    of a gmsh file, read once per version of the files gmsh reads for it (gmsh_file.check),
-    in a child process with a time limit."""
+    """(boundary groups, triangles in its mesh (0: none yet), bounding box width and height,
+    the median segment at the file's own sizes) of a gmsh file (gmsh_file.read_file), read once
+    per version of the files gmsh reads for it (gmsh_file.check), in a child process with a time
+    limit."""
     return gmsh_file.read_file(path, OPTIONS)
 
 

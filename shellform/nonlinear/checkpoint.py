@@ -20,7 +20,9 @@ where it is missing or damaged, PREVIOUS, and says which file was damaged and wh
 
 import hashlib
 import json
+import math
 import os
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -138,7 +140,30 @@ class Checkpoint:
         return out
 
 
-def _read_file(path: Path) -> tuple[dict, dict]:
+def _check_sizes(path: Path, limit: float) -> None:
+    """Before a member is loaded: the members' sizes (uncompressed, from the zip's directory)
+    sum to at most `limit` bytes, and each member's .npy header asks for no more bytes than the
+    member holds (numpy allocates the header's shape before it reads the data). ValueError."""
+    with zipfile.ZipFile(path) as z:
+        total = sum(info.file_size for info in z.infolist())
+        if total > limit:
+            raise ValueError(f"its arrays take {total / 1e6:,.1f} MB, more than the state of this run's mesh "
+                             f"can ({limit / 1e6:,.1f} MB, shellform/mesh/budget.py)")
+        for info in z.infolist():
+            with z.open(info) as f:
+                version = np.lib.format.read_magic(f)
+                header = {(1, 0): np.lib.format.read_array_header_1_0,
+                          (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+                if header is None:
+                    raise ValueError(f"{info.filename} is a .npy of version {version}, which numpy's savez does not write")
+                shape, _, dtype = header(f)
+                need = math.prod(shape) * dtype.itemsize
+            if need > info.file_size:
+                raise ValueError(f"{info.filename} claims {need:,} bytes in {info.file_size:,}")
+
+
+def _read_file(path: Path, limit: float = math.inf) -> tuple[dict, dict]:
+    _check_sizes(path, limit)
     with np.load(path, allow_pickle=False) as data:
         arrays = {k: data[k] for k in data.files}  # reads (and CRC-checks) every member
     if int(arrays.get("format", 0)) != FORMAT:
@@ -152,9 +177,11 @@ def _read_file(path: Path) -> tuple[dict, dict]:
     return meta, {k: v for k, v in arrays.items() if not k.startswith("meta.") and k != "format"}
 
 
-def read(folder: Path, comm=MPI.COMM_WORLD) -> Checkpoint:
+def read(folder: Path, comm=MPI.COMM_WORLD, limit: float = math.inf) -> Checkpoint:
     """The newest complete checkpoint in `folder`: CURRENT, or PREVIOUS where CURRENT is missing
-    or damaged (read by rank 0, sent to every rank). InputError("resume") where there is none."""
+    or damaged (read by rank 0, sent to every rank). InputError("resume") where there is none.
+    limit: the most bytes its arrays may take (mesh.budget.state_bytes of the resuming mesh); a
+    file past it counts as damaged, and nothing of it is loaded."""
     folder = Path(folder)
     found = None
     if comm.rank == 0:
@@ -164,7 +191,7 @@ def read(folder: Path, comm=MPI.COMM_WORLD) -> Checkpoint:
             if not path.exists():
                 continue
             try:
-                meta, arrays = _read_file(path)
+                meta, arrays = _read_file(path, limit)
             except Exception as err:  # noqa: BLE001  (a damaged file: BadZipFile, EOFError, ValueError, ...)
                 damaged.append(f"{path}: damaged ({type(err).__name__}: {err})")
                 continue

@@ -25,6 +25,10 @@ from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIR
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
+# process.report: each station stops the stepping there and writes the fields of the whole
+# sheet (a step of the .pvd and VTX series; a tool scene also its checkpoint and reports.json)
+MAX_REPORTS = 200
+
 
 def validate(s) -> None:
     """Raise InputError naming the first bad field of s."""
@@ -337,6 +341,9 @@ def _validate_process(s) -> None:
     require(len(pr.path) > 0, "process.path", "must list at least one load factor, e.g. [1.0]")
     require(all(math.isfinite(v) for v in pr.path), "process.path", f"must be finite numbers, got {pr.path}")
     lo, hi = min(0.0, *pr.path), max(0.0, *pr.path)  # the path starts at load factor 0
+    require(len(pr.report) <= MAX_REPORTS, "process.report",
+            f"lists {len(pr.report):,} stations; at most {MAX_REPORTS} (each writes the whole sheet's fields: "
+            "the force and the draw-in are recorded at every increment anyway)")
     for v in pr.report:
         require(math.isfinite(v) and lo <= v <= hi, "process.report",
                 f"{v} lies outside the load factors [{lo}, {hi}] that process.path covers")

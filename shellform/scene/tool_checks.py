@@ -13,6 +13,11 @@ from shellform.scene.schema import HOLDERS, SIDES, SPREADS, TOOL_SHAPES
 from shellform.tools import kinds as tool_kinds
 from shellform.tools.analytic import rounded_square_sdf
 
+# tools.drawbead: the points of all beads together. Every Newton iteration clips each segment to
+# the sheet's cells near it (shellform.contact.drawbead); a bead's line needs no segment shorter
+# than a cell, and a quarter blank's flange is crossed by a few hundred cells at the finest meshes.
+MAX_DRAWBEAD_POINTS = 1000
+
 
 def _validate_drawbead(bead, name: str, flat: float, corner: float) -> None:
     """A drawbead: a polyline of at least two distinct points, all on the die's flat top (outside
@@ -68,6 +73,10 @@ def validate_tools(s) -> None:
     require(t.friction > 0 or "friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
     require(bool(t.drawbead) or "drawbeads" not in s.effects, "tools.drawbead",
             "the effect 'drawbeads' needs at least one [[tools.drawbead]]")
+    points = sum(len(bead.points) for bead in t.drawbead)
+    require(points <= MAX_DRAWBEAD_POINTS, "tools.drawbead",
+            f"holds {points:,} points in all; at most {MAX_DRAWBEAD_POINTS:,} (each segment is clipped to the "
+            "sheet's cells at every Newton iteration: a bead needs no segment shorter than a cell)")
     for i, bead in enumerate(t.drawbead):
         _validate_drawbead(bead, f"tools.drawbead[{i}]", flat, corner)
     if g.shape == "rectangle":

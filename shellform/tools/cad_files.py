@@ -1,7 +1,8 @@
 """A tool's CAD file, checked before gmsh imports it in this process: it exists, is a CAD
 file by its name, is not too large, and a child process (importing gmsh only, no MPI) stopped
-after READ_SECONDS reads it and finds faces in it, so that a file that stalls or crashes OCC's
-reader does not stall or crash the run."""
+after READ_SECONDS reads it and finds faces in it, at most MAX_CAD_FACES, so that a file that
+stalls or crashes OCC's reader does not stall or crash the run, and one of thousands of faces
+(500 solids) is refused before its setup takes minutes."""
 
 import sys
 from pathlib import Path
@@ -12,6 +13,9 @@ from shellform.mesh.gmsh_file import read_in_child
 CAD_SUFFIXES = (".step", ".stp", ".STEP", ".STP", ".iges", ".igs", ".IGES", ".IGS", ".brep", ".BREP")
 MAX_CAD_BYTES = 200_000_000  # a tool's CAD file larger than this is refused
 READ_SECONDS = 60.0  # the longest the child may take to read a tool's file
+# a tool's faces: its setup samples every face and edge (cad_model.py), a time that grows faster
+# than the count (docs/reliability.md); the demos' tools have 3 to 54
+MAX_CAD_FACES = 500
 _MARK = "shellform-cad-read: "
 
 
@@ -29,6 +33,9 @@ def probe(path: Path, field: str) -> dict:
     result = read_in_child([sys.executable, "-P", "-c", _CHILD, str(path)], path, field, _MARK, READ_SECONDS)
     if result["faces"] == 0:
         raise InputError(field, f"{path} holds no surface (a tool is the faces of a CAD model)")
+    if result["faces"] > MAX_CAD_FACES:
+        raise InputError(field, f"{path} holds {result['faces']:,} faces; a tool may have at most {MAX_CAD_FACES} "
+                                "(setting a tool up samples every face: the time grows faster than their count)")
     return result
 
 
