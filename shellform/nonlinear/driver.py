@@ -13,6 +13,11 @@ without parts that bound the step, with the energy line search swapped; then it 
 and retried with dlambda / 4. An easy one (few iterations) lets the next grow by 1.5. Below
 min_step the run stops with ConvergenceFailure, after writing the last converged state to disk.
 Nothing non-finite is ever committed.
+
+What watches the run may shorten the next step ahead of an event it sees coming (the neck:
+shellform.results.neck.NeckWatch.ahead): after an increment, on_increment may call
+bound_next_step(dlambda); the step is never shortened below min_step, and it grows again from
+there as usual.
 """
 
 import time
@@ -163,6 +168,17 @@ class Driver(Newton):
             self.cause = f"{cause}; with the line search {'on' if self.searching else 'off'}: {self.cause}"
         return ok, its + its2, res, ev
 
+    @property
+    def next_step(self) -> float | None:
+        """The load-factor step the next increment will try (None outside a run's stepping)."""
+        return None if self._steps is None else self._steps[0]
+
+    def bound_next_step(self, dlam: float) -> None:
+        """Shorten the next increment's step to at most dlam, not below min_step (called from
+        on_increment, by what sees an event coming); a no-op outside a run's stepping."""
+        if self._steps is not None and dlam < self._steps[0]:
+            self._steps = (max(dlam, self.controls.min_step),) + self._steps[1:]
+
     def continue_from(self, lam: float) -> None:
         """q holds a converged state at load factor lam, reached from 0 (another driver's, or a
         state set by hand): the next run() steps on from there, a load reversal where it goes
@@ -250,6 +266,7 @@ class Driver(Newton):
             self._steps = (dlam, self._dlam_prev, x_n)  # the next step; this one and the state before it (the predictor's)
             if on_increment is not None:
                 on_increment(self)
+            dlam = self._steps[0]  # as a watch may have bounded it
             self._stop_if_requested()
         self._steps = None  # the next target starts its steps afresh
         return self.history

@@ -125,6 +125,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             if before is None:
                 p.driver.progress.note(f"shellform: the sheet starts to neck: "
                                        f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
+        if d.next_step is not None:  # shorter steps ahead of the onset
+            d.bound_next_step(necks.ahead(d.next_step))
 
     try:
         for target in s.process.path:

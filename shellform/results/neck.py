@@ -11,6 +11,19 @@ watched. Where the sheet thickens, compressed in the mean (a cup's flange and it
 a rim ironed between the tools), the membrane tangent may turn indefinite too, but that is the
 membrane's own wrinkling, which the shell's bending resists, or the faces' pressure, not a neck.
 
+Ahead of the onset the watch shortens the steps (`ahead`): from the least stability at the
+last two increments it extrapolates linearly where it reaches 0, and where the next step would
+go past that, the step is bounded to half the distance to it, but not below a quarter of the
+step it first bounded, so that the onset falls into a short increment (its interpolation the
+more accurate, the neck's first increments the easier for Newton) and the approach takes a few
+increments, not a halving without end. A fall that slows to less than a quarter of its rate
+at the increment before is not extrapolated: that is the elastic-plastic transition (a cup's
+least stability falls from some 36,000 to 8,000 MPa in its first plastic increment, then by
+1,000 in the next), which a straight line through the last two would see reach 0 within a
+step. After it the least stability decays about exponentially (halving every few millimetres of
+a cup's stroke), which the line sees reach 0 at about a step ahead, and which bounds nothing
+while the steps are shorter than its decay.
+
 The watch is told the sheet's state after every converged increment (a run's on_increment;
 the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
 tool scene, the load factor of a sheet scene) interpolated linearly between the last increment
@@ -23,6 +36,8 @@ reports it (summary.json "neck", null without a neck).
 """
 
 import numpy as np
+
+SLOWING = 0.25  # a fall of the least stability slowing below this fraction of its rate before is not extrapolated
 
 
 class NeckReached(Exception):
@@ -39,6 +54,8 @@ class NeckWatch:
         self.last = None  # (load measure, least stability) of the last increment
         self.thickness = None  # the local cells' thickness strains at the last increment
         self.onset = None  # {at, "increment_" + at, place, "thickness_strain", "stability"}, or None
+        self.trend = []  # (load measure, least stability) of the last three increments
+        self.shortest = None  # the least step `ahead` bounds to: a quarter of the first it bounded
 
     def carry(self, onset: dict | None, at: float) -> None:
         """Keep the onset an earlier run found at or before `at` (a resumed run's state), so that
@@ -72,8 +89,28 @@ class NeckWatch:
             self.onset = {self.at: float(start), f"increment_{self.at}": float(at), self.place: xy,
                           "thickness_strain": float(t), "stability": float(least)}
         self.last = (float(at), float(least))
+        self.trend = (self.trend + [self.last])[-3:]
         self.thickness = np.array(thickness_strain, dtype=float, copy=True)
         return self.onset is not None
+
+    def ahead(self, step: float) -> float:
+        """The longest next step (in the load measure) that does not overrun the onset the last
+        two increments predict (module docstring): step itself where no onset is predicted
+        within it (fewer than three increments seen, the stability not falling, its fall slowing
+        below SLOWING of its rate before, or the neck already started)."""
+        if self.onset is not None or len(self.trend) < 3:
+            return step
+        (a_, m_), (a0, m0), (a1, m1) = self.trend
+        if not np.all(np.isfinite([m_, m0, m1])) or m1 <= 0.0 or m1 >= m0 or a1 == a0 or a0 == a_:
+            return step
+        if (m0 - m1) / abs(a1 - a0) < SLOWING * (m_ - m0) / abs(a0 - a_):  # the elastic-plastic transition
+            return step
+        distance = m1 * abs(a1 - a0) / (m0 - m1)  # to the linear extrapolation's zero
+        if distance >= step:
+            return step
+        if self.shortest is None:
+            self.shortest = step / 4
+        return min(step, max(distance / 2, self.shortest))
 
 
 def words(onset: dict, at: str = "stroke_mm", place: str = "initial_xy_mm") -> str:
