@@ -13,8 +13,9 @@ Each command takes -q (the closing line, warnings and errors only) or -v (every 
 line, also on a terminal, where the default rewrites one line in place). The library logs
 through Python's logging (shellform.results.log) and prints nothing itself: the command shows its log.
 
-Exit status: 0 done, 2 input error, 3 stopped early, 128 + the signal when Ctrl-C or SIGTERM
-stopped it. Scenes: docs/scenes.md; results: docs/results.md; studies: docs/checked.md.
+Exit status: 0 done, 2 input error, 3 stopped early (a full disk included), 128 + the signal
+when Ctrl-C or SIGTERM stopped it. Scenes: docs/scenes.md; results: docs/results.md; studies:
+docs/checked.md.
 """
 
 import argparse
@@ -149,6 +150,7 @@ def main(argv=None) -> int:
     import logging
 
     from shellform.nonlinear.interrupt import Interrupted, stop_now
+    from shellform.results.disk import DiskFull
     from shellform.results.log import RESULT, console, quiet, say  # every line below once per run, on rank 0
 
     main_thread = threading.current_thread() is threading.main_thread()
@@ -181,6 +183,9 @@ def main(argv=None) -> int:
     except InputError as err:
         say(f"shellform: input error: {err}", file=sys.stderr)
         return 2
+    except DiskFull as err:  # outside a run's own handling (before stepping: run.json; a study)
+        say(f"shellform: disk full: {err}", file=sys.stderr)
+        return 3
     except Interrupted as err:  # outside a run's own handling (a study): its state is on disk
         say(f"shellform: {err}" + (f"; the last converged state: {err.checkpoint}" if err.checkpoint else ""),
             file=sys.stderr)

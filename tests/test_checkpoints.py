@@ -3,11 +3,14 @@ checkpoints written whole or not at all, the previous one kept; --out checked be
 computation; a run's folder its own; a resume refused for another state or a shorter stroke;
 the counts of the whole run; checkpoints that resume on another number of ranks."""
 
+import errno
 import io
 import json
 import logging
 import os
 import shutil
+import subprocess
+import sys
 import zipfile
 from pathlib import Path
 
@@ -138,6 +141,254 @@ def test_summaries_and_tables_survive_a_full_disk(tmp_path, monkeypatch):
     assert json.loads((tmp_path / "summary.json").read_text()) == {"a": 1}
     assert (tmp_path / "rows.csv").read_text().splitlines() == ["x", "1"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rows.csv", "summary.json"]
+
+
+# the short cup through the command: reports at 0.3 and 0.6 mm (a checkpoint at each), no timed ones
+DISK_CUP = ["--set", "mesh.n=6", "--set", "tools.stroke=1.0", "--set", "process.report=[0.3, 0.6]",
+            "--set", "process.initial_step_mm=0.05", "--set", "process.max_step_mm=0.1",
+            "--set", "output.checkpoint_every=0", "--set", "output.png=false", "--set", "output.fld=false",
+            "--set", "process.springback=false"]
+
+
+def _no_space(*args, **kwargs):
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def _run_cup(out, *settings):
+    return cli.main(["run", str(ROOT / "demos" / "square_cup.toml"), "--out", str(out), *DISK_CUP, *settings])
+
+
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize("failing", [1, 2])
+def test_a_full_disk_stops_the_run_keeping_the_last_complete_checkpoint(tmp_path, monkeypatch, capsys, failing):
+    """The checkpoint's write meets a full disk (np.savez raises ENOSPC) at the second report
+    (0.6 mm), or at the first (0.3 mm): the run stops there with exit 3 and one line on
+    stderr, no traceback; summary.json says "disk full at S mm" and which checkpoint is kept
+    (the one at 0.3 mm, whole and loadable, or that none was written yet); the tables after the
+    stroke are not written, nor any temporary file left (today: an OSError traceback, and for
+    the first checkpoint "the one before is kept", though there is none)."""
+    from shellform.nonlinear import checkpoint
+
+    real, calls = np.savez, []
+
+    def full_at_last(file, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == failing:
+            _no_space()
+        return real(file, *args, **kwargs)
+
+    monkeypatch.setattr(np, "savez", full_at_last)
+    out = tmp_path / "out"
+    rc = _run_cup(out, "--set", "output.vtx=false")
+    monkeypatch.undo()
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    stop = 0.3 * failing
+    assert rc == 3
+    assert "Traceback" not in captured.err + captured.out
+    assert len(err) == 1 and err[0].startswith(f"shellform: the run stopped early: disk full at {stop:g} mm: "), err
+    assert "No space left on device" in err[0]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped"].startswith(f"disk full at {stop:g} mm: the checkpoint {out / 'checkpoint.npz'} "
+                                         "could not be written (No space left on device); ")
+    assert summary["stroke_mm"] == pytest.approx(stop)
+    assert "the one before is kept" not in summary["stopped"]
+    if failing == 1:
+        assert summary["stopped"].endswith("; no checkpoint was written yet")
+        assert not (out / "checkpoint.npz").exists() and not (out / "checkpoint.previous.npz").exists()
+    else:
+        assert summary["stopped"].endswith(f"; the last complete checkpoint, {out / 'checkpoint.npz'} at 0.3 mm, "
+                                           "is kept: --resume continues from it once there is room")
+        saved = checkpoint.read(out)
+        assert saved.path == out / "checkpoint.npz" and not saved.damaged
+        assert float(saved.arrays["global.lam"]) == pytest.approx(0.3)
+    assert not list(out.glob("thickness_*.csv")) and not (out / "force_stroke.png").exists()
+    assert not [f for f in out.iterdir() if f.name.startswith(".")]
+
+
+@pytest.mark.timeout(300)
+def test_a_disk_without_room_for_the_next_write_stops_before_the_series_is_written(tmp_path, monkeypatch, capsys):
+    """After the first checkpoint (0.3 mm) the disk reports 1 MB free (shutil.disk_usage), less
+    than the room kept for a write: at the next report (0.6 mm) the run stops before the VTX
+    series (ADIOS2, which ends the process on a full disk) is written, with exit 3 and one line,
+    the checkpoint at 0.3 mm kept and summary.json written (today: the run went on and wrote)."""
+    from shellform.nonlinear import checkpoint
+    from shellform.results import cup as cup_results
+
+    saves, series = [], []
+    real_save, real_write, real_usage = checkpoint.save, cup_results.CupSeries.write, shutil.disk_usage
+
+    def save(*args, **kwargs):
+        path = real_save(*args, **kwargs)
+        saves.append(path)
+        return path
+
+    def write(self, stroke):
+        series.append(stroke)
+        return real_write(self, stroke)
+
+    def usage(path):
+        real = real_usage(path)
+        return real._replace(free=1_000_000) if saves else real
+
+    monkeypatch.setattr(checkpoint, "save", save)
+    monkeypatch.setattr(cup_results.CupSeries, "write", write)
+    monkeypatch.setattr(shutil, "disk_usage", usage)
+    out = tmp_path / "out"
+    rc = _run_cup(out, "--set", "output.vtx=true", "--set", "output.vtu=false")
+    monkeypatch.undo()
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert rc == 3 and "Traceback" not in captured.err + captured.out
+    assert series == [pytest.approx(0.3)] and len(saves) == 1
+    assert len(err) == 1 and err[0].startswith("shellform: the run stopped early: disk full at 0.6 mm: 1 MB free "
+                                               f"on the disk of {out}, less than the "), err
+    assert "kept for the report (" in err[0]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped"] == err[0][len("shellform: the run stopped early: "):]
+    assert summary["stopped"].endswith(f"the last complete checkpoint, {out / 'checkpoint.npz'} at 0.3 mm, is kept: "
+                                       "--resume continues from it once there is room")
+    assert [r["stroke_mm"] for r in summary["reports"]] == [pytest.approx(0.3), pytest.approx(0.6)]
+    assert float(checkpoint.read(out).arrays["global.lam"]) == pytest.approx(0.3)
+
+
+FULL_ON_RANK_0 = """
+import builtins, errno, sys
+sys.path.insert(0, "TESTS")
+from mpi4py import MPI
+from shellform import cli
+from test_checkpoints import ROOT, DISK_CUP
+real_open, calls = builtins.open, []
+
+def full_at_the_second_report(file, mode="r", *args, **kwargs):
+    if "w" in mode and str(file).split("/")[-1].startswith(".reports.json."):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+    return real_open(file, mode, *args, **kwargs)
+
+builtins.open = full_at_the_second_report
+rc = cli.main(["run", str(ROOT / "demos" / "square_cup.toml"), "--out", "OUT", *DISK_CUP, "--set", "output.vtx=false"])
+sys.exit(rc)
+"""
+
+
+@pytest.mark.mpi
+@pytest.mark.timeout(600)
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_a_full_disk_met_by_rank_0_alone_stops_both_ranks(tmp_path):
+    """Under mpiexec -n 2, reports.json (written by rank 0 alone) meets a full disk at the second
+    report: both ranks stop there together (the measured write shares its failure), exit 3,
+    one stop line, the checkpoint at 0.3 mm kept (before: a failure on rank 0 alone)."""
+    out = tmp_path / "out"
+    script = tmp_path / "run.py"
+    script.write_text(FULL_ON_RANK_0.replace("TESTS", str(Path(__file__).parent)).replace("OUT", str(out)))
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    proc = subprocess.run([mpiexec(), "-n", "2", sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=300, env=env)
+    assert proc.returncode == 3, proc.stderr[-3000:]
+    assert "Traceback" not in proc.stderr, proc.stderr[-3000:]
+    lines = [ln for ln in proc.stderr.splitlines() if ln.startswith("shellform: ")]
+    assert len(lines) == 1 and lines[0].startswith("shellform: the run stopped early: disk full at 0.6 mm: "
+                                                   f"{out / 'reports.json'} could not be written"), lines
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["ranks"] == 2 and summary["stopped"] == lines[0][len("shellform: the run stopped early: "):]
+    assert summary["stopped"].endswith(f"the last complete checkpoint, {out / 'checkpoint.npz'} at 0.3 mm, is kept: "
+                                       "--resume continues from it once there is room")
+
+
+SHEET = """title = "strip with a full disk"
+effects = ["bending", "membrane", "plasticity"]
+[geometry]
+lx = 1.0
+ly = 0.125
+[mesh]
+n = 4
+[material]
+E = 1000.0
+nu = 0.3
+thickness = 0.02
+hardening = "swift"
+K = 1.0
+eps0 = 1.0
+n = 0.0
+[supports]
+left = "clamped"
+top = "symmetry"
+bottom = "symmetry"
+[loads]
+pressure = 1.0e-4
+[process]
+initial_step = 0.25
+report = [0.5]
+[output]
+vtx = true
+vtu = true
+png = false
+"""
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("summary_fits", [True, False])
+def test_a_sheet_scene_stops_on_a_disk_without_room_with_its_summary(tmp_path, monkeypatch, capsys, summary_fits):
+    """A nonlinear sheet scene on a disk with 1 MB free: its first report's series is not
+    written; exit 3, one line, summary.json "disk full at load factor 0.5" and that no
+    checkpoint was written yet; where summary.json does not fit either (its write raises
+    ENOSPC), the one line says so (today: the run wrote on)."""
+    import builtins
+
+    scene = tmp_path / "sheet.toml"
+    scene.write_text(SHEET)
+    real_usage, real_open = shutil.disk_usage, builtins.open
+
+    def no_room_for_the_summary(file, mode="r", *args, **kwargs):
+        if "w" in mode and Path(file).name.startswith(".summary.json."):
+            _no_space()
+        return real_open(file, mode, *args, **kwargs)
+
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: real_usage(path)._replace(free=1_000_000))
+    if not summary_fits:
+        monkeypatch.setattr(builtins, "open", no_room_for_the_summary)
+    out = tmp_path / "out"
+    rc = cli.main(["run", str(scene), "--out", str(out)])
+    monkeypatch.undo()
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert rc == 3 and "Traceback" not in captured.err + captured.out
+    assert len(err) == 1 and err[0].startswith("shellform: the run stopped early: disk full at load factor 0.5: "), err
+    assert not [name for name in ("sheet.pvd", "nodal.bp", "increments.csv") if (out / name).exists()]
+    if not summary_fits:
+        assert err[0].endswith(f"; no checkpoint was written yet; summary.json could not be written "
+                               f"({out / 'summary.json'} could not be written (No space left on device))"), err
+        assert not (out / "summary.json").exists()
+        return
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped"].endswith("; no checkpoint was written yet")
+    assert [r["load_factor"] for r in summary["reports"]] == [pytest.approx(0.5)]
+
+
+@pytest.mark.timeout(60)
+def test_a_full_disk_before_stepping_is_one_line_and_exit_3(tmp_path, monkeypatch, capsys):
+    """run.json meets a full disk (its write raises ENOSPC): one line naming it, exit 3, before
+    the scene is meshed (today: an OSError traceback)."""
+    import builtins
+
+    _never_meshed(monkeypatch)
+    real_open = builtins.open
+
+    def full_for_run_json(file, mode="r", *args, **kwargs):
+        if "w" in mode and Path(file).name.startswith(".run.json."):
+            _no_space()
+        return real_open(file, mode, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "open", full_for_run_json)
+    out = tmp_path / "out"
+    rc = cli.main(["run", str(ROOT / "demos" / "square_cup.toml"), "--out", str(out)])
+    monkeypatch.undo()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 3
+    assert err == [f"shellform: disk full: {out / 'run.json'} could not be written (No space left on device)"]
+    assert not (out / "run.json").exists()
 
 
 def _never_meshed(monkeypatch):

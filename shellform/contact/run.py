@@ -60,6 +60,12 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
     run.json                 the run: scene file and hash, title, code version, started, resumed
 
 DX, DY, DD: shellform.results.cup.
+
+A full disk (results/disk.py: DiskFull, from a write or from the room the driver keeps before
+each checkpoint, report and the tables after the stroke) stops the run as a stop does: after
+the increment under way, the last complete checkpoint kept as it is, nothing more written but
+summary.json, its "stopped" saying "disk full at S mm: what could not be written and why" and
+which checkpoint is kept.
 """
 
 import json
@@ -76,6 +82,7 @@ from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
 from shellform.results import cup, fld, neck, run_folder
+from shellform.results.disk import DiskFull
 from shellform.results.log import Progress, say
 from shellform.results.summary import DrawingSummary
 from shellform.results.tables import write_csv, write_json
@@ -94,6 +101,11 @@ class FormingLimitReached(Exception):
     """The stroke ends: an element's margin to the forming-limit curve reached 0."""
 
 
+def _stroke_of(lam, travel) -> float:
+    """The punch's stroke (mm) of a checkpoint's load factor and the tools' travel."""
+    return float(lam) * abs(float(travel[0]))
+
+
 def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list, dict]:
     """Restore the last complete checkpoint in outdir (checkpoint.read: the previous one where
     the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
@@ -108,7 +120,7 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
         raise InputError("resume", f"the checkpoint {saved.path} was written for another scene, mesh or code: "
                                    f"{', '.join(differ)} differ")
     try:
-        at = float(saved.arrays["global.lam"]) * abs(float(saved.arrays["global.contact_travel"][0]))
+        at = _stroke_of(saved.arrays["global.lam"], saved.arrays["global.contact_travel"])
     except (KeyError, IndexError, TypeError, ValueError) as err:
         raise InputError("resume", f"the checkpoint {saved.path} is damaged ({type(err).__name__}: {err})") from None
     if at > s.tools.stroke * (1 + 1e-12) + 1e-12:
@@ -229,7 +241,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             raise neck.NeckReached
 
     def write_curve():
-        write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
+        with p.driver.room.write("force_stroke.csv"):
+            write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
 
     def checkpoint_now():
         """The curve so far, then the state it ends at: a resume takes the curve's rows up to the
@@ -247,73 +260,105 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if paths is not None:
             f = p.model.cell_fields()
             paths.record(p.stroke, f["major_strain"], f["minor_strain"], final=True)
-        write_json(outdir / "reports.json", reports)  # what a resumed run takes over
-        if series is not None:
-            series.write(p.stroke)
+        with p.driver.room.write("the report"):  # rank 0's writes after the collective ones
+            if series is not None:
+                series.write(p.stroke)
+            write_json(outdir / "reports.json", reports)  # what a resumed run takes over
 
+    def disk_full(err: DiskFull, when: str) -> str:
+        """A full disk's stop in one sentence: where, why, and which checkpoint is kept."""
+        found = comm.bcast(checkpoint.last_complete(outdir) if comm.rank == 0 else None, root=0)
+        g = found[1] if found else {}
+        at = f" at {_stroke_of(g['lam'], g['contact_travel']):.4g} mm" if "lam" in g and "contact_travel" in g else ""
+        resume = ": --resume continues from it once there is room" if found else ""
+        return f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}{resume}"
+
+    def after_the_stroke():
+        """The tables and pictures of the drawn cup, then the springback: (rim, limits, sprung);
+        an Interrupted springback sets stopped and signum."""
+        nonlocal stopped, signum
+        if p.driver.verbose:
+            say("shellform: writing the tables and pictures" + (", then the springback" if s.process.springback else ""))
+        lines = cup.thickness_lines(p)
+        for name, line in lines.items():
+            write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
+        cup.plot_thickness(outdir / "thickness.png", lines, f"{s.title}: stroke {p.stroke:.1f} mm")
+        rim = cup.write_rim(outdir, p, s.title) if tool_kinds.kind(s.tools.shape).RIM else None
+        cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
+        if s.output.png:
+            cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
+        limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
+        if paths is not None:
+            path = paths.critical(centres)
+            if path:
+                rows = [dict(zip(("stroke_mm", "major", "minor", "margin"), r))
+                        for r in zip(path["stroke_mm"], path["major"], path["minor"], path["margin"])]
+                write_csv(outdir / "strain_path.csv", rows, ["stroke_mm", "major", "minor", "margin"])
+                limits["strain_path"] = {"initial_xy_mm": path["initial_xy_mm"], "points": len(rows),
+                                         "end": {k: path[k][-1] for k in ("stroke_mm", "major", "minor", "margin")}}
+        if watch is not None:
+            limits["forming_limit_reached"] = watch.limit
+        sprung = None
+        if s.process.springback and stopped is None:
+            before = cup.profiles(p.initial_positions(), p.driver.displacements(), comm)
+            if p.driver.verbose:
+                say("shellform: springback: the tools withdraw")
+            try:
+                released = springback.release(p.driver)
+            except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
+                sprung = {"stopped": str(err)}
+                if isinstance(err, Interrupted):
+                    stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
+            else:
+                sprung = cup.springback(outdir, p, s.title, before, released)
+        return rim, limits, sprung
+
+    full = None  # the DiskFull that stopped the run
     try:
-        for target in sorted(set(s.process.report) | {1.0}):
-            if target <= p.driver.lam + 1e-12:
-                continue  # reached before the resumed state
-            p.driver.run(target, on_increment=on_increment)
+        try:
+            for target in sorted(set(s.process.report) | {1.0}):
+                if target <= p.driver.lam + 1e-12:
+                    continue  # reached before the resumed state
+                p.driver.run(target, on_increment=on_increment)
+                report()
+                checkpoint_now()
+        except FormingLimitReached:  # the stroke ends here, drawn as far as the sheet can go
+            p.driver.progress.note(f"shellform: the forming-limit curve is reached at {watch.limit['stroke_mm']:.4g} mm")
             report()
             checkpoint_now()
-    except FormingLimitReached:  # the stroke ends here, drawn as far as the sheet can go
-        p.driver.progress.note(f"shellform: the forming-limit curve is reached at {watch.limit['stroke_mm']:.4g} mm")
-        report()
-        checkpoint_now()
-    except neck.NeckReached:  # the stroke ends where the sheet starts to neck
-        p.driver.progress.note(f"shellform: the stroke ends: {neck.words(necks.onset)}")
-        report()
-        checkpoint_now()
-    except ConvergenceFailure as err:
-        stopped = str(err)
-        p.driver.progress.note(f"shellform: stopped: {err}")
-        report()
-        write_curve()
-    except Interrupted as err:  # the driver wrote the state; the curve up to it, and no report
-        stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal
-        p.driver.progress.note(f"shellform: {stopped}")
-        write_curve()
-        reports.append(state())  # in the summary only: a resumed run reports where the scene says
+        except neck.NeckReached:  # the stroke ends where the sheet starts to neck
+            p.driver.progress.note(f"shellform: the stroke ends: {neck.words(necks.onset)}")
+            report()
+            checkpoint_now()
+        except ConvergenceFailure as err:
+            stopped = str(err)
+            p.driver.progress.note(f"shellform: stopped: {err}")
+            report()
+            write_curve()
+        except Interrupted as err:  # the driver wrote the state; the curve up to it, and no report
+            stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal
+            p.driver.progress.note(f"shellform: {stopped}")
+            write_curve()
+            reports.append(state())  # in the summary only: a resumed run reports where the scene says
+    except DiskFull as err:  # after the increment under way; nothing more is written but the summary
+        full = err
+        stopped = (f"{stopped}; " if stopped else "") + disk_full(err, f"at {p.stroke:.4g} mm")
+        p.driver.progress.note(f"shellform: stopped: {stopped}")
+        if not reports or reports[-1]["stroke_mm"] != p.stroke:
+            reports.append(state())  # in the summary only, as at a signal
     p.driver.progress.close()
     if series is not None:
         series.close()
     d = p.driver
-    if d.verbose:
-        say("shellform: writing the tables and pictures" + (", then the springback" if s.process.springback else ""))
-    lines = cup.thickness_lines(p)
-    for name, line in lines.items():
-        write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
-    cup.plot_thickness(outdir / "thickness.png", lines, f"{s.title}: stroke {p.stroke:.1f} mm")
-    rim = cup.write_rim(outdir, p, s.title) if tool_kinds.kind(s.tools.shape).RIM else None
-    cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
-    if s.output.png:
-        cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
-    limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
-    if paths is not None:
-        path = paths.critical(centres)
-        if path:
-            rows = [dict(zip(("stroke_mm", "major", "minor", "margin"), r))
-                    for r in zip(path["stroke_mm"], path["major"], path["minor"], path["margin"])]
-            write_csv(outdir / "strain_path.csv", rows, ["stroke_mm", "major", "minor", "margin"])
-            limits["strain_path"] = {"initial_xy_mm": path["initial_xy_mm"], "points": len(rows),
-                                     "end": {k: path[k][-1] for k in ("stroke_mm", "major", "minor", "margin")}}
-    if watch is not None:
-        limits["forming_limit_reached"] = watch.limit
-    sprung = None
-    if s.process.springback and stopped is None:
-        before = cup.profiles(p.initial_positions(), p.driver.displacements(), comm)
-        if d.verbose:
-            say("shellform: springback: the tools withdraw")
+    rim, limits, sprung = None, {}, None  # as far as a full disk lets them come
+    if full is None:
         try:
-            released = springback.release(p.driver)
-        except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
-            sprung = {"stopped": str(err)}
-            if isinstance(err, Interrupted):
-                stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
-        else:
-            sprung = cup.springback(outdir, p, s.title, before, released)
+            d.room.check("the tables and pictures")
+            rim, limits, sprung = after_the_stroke()
+        except DiskFull as err:
+            stopped = (f"{stopped}; " if stopped else "") + disk_full(err, "writing the tables and pictures "
+                                                                           f"at {p.stroke:.4g} mm")
+            p.driver.progress.note(f"shellform: stopped: {stopped}")
     summary = DrawingSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
@@ -331,5 +376,5 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "cpu_time_s": comm.allreduce(time.process_time() - c0, op=MPI.SUM),
         "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
     }, outdir)
-    write_json(outdir / "summary.json", summary)
+    summary.write(comm)
     return summary

@@ -15,7 +15,9 @@ so that a run checkpointed on 1 rank continues on 2 and the reverse.
 The file is written whole or not at all (shellform.results.tables.write_atomically), and the
 previous generation is kept: CURRENT is renamed to PREVIOUS just before the new file takes
 its name, so that at every moment one complete checkpoint is on disk. read takes CURRENT and,
-where it is missing or damaged, PREVIOUS, and says which file was damaged and why.
+where it is missing or damaged, PREVIOUS, and says which file was damaged and why. A write
+that fails says which checkpoint is kept (kept_words), and on a full disk raises
+shellform.results.disk.DiskFull.
 """
 
 import hashlib
@@ -30,6 +32,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.errors import InputError
+from shellform.results.disk import DiskFull, is_full
 from shellform.results.tables import sync_folder, write_atomically
 
 CURRENT, PREVIOUS = "checkpoint.npz", "checkpoint.previous.npz"
@@ -83,7 +86,8 @@ def mesh_hash(V) -> str:
 def save(folder: Path, numbering: Numbering, state: dict, meta: dict) -> Path:
     """Gather `state` (the three groups) to rank 0 and write it, with `meta` (JSON-able values,
     each stored as a JSON string), as the folder's CURRENT checkpoint; the one before becomes
-    PREVIOUS. Collective; returns the path."""
+    PREVIOUS. Collective; returns the path. Where the write fails (on every rank): an OSError
+    saying which checkpoint is kept (the one before, or none yet), DiskFull on a full disk."""
     comm = numbering.comm
     folder = Path(folder)
     local = {"nodes": (numbering.nodes, state["nodes"]), "cells": (numbering.cells, state["cells"])}
@@ -109,11 +113,35 @@ def save(folder: Path, numbering: Numbering, state: dict, meta: dict) -> Path:
             os.replace(tmp, folder / CURRENT)
             sync_folder(folder)
         except OSError as err:
-            error = f"{type(err).__name__}: {err}"
+            full = is_full(err)
+            why = os.strerror(err.errno) if full else f"{type(err).__name__}: {err}"
+            error = (full, err.errno, f"the checkpoint {folder / CURRENT} could not be written ({why})",
+                     kept_words(last_complete(folder)))
     error = comm.bcast(error, root=0)
     if error is not None:
-        raise OSError(f"the checkpoint in {folder} could not be written ({error}); the one before is kept")
+        full, code, message, kept = error
+        raise DiskFull(message, code, kept) if full else OSError(f"{message}; {kept}")
     return folder / CURRENT
+
+
+def last_complete(folder: Path) -> tuple[Path, dict] | None:
+    """The newest checkpoint file in `folder` that opens (CURRENT, else PREVIOUS; each is written
+    whole or not at all) and its global values (the load factor "lam", ...); None without one.
+    Read where it is called (rank 0's view under MPI), not collective."""
+    for name in (CURRENT, PREVIOUS):
+        path = Path(folder) / name
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                return path, {k[len("global."):]: data[k] for k in data.files if k.startswith("global.")}
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile):
+            continue
+    return None
+
+
+def kept_words(found: tuple[Path, dict] | None, at: str = "") -> str:
+    """What is kept, in words: "the last complete checkpoint, PATH{at}, is kept", or that none
+    was written yet (found: last_complete's answer; at: where its state lies, as " at 0.5 mm")."""
+    return f"the last complete checkpoint, {found[0]}{at}, is kept" if found else "no checkpoint was written yet"
 
 
 @dataclass

@@ -30,6 +30,7 @@ from shellform.errors import InputError
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.interrupt import Interrupted, StopRequests
 from shellform.nonlinear.newton import Controls, Newton  # noqa: F401 (the driver's controls)
+from shellform.results.disk import Room
 from shellform.results.log import Progress
 from shellform.results.tables import write_json
 
@@ -75,6 +76,9 @@ class Driver(Newton):
         self.known_tolerance = max([0.0] + [p.known_tolerance for p in self.parts])
         self.swap_line_search = all(np.isinf(p.largest_move()) for p in self.parts)
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
+        # the room kept on the checkpoints' disk (results/disk.py): each checkpoint, and the run's
+        # series written there, refused before it starts where it might not fit
+        self.room = Room(self.checkpoint_dir, model.mesh.comm) if self.checkpoint_dir else None
         self.verbose, self.trace = verbose, trace
         self.progress = Progress()  # a run sets its own (label, total, unit)
         self.stops = StopRequests(model.mesh.comm)  # Ctrl-C and SIGTERM while it steps (interrupt.py)
@@ -330,13 +334,15 @@ class Driver(Newton):
         checkpoint_dir/checkpoint.npz, keeping the one before (shellform.nonlinear.checkpoint);
         and the history as history.json. Collective; safe at any time of a run (it writes the
         state of the last converged increment, not a Newton iterate). Returns the path (None
-        without a checkpoint_dir)."""
+        without a checkpoint_dir). Where the disk has not the room kept for it (self.room) or
+        fills meanwhile: DiskFull, the last complete checkpoint kept."""
         if self.checkpoint_dir is None:
             return None
         history = [asdict(h) for h in self.history]
-        path = checkpoint.save(self.checkpoint_dir, self.numbering(), self.checkpoint_state(),
-                               {"fingerprint": self.fingerprint, "history": history})
-        write_json(self.checkpoint_dir / "history.json", history)
+        with self.room.write("the checkpoint"):
+            path = checkpoint.save(self.checkpoint_dir, self.numbering(), self.checkpoint_state(),
+                                   {"fingerprint": self.fingerprint, "history": history})
+            write_json(self.checkpoint_dir / "history.json", history)
         return path
 
     def resume(self, saved: checkpoint.Checkpoint, lam_scale: float | None = None) -> None:

@@ -22,6 +22,12 @@ summary.json "neck" (plasticity): where the sheet starts to neck (results/neck.p
 where a cell's membrane stability reaches 0 (interpolated within the increment), the cell's
 initial x y and thickness strain there; null without a neck. With [process] stop_at_neck the
 load path ends at that increment (its state reported), as a finished run.
+
+A full disk (results/disk.py: DiskFull, from a write or from the room the driver keeps before
+each report's series and checkpoint and the fields after the path) stops the run after the
+increment under way: nothing more is written but summary.json, its "stopped" saying
+"disk full at load factor P: what could not be written and why" and which checkpoint is
+kept.
 """
 
 import time
@@ -38,9 +44,10 @@ from shellform.nonlinear.interrupt import Interrupted
 from shellform.nonlinear.problem import SheetProblem
 from shellform.scene import Scene
 from shellform.results import fields, neck, run_folder
+from shellform.results.disk import DiskFull
 from shellform.results.log import Progress
 from shellform.results.summary import SheetSummary
-from shellform.results.tables import write_csv, write_json
+from shellform.results.tables import write_csv
 
 
 def cell_functions(p: SheetProblem) -> dict:
@@ -113,7 +120,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
     def record():
         reports.append(_record(p, s))
         if series is not None:
-            series.write(p.driver.lam, p.driver.q, p.model.components, p.model.cell_fields())
+            with p.driver.room.write("the report"):
+                series.write(p.driver.lam, p.driver.q, p.model.components, p.model.cell_fields())
+
+    def disk_full(err: DiskFull, when: str) -> str:
+        """A full disk's stop in one sentence: where, why, and which checkpoint is kept."""
+        found = comm.bcast(checkpoint.last_complete(outdir) if comm.rank == 0 else None, root=0)
+        at = f" at load factor {float(found[1]['lam']):.6g}" if found and "lam" in found[1] else ""
+        return f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}"
 
     def on_increment(d):
         if necks is None:
@@ -128,27 +142,51 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         if d.next_step is not None:  # shorter steps ahead of the onset
             d.bound_next_step(necks.ahead(d.next_step))
 
+    full = None  # the DiskFull that stopped the run
     try:
-        for target in s.process.path:
-            # stop at every report point on the way to the target
-            lo, hi = sorted((p.driver.lam, target))
-            stops = [r for r in targets if lo < r < hi]
-            for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
-                p.driver.run(r, on_increment=on_increment)
-                record()
-    except neck.NeckReached:  # the load path ends where the sheet starts to neck
-        p.driver.progress.note(f"shellform: the load path ends: "
-                               f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
-        record()
-    except (ConvergenceFailure, Interrupted) as err:
-        stopped = str(err)
-        if isinstance(err, Interrupted):
-            signum = err.signal
-            stopped = f"{err} at load factor {p.driver.lam:.6g}"
+        try:
+            for target in s.process.path:
+                # stop at every report point on the way to the target
+                lo, hi = sorted((p.driver.lam, target))
+                stops = [r for r in targets if lo < r < hi]
+                for r in (stops if target > p.driver.lam else stops[::-1]) + [target]:
+                    p.driver.run(r, on_increment=on_increment)
+                    record()
+        except neck.NeckReached:  # the load path ends where the sheet starts to neck
+            p.driver.progress.note(f"shellform: the load path ends: "
+                                   f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
+            record()
+        except (ConvergenceFailure, Interrupted) as err:
+            stopped = str(err)
+            if isinstance(err, Interrupted):
+                signum = err.signal
+                stopped = f"{err} at load factor {p.driver.lam:.6g}"
+            p.driver.progress.note(f"shellform: stopped: {stopped}")
+            record()  # the last converged state, which the driver restored
+    except DiskFull as err:  # after the increment under way; nothing more is written but the summary
+        full = err
+        stopped = (f"{stopped}; " if stopped else "") + disk_full(err, f"at load factor {p.driver.lam:.6g}")
         p.driver.progress.note(f"shellform: stopped: {stopped}")
-        record()  # the last converged state, which the driver restored
+        if not reports or reports[-1]["load_factor"] != p.driver.lam:
+            reports.append(_record(p, s))  # in the summary only
     p.driver.progress.close()
     d = p.driver
+    if full is None:
+        try:
+            d.room.check("the tables and fields")
+            rows = [{"increment": h.number, "load_factor": h.lam, "step": h.dlam, "iterations": h.iterations,
+                     "first_residual": h.residuals[0], "last_residual": h.residuals[-1],
+                     "plastic_layers": h.plastic_layers, "cutbacks": h.cutbacks} for h in d.history]
+            write_csv(outdir / "increments.csv", rows, list(rows[0]) if rows else ["increment"])
+            if s.output.vtx:
+                with d.room.write("the fields"):
+                    fields.write_vtx(outdir, d.q, p.model.components, cell_functions(p))
+            if s.output.png:
+                fields.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
+        except DiskFull as err:
+            stopped = (f"{stopped}; " if stopped else "") + disk_full(err, "writing the tables and fields at "
+                                                                           f"load factor {d.lam:.6g}")
+            p.driver.progress.note(f"shellform: stopped: {stopped}")
     summary = SheetSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global,
@@ -158,13 +196,5 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         "neck": necks.onset if necks is not None else None,
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
     }, outdir)
-    rows = [{"increment": h.number, "load_factor": h.lam, "step": h.dlam, "iterations": h.iterations,
-             "first_residual": h.residuals[0], "last_residual": h.residuals[-1],
-             "plastic_layers": h.plastic_layers, "cutbacks": h.cutbacks} for h in d.history]
-    write_csv(outdir / "increments.csv", rows, list(rows[0]) if rows else ["increment"])
-    if s.output.vtx:
-        fields.write_vtx(outdir, d.q, p.model.components, cell_functions(p))
-    if s.output.png:
-        fields.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
-    write_json(outdir / "summary.json", summary)
+    summary.write(comm)
     return summary

@@ -28,6 +28,7 @@ from mpi4py import MPI
 
 import shellform
 from shellform.errors import InputError
+from shellform.results.disk import DiskFull
 from shellform.results.tables import write_json
 
 MANIFEST = "run.json"
@@ -164,7 +165,8 @@ def read_manifest(outdir: Path) -> dict | None:
 def start(outdir: Path, s, scene_path=None, resume: bool = False, comm=MPI.COMM_WORLD) -> dict | None:
     """Check outdir (check_writable), and make it this run's: without resume, refuse another
     scene's run or clear the older run's outputs, and write run.json (returned). With resume
-    nothing changes yet: the resume's checks come first, then resumed() updates run.json."""
+    nothing changes yet: the resume's checks come first, then resumed() updates run.json.
+    DiskFull on every rank where run.json finds no room."""
     outdir = Path(outdir)
     check_writable(outdir, comm)
     if comm.rank == 0:
@@ -174,7 +176,7 @@ def start(outdir: Path, s, scene_path=None, resume: bool = False, comm=MPI.COMM_
         return None
     scene_path = str(Path(scene_path).resolve()) if scene_path else None
     digest = scene_hash(s)
-    error, manifest = None, None
+    error, full, manifest = None, None, None
     if comm.rank == 0:
         old = read_manifest(outdir)
         if old and old.get("scene") and scene_path and old["scene"] != scene_path \
@@ -186,10 +188,15 @@ def start(outdir: Path, s, scene_path=None, resume: bool = False, comm=MPI.COMM_
             manifest = {"scene": scene_path, "scene_hash": digest, "title": s.title,
                         "code_version": code_version(), "started": now, "resumed": []}
             clear(outdir)
-            write_json(outdir / MANIFEST, manifest)
-    error, manifest = comm.bcast((error, manifest), root=0)
+            try:
+                write_json(outdir / MANIFEST, manifest)
+            except DiskFull as err:  # on every rank, below
+                full = (err.strerror, err.errno)
+    error, full, manifest = comm.bcast((error, full, manifest), root=0)
     if error:
         raise InputError("--out", error)
+    if full:
+        raise DiskFull(*full)
     return manifest
 
 

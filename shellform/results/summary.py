@@ -7,16 +7,22 @@ Summary: a dict holding exactly what summary.json holds, which also knows
                      cells, the route's result in a few numbers (and where the sheet started to
                      neck, summary.json "neck", if it did), the time, the output folder
     stop_line()      where the run stopped early (no convergence, a limit load, Ctrl-C,
-                     SIGTERM), the line for stderr; None when it ran to its end
+                     SIGTERM, a full disk), and that summary.json could not be written where
+                     it could not: the line for stderr; None when it ran to its end
     exit_status()    0 when it ran to its end, 128 + the signal when a signal stopped it, 3
-                     when it stopped otherwise (docs/reliability.md)
+                     when it stopped otherwise or its summary could not be written
+                     (docs/reliability.md)
+    write()          summary.json, or, where it cannot be written, why (for stop_line)
 
 so that the command line prints and returns without asking which route ran.
 """
 
 from pathlib import Path
 
+from mpi4py import MPI
+
 from shellform.results import neck
+from shellform.results.tables import write_json
 
 
 def printable(text: str) -> str:
@@ -30,15 +36,28 @@ class Summary(dict):
     def __init__(self, content: dict, outdir):
         super().__init__(content)
         self.outdir = Path(outdir)
+        self.unwritten = None  # why summary.json could not be written (write)
+
+    def write(self, comm=MPI.COMM_WORLD) -> None:
+        """summary.json (rank 0); where it cannot be written (a full disk), the reason is kept
+        in `unwritten` on every rank, for the stop line, and the run ends as stopped. Collective."""
+        error = None
+        try:
+            write_json(self.outdir / "summary.json", self)
+        except OSError as err:
+            error = str(err)
+        self.unwritten = comm.bcast(error, root=0)
 
     def closing_line(self) -> str:
         return f"shellform: {printable(self['title'])}: {self['cells']} cells; results in {self.outdir}"
 
     def stop_line(self) -> str | None:
-        return f"shellform: the run stopped early: {self['stopped']}" if self.get("stopped") else None
+        said = ([f"the run stopped early: {self['stopped']}"] if self.get("stopped") else []) \
+            + ([f"summary.json could not be written ({self.unwritten})"] if self.unwritten else [])
+        return "shellform: " + "; ".join(said) if said else None
 
     def exit_status(self) -> int:
-        if not self.get("stopped"):
+        if not self.get("stopped") and not self.unwritten:
             return 0
         return 128 + self["signal"] if self.get("signal") else 3
 

@@ -2,7 +2,8 @@
 
 Every file is written whole or not at all (write_atomically): into a temporary file in the same
 folder, flushed and synced to the disk, then renamed over the final name, and the folder synced;
-a kill or a full disk during the write leaves the previous file as it was (docs/reliability.md).
+a kill or a full disk during the write leaves the previous file as it was, and a full disk
+(ENOSPC, EDQUOT) is raised as disk.DiskFull naming the file (docs/reliability.md).
 A rename replaces a link at the final name and never writes through it: pictures are written
 the same way (write_figure, write_screenshot).
 """
@@ -16,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
+
+from shellform.results.disk import DiskFull, is_full
 
 
 def sync_folder(folder: Path) -> None:
@@ -35,7 +38,8 @@ def sync_folder(folder: Path) -> None:
 
 def write_atomically(path: Path, write, binary: bool = False) -> None:
     """Call write(f) on a temporary file next to `path`, flush and fsync it, then os.replace it
-    onto `path` and fsync the folder: readers see the old file or the new one, never a part."""
+    onto `path` and fsync the folder: readers see the old file or the new one, never a part.
+    A full disk or quota: DiskFull naming `path`, the file before it left as it was."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     tmp.unlink(missing_ok=True)  # a kill's leftover, or a link: the file is created anew, not opened through one
@@ -45,8 +49,10 @@ def write_atomically(path: Path, write, binary: bool = False) -> None:
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as err:
         tmp.unlink(missing_ok=True)
+        if isinstance(err, OSError) and not isinstance(err, DiskFull) and is_full(err):
+            raise DiskFull(f"{path} could not be written ({os.strerror(err.errno)})", err.errno) from err
         raise
     sync_folder(path.parent)
 
