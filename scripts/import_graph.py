@@ -4,11 +4,12 @@ says of it.
     python scripts/import_graph.py [ROOT]    # the report: lines per folder, the largest modules
                                              # and classes, upward arrows, circles
 
-A module is a file of shellform/ (and of forms/, installed as shellform.forms). An arrow a -> b
-is an import of b in a, at the top of a or inside one of its functions: ``import shellform.x.y``
-and ``from shellform.x.y import name`` point to shellform.x.y, ``from shellform.x import y`` to
-the module shellform.x.y where y is one, else to the package shellform.x (its __init__). The
-parents a module's import runs implicitly (shellform, shellform.x) are not arrows.
+A module is a file of shellform/ (and of forms/, installed as shellform.forms, and
+demos/__init__.py, installed as shellform.demos). An arrow a -> b is an import of b in a, at
+the top of a or inside one of its functions: ``import shellform.x.y`` and ``from shellform.x.y
+import name`` point to shellform.x.y, ``from shellform.x import y`` to the module shellform.x.y
+where y is one, else to the package shellform.x (its __init__). The parents a module's import
+runs implicitly (shellform, shellform.x) are not arrows.
 
 The layers are docs/design.md's fenced block that begins with the line ``layers (top to
 bottom)``: one layer per line, its modules or packages by name separated by spaces (a package
@@ -27,7 +28,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def modules(root: Path = ROOT) -> dict[str, Path]:
-    """Dotted name -> file of every module of shellform and shellform.forms."""
+    """Dotted name -> file of every module of shellform and shellform.forms, and shellform.demos
+    (demos/__init__.py, the scenes' accessor; the literate demos beside it are scripts)."""
     found = {}
     for base, prefix in ((root / "shellform", "shellform"), (root / "forms", "shellform.forms")):
         for path in sorted(base.rglob("*.py")):
@@ -35,6 +37,8 @@ def modules(root: Path = ROOT) -> dict[str, Path]:
             if parts[-1] == "__init__":
                 parts = parts[:-1]
             found[".".join([prefix, *parts])] = path
+    if (root / "demos" / "__init__.py").is_file():
+        found["shellform.demos"] = root / "demos" / "__init__.py"
     return found
 
 

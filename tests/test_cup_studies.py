@@ -11,11 +11,15 @@ import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 import csv
 import json
 import math
+from pathlib import Path
 
 import pytest
 
-from shellform.studies import cup_accuracy, numisheet_cost
+from shellform.errors import InputError
+from shellform.studies import cup_accuracy, cup_paper, numisheet_cost
 from shellform.studies.cup_hard import folder
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_picks_take_the_cheapest_run_within_each_tolerance():
@@ -34,12 +38,23 @@ def test_picks_take_the_cheapest_run_within_each_tolerance():
 def test_numisheet_cost_reference_is_the_converged_answer():
     """The reference of each answer: the cup-convergence study's Richardson estimate where it
     found an order, else its finest mesh's value, with the uncertainty it states."""
-    ref = numisheet_cost.reference()
+    ref = numisheet_cost.reference(ROOT / "docs" / "results" / numisheet_cost.ESTIMATES)
     assert set(ref) == set(numisheet_cost.answers())
     assert ref["DX_15"][0] == pytest.approx(5.15221) and ref["DX_15"][1] == pytest.approx(0.00416298)
     assert ref["DX_15"][2].startswith("Richardson")
     assert ref["DD_15"][0] == pytest.approx(2.89934) and ref["DD_15"][1] == pytest.approx(0.0124559)
     assert ref["DD_15"][2] == "finest mesh, no order"
+
+
+def test_studies_of_other_studies_results_read_them_beside_out_before_any_run(tmp_path):
+    """numisheet-cost's reference (cup-convergence's estimates) and cup-paper's runs (cup-mesh's,
+    cup-hard's) lie in the folders beside --out, as docs/results/ holds them; where they are
+    missing the study says which to run, before its first run."""
+    with pytest.raises(InputError, match="study cup-convergence --out .*cup_convergence"):
+        numisheet_cost.run(tmp_path / "numisheet_cost")
+    with pytest.raises(InputError, match="study cup-mesh --out .*cup_mesh.* cup-hard --out .*cup_hard"):
+        cup_paper.run(tmp_path / "cup_paper")
+    assert not (tmp_path / "numisheet_cost").exists() and not (tmp_path / "cup_paper").exists()
 
 
 def test_numisheet_cost_picks_credit_no_more_than_the_reference_vouches_for():

@@ -100,11 +100,10 @@ def test_a_narrow_waist_is_pulled_in_uniaxial_tension_the_whole_disc_equibiaxial
 def test_stopping_at_the_forming_limit_needs_a_tool_scene_with_plasticity():
     """A plate's scene (no tools, no plasticity) that asks to stop at the forming limit: an
     error naming the key, before anything is solved."""
-    from shellform import scene
+    from shellform import demos, scene
     from shellform.errors import InputError
-    from shellform.studies import nakajima
 
     with pytest.raises(InputError) as err:
-        scene.load(nakajima.ROOT / "demos" / "clamped_disc_large_deflection.toml").changed(
+        scene.load(demos.path("clamped_disc_large_deflection.toml")).changed(
             {"process.stop_at_forming_limit": True})
     assert err.value.field == "process.stop_at_forming_limit"

@@ -1,14 +1,25 @@
-"""Packaging: forms/ installs as shellform.forms, and every package folder is in the wheel."""
+"""Packaging: forms/ installs as shellform.forms, demos/ as shellform.demos (the scenes as
+package data), and every package folder is in the wheel."""
 
+import ast
 import os
+import re
+import shutil
 import subprocess
 import sys
 import tomllib
+import zipfile
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+# a scene or a file a scene names, as the studies write its name (csv files are their outputs)
+DEMO_FILE = re.compile(r"[\w/.-]*\w\.(toml|geo|msh|step|stp|stl|brep)")
+# the scenes and files of the studies (issue 47 item 8); the studies' own list must hold them
+STUDY_FILES = {"numisheet93_aluminium.toml", "numisheet93_steel.toml", "numisheet93_aluminium_graded.toml",
+               "square_cup.toml", "esaform2021_cup.toml", "nakajima.toml", "meshes/nakajima/specimen.geo",
+               "meshes/curved_beam.geo", "meshes/square_cup_graded.geo"}
 
 
 def test_forms_install_as_shellform_forms(tmp_path):
@@ -24,11 +35,112 @@ def test_forms_install_as_shellform_forms(tmp_path):
 
 
 def test_every_package_folder_is_listed():
+    """Every package of shellform, forms/ and demos/, and each folder under demos/meshes (a data
+    folder that setuptools would warn of as a package left out), and the demos' data globs."""
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     listed = set(config["packages"])
     found = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "shellform").rglob("__init__.py")}
-    assert found | {"shellform.forms"} == listed
-    assert config["package-dir"] == {"shellform.forms": "forms"}
+    meshes = {"shellform.demos." + ".".join(d.relative_to(ROOT / "demos").parts)
+              for d in [ROOT / "demos" / "meshes", *(ROOT / "demos" / "meshes").rglob("*")] if d.is_dir()}
+    assert found | {"shellform.forms", "shellform.demos"} | meshes == listed
+    assert config["package-dir"] == {"shellform.forms": "forms", "shellform.demos": "demos"}
+    assert config["package-data"] == {"shellform.demos": ["*.toml", "meshes/**/*"]}
+
+
+def _study_files() -> set:
+    """The demo files the studies name (string constants of shellform/studies), and the files
+    those scenes name in turn (relative to demos/)."""
+    names = {n.value for f in (ROOT / "shellform" / "studies").glob("*.py") for n in ast.walk(ast.parse(f.read_text()))
+             if isinstance(n, ast.Constant) and isinstance(n.value, str) and DEMO_FILE.fullmatch(n.value)}
+    return names | {f for n in names if n.endswith(".toml") for f in _named_files(ROOT / "demos" / n)}
+
+
+def _named_files(scene_file: Path) -> list:
+    """The files a scene names (geometry.file, material's curves, the tools' files), relative to it."""
+    data = tomllib.loads(scene_file.read_text())
+    section = lambda name: data.get(name) if isinstance(data.get(name), dict) else {}  # noqa: E731
+    named = [section("geometry").get("file"),
+             *(section("material").get(k) for k in ("flow_curve", "forming_limit_curve")),
+             *(section("tools").get(k) for k in ("punch_file", "die_file"))]
+    return [n for n in named if isinstance(n, str) and n]
+
+
+def test_the_studies_find_their_scenes_through_shellform_demos():
+    """shellform.demos.path finds every scene the studies draw and every file those name, beside
+    itself (where a wheel ships them and an editable install maps demos/); every demo scene names
+    only files under meshes/, which the package data ships."""
+    from shellform import demos
+
+    needed = _study_files()
+    assert STUDY_FILES <= needed
+    for name in needed:
+        found = demos.path(name)
+        assert found.is_file() and found.relative_to(demos.HERE).as_posix() == name
+    for scene_file in sorted((ROOT / "demos").glob("*.toml")):
+        for name in _named_files(scene_file):
+            assert name.startswith("meshes/") and (ROOT / "demos" / name).is_file(), (scene_file.name, name)
+    with pytest.raises(FileNotFoundError, match="no demo file 'nothing.toml'"):
+        demos.path("nothing.toml")
+
+
+def test_no_module_reaches_the_source_tree():
+    """No module of the package (shellform/, forms/, demos/__init__.py) finds a file by walking up
+    from itself (`parents[...]`, `.parent / "demos"`): that tree exists only in a clone. The demos'
+    files come through shellform.demos.path, another study's results from beside --out."""
+    sources = [*(ROOT / "shellform").rglob("*.py"), *(ROOT / "forms").rglob("*.py"), ROOT / "demos" / "__init__.py"]
+    walks = re.compile(r"\.parents\s*\[|\.parent\s*/\s*[\"'](demos|forms|docs|shellform)\b|[\"']\.\./")
+    found = [f"{p.relative_to(ROOT)}:{i}: {line.strip()}" for p in sources
+             for i, line in enumerate(p.read_text().splitlines(), 1) if walks.search(line)]
+    assert found == []
+    assert walks.search('ROOT = Path(__file__).resolve().parents[2]') and walks.search('root.parent / "forms"')
+
+
+@pytest.mark.slow
+def test_the_wheel_holds_the_scenes_and_a_study_runs_from_it(tmp_path):
+    """The wheel built from the sources (pip, offline, no build isolation) holds the demos'
+    scenes and the files they name; installed into a folder of its own, a study imported from it
+    finds its scenes there, and `shellform study yld2000-fit` runs from it in a folder outside
+    the clone."""
+    setuptools = pytest.importorskip("setuptools")
+    if int(setuptools.__version__.split(".")[0]) < 77:
+        pytest.skip(f"setuptools {setuptools.__version__}: the build needs 77 (pyproject's build-system)")
+    src = tmp_path / "src"  # a copy, so that the build leaves no build/ or egg-info in the clone
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        (src / name).parent.mkdir(exist_ok=True)
+        shutil.copy(ROOT / name, src / name)
+    for name in ("shellform", "forms", "demos"):
+        shutil.copytree(ROOT / name, src / name, ignore=shutil.ignore_patterns("__pycache__"))
+    built = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-v",
+                            str(src), "-w", str(tmp_path / "wheel")], capture_output=True, text=True)
+    assert built.returncode == 0, built.stdout + built.stderr
+    # -v shows setuptools' warnings: none of a data folder it could import as a package left out
+    assert "is absent from the `packages` configuration" not in built.stdout + built.stderr
+    (wheel,) = (tmp_path / "wheel").glob("shellform-*.whl")
+    names = set(zipfile.ZipFile(wheel).namelist())
+    shipped = {n.removeprefix("shellform/demos/") for n in names if n.startswith("shellform/demos/")}
+    demos = ROOT / "demos"
+    every = {p.relative_to(demos).as_posix() for p in [*demos.glob("*.toml"), *demos.glob("*.py"),
+                                                       *(demos / "meshes").rglob("*")] if p.is_file()}
+    assert _study_files() <= shipped and STUDY_FILES <= shipped
+    assert every == shipped  # the scenes, the files they name, the literate demos and __init__.py
+    assert "shellform/forms/functional.py" in names
+
+    target = tmp_path / "site"
+    installed = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--no-index", "-q",
+                                "--target", str(target), str(wheel)], capture_output=True, text=True)
+    assert installed.returncode == 0, installed.stderr
+    away = tmp_path / "elsewhere"
+    away.mkdir()
+    code = ("import sys\nfrom shellform import demos, cli\nfrom shellform.studies import nakajima, locking, yld2000_fit\n"
+            "print(demos.HERE, nakajima.SCENE, nakajima.SPECIMEN, locking.BEAM_GEO, yld2000_fit.SCENE)\n"
+            "sys.exit(cli.main(['study', 'yld2000-fit', '--out', 'fit', '-q']))\n")
+    env = {**os.environ, "PYTHONPATH": str(target)}
+    out = subprocess.run([sys.executable, "-c", code], cwd=away, env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    here, *paths = map(Path, out.stdout.split("\n")[0].split())
+    assert here == (target / "shellform" / "demos").resolve()
+    assert all(p.is_file() and p.is_relative_to(here) for p in paths)
+    assert (away / "fit" / "residuals.csv").is_file()
 
 
 def test_one_blas_thread_unless_the_user_sets_it():

@@ -15,6 +15,7 @@ fingerprint      what defines a run's state (scene content but for the knobs of 
 """
 
 import hashlib
+import importlib.util
 import json
 import os
 import shutil
@@ -111,12 +112,18 @@ def scene_hash(s) -> str:
 @lru_cache(maxsize=1)
 def code_version() -> str:
     """shellform's version and a hash of its sources (the package and its forms): any change of
-    the code gives another version."""
+    the code gives another version. Each folder is the one the import system finds (a wheel holds
+    forms/ inside the package, the clone beside it), never a guess beside the package (in a wheel
+    that is site-packages); the demos (shellform.demos: scenes and literate scripts) are data, not
+    code, and left out, so that the same code has the same version in every kind of install."""
     root = Path(shellform.__file__).resolve().parent
+    forms = Path(importlib.util.find_spec("shellform.forms").origin).resolve().parent
+    inside = [root / "forms", root / "demos"]  # a wheel's; hashed as their own folder, or not at all
     h = hashlib.sha256()
-    folders = [root] + [f for f in (root / "forms", root.parent / "forms") if f.is_dir()]
-    for folder in folders:
+    for folder in (root, forms):
         for f in sorted(folder.rglob("*.py")):
+            if folder == root and any(f.is_relative_to(d) for d in inside):
+                continue
             h.update(str(f.relative_to(folder)).encode())
             h.update(f.read_bytes())
     return f"{shellform.__version__}+src.{h.hexdigest()[:12]}"

@@ -16,12 +16,11 @@ converged state.
 
 from pathlib import Path
 
-from shellform import scene
+from shellform import demos, scene
 from shellform.contact.run import run as run_cup
 from shellform.results.log import say
 from shellform.results.tables import write_csv
 
-ROOT = Path(__file__).resolve().parents[2]
 COLUMNS = ["case", "n", "stroke_mm", "target_mm", "finished", "increments", "newton_iterations", "cutbacks",
            "wall_s", "peak_punch_force_kN", "min_thickness_strain", "stopped"]
 
@@ -30,7 +29,7 @@ def variant(n: int, name: str = "square_cup.toml", **changes) -> scene.Scene:
     """A demo scene on an n x n quarter mesh with changes section__key=value or effects=[...]
     (no VTX output, no springback: the studies compare the drawn state), checked as a scene
     file is (Scene.changed)."""
-    return scene.load(ROOT / "demos" / name).changed({
+    return scene.load(demos.path(name)).changed({
         "mesh.n": n, "output.vtx": False, "process.springback": False,
         **{key.replace("__", "."): value for key, value in changes.items()}})
 
@@ -65,7 +64,7 @@ def row(name: str, s: scene.Scene, out: Path) -> dict:
 
 def cases(n: int = 16) -> dict:
     """The hard variants of the paper's cup scene on an n x n quarter mesh."""
-    big = 10 * scene.load(ROOT / "demos" / "square_cup.toml").process.max_step_mm
+    big = 10 * scene.load(demos.path("square_cup.toml")).process.max_step_mm
     variant_n = lambda **changes: variant(n, **changes)  # noqa: E731
     return {
         "mu 0.3": variant_n(tools__friction=0.3),

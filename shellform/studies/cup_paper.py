@@ -21,9 +21,10 @@ import csv
 import json
 from pathlib import Path
 
+from shellform.errors import InputError
 from shellform.results.log import say
 from shellform.results.tables import write_csv
-from shellform.studies.cup_hard import ROOT, draw, folder, variant
+from shellform.studies.cup_hard import draw, folder, variant
 
 FRICTION = (0.0, 0.05, 0.1, 0.15, 0.2)
 MESHES = ("n 12", "n 16", "n 24")
@@ -39,19 +40,30 @@ def friction_runs() -> dict:
             for mu in FRICTION if mu != 0.1}
 
 
-def run(out: Path, meshes: Path = ROOT / "docs/results/cup_mesh", hard: Path = ROOT / "docs/results/cup_hard"):
+def run(out: Path, meshes: Path | None = None, hard: Path | None = None):
+    """The friction runs into out, then the figures; meshes and hard: the cup-mesh and cup-hard
+    studies' folders, by default beside out (as the commands above place them), checked before
+    the first run."""
     out = Path(out)
+    meshes = Path(out.resolve().parent / "cup_mesh" if meshes is None else meshes)
+    hard = Path(out.resolve().parent / "cup_hard" if hard is None else hard)
+    needed = [folder(meshes, name) for name in MESHES] + [folder(hard, "BHF 4t, die radius 20 mm")]
+    missing = [str(d) for d in needed if not (d / "summary.json").is_file()]
+    if missing:
+        raise InputError("--out", f"no run in {', '.join(missing)}: run `shellform study cup-mesh --out {meshes}` "
+                                  f"and `shellform study cup-hard --out {hard}` first")
     out.mkdir(parents=True, exist_ok=True)
     for name, s in friction_runs().items():
         say(f"cup-paper: {name}")
         draw(name, s, out)
-    return figures(out, Path(meshes), Path(hard))
+    return figures(out, meshes, hard)
 
 
 def _shown(d: Path) -> str:
-    """A run's folder as the table shows it: from the repository's root when it lies inside."""
+    """A run's folder as the table shows it: from the working folder when it lies inside (the
+    clone's root, where the commands above run)."""
     try:
-        return str(Path(d).resolve().relative_to(ROOT.resolve()))
+        return str(Path(d).resolve().relative_to(Path.cwd().resolve()))
     except ValueError:
         return str(d)
 

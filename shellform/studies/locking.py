@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from shellform import linear
+from shellform import demos, linear
 from shellform.material import Hill79Material
 from shellform.nonlinear.driver import Controls, ConvergenceFailure
 from shellform.nonlinear.loads import SheetLoads
@@ -54,7 +54,7 @@ ROOF_LEVELS = (8, 16, 32, 64)
 ROOF_OVERKILL = {"linear": 128, "sheet": 128}
 BEAM_LEVELS = ((6, 1), (12, 2), (24, 4), (48, 8))  # divisions along the arc, across
 BEAM_REFERENCE = {"in-plane": 0.08734, "out-of-plane": 0.5022}
-BEAM_GEO = Path(__file__).resolve().parents[2] / "demos" / "meshes" / "curved_beam.geo"
+BEAM_GEO = demos.path("meshes/curved_beam.geo")
 LEVELS = (ROLLUP_LEVELS, ROOF_LEVELS, BEAM_LEVELS)
 QUICK_LEVELS = ((16,), (8, 16), ((6, 1),))
 COLUMNS = ["case", "element", "membrane", "thickness", "n", "cells", "value", "reference", "error", "rate",

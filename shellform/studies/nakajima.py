@@ -26,14 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from shellform import scene
+from shellform import demos, scene
 from shellform.contact.run import run as run_cup
 from shellform.results.log import say
 from shellform.results.tables import write_csv
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENE = ROOT / "demos" / "nakajima.toml"
-SPECIMEN = ROOT / "demos" / "meshes" / "nakajima" / "specimen.geo"
+SCENE = demos.path("nakajima.toml")
+SPECIMEN = demos.path("meshes/nakajima/specimen.geo")
 WIDTHS = (20, 40, 60, 80, 100, 110, 120, 130, 140, 160, 180)  # mm; 180: the whole disc
 LEVEL = 24
 QUICK_LEVELS = (8,)  # --quick: a narrow waist and the whole disc on a coarse mesh

@@ -12,7 +12,8 @@ one choice each:
 
 The reference is the converged answer, not the finest run: per answer the Richardson estimate
 q* with its uncertainty u over the three finest meshes of the cup-convergence study
-(docs/results/cup_convergence/cup_convergence_estimates.csv, docs/cup-convergence.md); where
+(cup_convergence_estimates.csv in the folder cup_convergence beside --out: the clone keeps it
+in docs/results/cup_convergence, docs/cup-convergence.md); where
 that study found no order (differences that change sign), the finest mesh's value with the
 spread of the three as u. A run's error in an answer is e = (q - q*) / |q*|; it is *within* a
 tolerance tol where |e| + u / |q*| <= tol, so that no run is credited with more accuracy than
@@ -37,16 +38,17 @@ import os
 import shutil
 from pathlib import Path
 
-from shellform import scene
+from shellform import demos, scene
+from shellform.errors import InputError
 from shellform.results.log import say
 from shellform.results.tables import write_csv
-from shellform.studies.cup_hard import ROOT, draw, folder, variant
+from shellform.studies.cup_hard import draw, folder, variant
 
 SCENE = "numisheet93_aluminium.toml"
 GRADED = "numisheet93_aluminium_graded.toml"
 LEVELS = (8, 12, 16, 24, 35)
 VARIED = (16, 24)  # the meshes on which the step, the thickness points and rtol are varied
-REFERENCE = ROOT / "docs" / "results" / "cup_convergence" / "cup_convergence_estimates.csv"
+ESTIMATES = Path("cup_convergence") / "cup_convergence_estimates.csv"  # the cup-convergence study's, beside --out
 MEASURES = ("DX", "DY", "DD", "force")
 TOLERANCES = (0.01, 0.02, 0.05)
 
@@ -56,10 +58,13 @@ def answers(at=("15", "40")) -> tuple[str, ...]:
     return tuple(f"{q}_{mm}" for mm in at for q in MEASURES) + ("min_thickness_strain",)
 
 
-def reference(path: Path = REFERENCE, case: str = "aluminium") -> dict:
-    """{answer: (q*, u, source)} from the cup-convergence study's estimates: the Richardson
-    estimate where it has one, else the finest mesh's value with the spread as u."""
+def reference(path: Path, case: str = "aluminium") -> dict:
+    """{answer: (q*, u, source)} from the cup-convergence study's estimates (the file `path`):
+    the Richardson estimate where it has one, else the finest mesh's value with the spread as u."""
     out = {}
+    if not Path(path).is_file():
+        raise InputError("--out", f"no {path}: the reference is the cup-convergence study's estimates; run "
+                                  f"`shellform study cup-convergence --out {Path(path).parent}` first")
     with open(path) as f:
         for r in csv.DictReader(f):
             if r["case"] != case:
@@ -77,7 +82,7 @@ def runs(levels=LEVELS, varied=VARIED, graded: bool = True, stroke=None) -> list
     short = {"tools__stroke": stroke} if stroke is not None else {}
     out = [(f"n {n}", variant(n, SCENE, **short)) for n in levels]
     if graded:
-        s = scene.load(ROOT / "demos" / GRADED).changed({"output.vtx": False, "process.springback": False,
+        s = scene.load(demos.path(GRADED)).changed({"output.vtx": False, "process.springback": False,
                                                           **{k.replace("__", "."): v for k, v in short.items()}})
         out.append(("graded", s))
     for n in varied:
@@ -96,11 +101,14 @@ def runs(levels=LEVELS, varied=VARIED, graded: bool = True, stroke=None) -> list
 
 
 def run(out: Path, levels=LEVELS, varied=VARIED, graded: bool = True, stroke=None, fresh: bool = True,
-        threads: int = 1) -> list[dict]:
-    """Draw every run (draw_all) and write the table against the converged answers."""
+        threads: int = 1, estimates=None) -> list[dict]:
+    """Draw every run (draw_all) and write the table against the converged answers: those of
+    `estimates`, by default the cup-convergence study's beside out (out/../ESTIMATES), read
+    before the first run."""
+    ref = reference(Path(out).resolve().parent / ESTIMATES if estimates is None else estimates)
     runs_ = runs(levels, varied, graded, stroke)
     draw_all(out, runs_, fresh, threads)
-    return table(out, runs_, reference())
+    return table(out, runs_, ref)
 
 
 def draw_all(out: Path, runs_, fresh: bool = True, threads: int = 1) -> None:

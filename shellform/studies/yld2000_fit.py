@@ -14,13 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from shellform import scene
+from shellform import demos, scene
 from shellform.material import yld2000_fit
 from shellform.results.log import say
 from shellform.results.tables import write_csv
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENE = ROOT / "demos" / "esaform2021_cup.toml"
+SCENE = demos.path("esaform2021_cup.toml")
 
 
 def fit_of(path=SCENE) -> yld2000_fit.Fit:
