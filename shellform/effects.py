@@ -96,8 +96,10 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            why="with the tools moves the sheet far", keys=("tools",),
            doc="contact of the sheet with the rigid tools of [tools]"),
     Effect("friction", "contact part", "shellform.contact.friction.CoulombFriction", (TOOLS,), ("contact",),
-           why="acts at the contact with the tools", keys=("tools.friction",),
-           doc="Coulomb friction at that contact, coefficient tools.friction > 0"),
+           why="acts at the contact with the tools",
+           keys=("tools.friction", "tools.punch_friction", "tools.die_friction", "tools.holder_friction"),
+           doc="Coulomb friction at that contact, coefficient tools.friction on every tool or a tool's own "
+               "(tools.punch_friction, die_friction, holder_friction), one > 0"),
     Effect("ironing", "contact part", "shellform.contact.ironing.Ironing", (TOOLS,), ("contact", "finite_strain"),
            why="bounds the thickness of a sheet that thins and thickens between the tools",
            doc="where two tools face each other across the sheet closer than its thickness (the punch's and "

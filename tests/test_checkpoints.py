@@ -613,6 +613,24 @@ def test_another_holder_force_or_friction_is_refused_on_a_resume(tmp_path, whole
     assert err.value.field == "tools.friction" and "0.5 mm" in str(err.value)
 
 
+@pytest.mark.timeout(180)
+@pytest.mark.parametrize("tool", ["punch", "die", "holder"])
+def test_another_friction_of_one_tool_is_refused_on_a_resume(tmp_path, whole, tool):
+    """A tool's own coefficient (tools.punch_friction, die_friction, holder_friction) acts from
+    the first increment as tools.friction does: resumed from the checkpoint at 0.5 mm with the
+    punch lubricated (0.05, the others 0.1), or the die or the holder, the run is refused naming
+    that key; nothing is drawn. The summary records the coefficients the tools carried."""
+    assert whole[1]["friction"] == {"punch": 0.1, "die": 0.1, "holder": 0.1}
+    out = tmp_path / "out"
+    shutil.copytree(whole[0], out)
+    (out / "checkpoint.npz").unlink()  # the resume takes checkpoint.previous.npz, at 0.5 mm
+    c = cup().changed({f"tools.{tool}_friction": 0.05})
+    with pytest.raises(InputError) as err:
+        contact_run.run(c, out, resume=True)
+    assert err.value.field == f"tools.{tool}_friction" and "0.5 mm" in str(err.value)
+    assert "None there, 0.05 now" in str(err.value)
+
+
 def fld_cup():
     """cup() with the forming-limit view and the pictures: fld.csv, strain_path.csv, fld.png,
     cup.png, cup_margin.png."""

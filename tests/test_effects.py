@@ -73,7 +73,8 @@ def test_keys_of_an_effect_that_is_off_keep_their_defaults():
               "material.fit_sigma": [1.0] * 3,
               "material.Q": 100.0, "material.beta": 10.0, "material.swift_weight": 0.5, "material.flow_curve": "c.csv",
               "material.extrapolation": "swift", "material.forming_limit_curve": "flc.csv",
-              "tools.friction": 0.1,
+              "tools.friction": 0.1, "tools.punch_friction": 0.02, "tools.die_friction": 0.1,
+              "tools.holder_friction": 0.15,
               "tools.drawbead": [{"points": [[45.0, 0.0], [45.0, 50.0]], "restraint": 10.0}]}
     base = {"effects": ["bending", "membrane", "geometric_nonlinearity", "contact"],
             "geometry": {"lx": 100.0, "ly": 100.0, "region": "quarter"}, "material": {"thickness": 0.8},

@@ -1,6 +1,7 @@
 """Coulomb friction, a part of the contact (shellform/contact/friction.py): the clamping force
-it carries between flat tools, a slip reversal without flips, the cup's punch force, and the
-slipping force's normal-force term in the tangent."""
+it carries between flat tools, a slip reversal without flips, the cup's punch force, the
+slipping force's normal-force term in the tangent, and friction per tool (a coefficient per
+punch, die and holder)."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
@@ -8,8 +9,11 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from functools import lru_cache
+
 from shellform import scene
 from shellform.contact.problem import DrawingProblem
+from shellform.results import cup
 from shellform.assembly.sheet_element import BS
 from shellform.contact.semi_inverse import FREE
 
@@ -126,3 +130,74 @@ def test_slip_tangent_carries_the_normal_force_change():
                if j not in d.bc_dofs]
     error = tangent_error(d, lam, rows, columns)
     assert error <= 1e-6, error
+
+
+def test_strip_between_a_die_and_a_holder_of_other_frictions_carries_each_face_with_its_own():
+    """Friction per tool on a pinched node: the strip between a die of mu 0.05 and a holder of mu
+    0.25 (F = 1 kN), pulled 2 mm. Both faces slip together, each with its own coefficient: once
+    it slides, the pull equals mu_die sum d_i + mu_holder sum h_i (to 1e-8) and (mu_die +
+    mu_holder) F (to 1e-4), as with one coefficient 0.15; every pinched node's coefficient lies
+    between the two, and no tangential force exceeds mu_die d_i + mu_holder h_i."""
+    mu_die, mu_holder, F = 0.05, 0.25, 1000.0
+    rect, d = strip((mu_die, mu_holder), F)
+    comm = MPI.COMM_WORLD
+
+    def check(dr):
+        die, holder = dr.contact.faces()
+        ft = np.linalg.norm(dr.friction.force, axis=1)
+        assert np.all(ft <= (mu_die * die + mu_holder * holder) * (1 + 1e-8) + 1e-9)
+        mu = dr.friction.coefficient[dr.holder.pinched]
+        assert np.all((mu >= mu_die) & (mu <= mu_holder))
+
+    d.run(1.0, on_increment=check)
+    pull = side_sum(d, rect, ("right",), 0)
+    die, holder = d.contact.faces()
+    limit = comm.allreduce(float(mu_die * die.sum() + mu_holder * holder.sum()), op=MPI.SUM)
+    assert abs(pull - limit) <= 1e-8 * limit
+    assert abs(pull - (mu_die + mu_holder) * F) <= 1e-4 * (mu_die + mu_holder) * F
+    assert np.all(d.friction.slipping[d.contact.on(0)])
+
+
+@lru_cache(maxsize=None)
+def _drawn_6mm(**tools) -> dict:
+    """The paper's cup on 6 x 6 drawn 6 mm with the tools keys (friction 0.1 from the demo): its
+    punch force, draw-in, thickness strains (the peak and the mean over the nodes that start on
+    the punch's flat face, x, y < 27 mm), Newton iterations and contact passes."""
+    s = square_cup(n=6, changes={"process.initial_step_mm": 0.6, "process.max_step_mm": 1.5,
+                                 **{f"tools.{k}": v for k, v in tools.items()}})
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(6.0 / s.tools.stroke)
+    X, _, e33 = p.nodal_values()
+    face = np.all(X < 27.0, axis=1)
+    h = p.driver.history
+    return {"force": p.punch_force(), **cup.draw_in(p), **cup.peak_thinning(p), "face": float(e33[face].mean()),
+            "iterations": sum(r.iterations for r in h), "passes": sum(r.contact["passes"] for r in h)}
+
+
+def test_friction_per_tool_all_equal_is_the_one_coefficient():
+    """tools.punch_friction, die_friction and holder_friction all equal to tools.friction (0.1)
+    draw the same cup as tools.friction alone: every node's mu_i is then that coefficient exactly
+    and each expression of friction.py reduces to the one coefficient's, so the punch force,
+    draw-in (DX, DD), thinning, iterations and passes agree (to 1e-9; bit for bit in fact)."""
+    one = _drawn_6mm()
+    each = _drawn_6mm(punch_friction=0.1, die_friction=0.1, holder_friction=0.1)
+    for key in ("force", "DX", "DD", "min_thickness_strain", "face"):
+        assert each[key] == pytest.approx(one[key], rel=1e-9, abs=0.0), key
+    assert (each["iterations"], each["passes"]) == (one["iterations"], one["passes"])
+
+
+def test_a_lubricated_punch_thins_the_cup_more():
+    """A lubricated punch (punch_friction 0.02, the die and holder 0.1) against 0.1 on every
+    tool, and a dry one (0.3): the punch's friction holds the sheet on its face and nose, so
+    with less of it the bottom slides over the punch and stretches more, and less of the cup
+    comes from the flange. Ordered by the punch's coefficient: the peak thinning (on the punch's
+    face where its corner nose begins) and the mean thinning of the bottom grow as it falls, the draw-in (DX, DD) shrinks.
+    The punch force is not asserted (docs/contact.md: its numbers)."""
+    lub = _drawn_6mm(punch_friction=0.02)
+    base = _drawn_6mm()
+    dry = _drawn_6mm(punch_friction=0.3)
+    for key in ("min_thickness_strain", "face"):
+        assert lub[key] < base[key] < dry[key] < 0, (key, lub[key], base[key], dry[key])
+    for key in ("DX", "DD"):
+        assert 0 < lub[key] < base[key] < dry[key], (key, lub[key], base[key], dry[key])
+    assert lub["where_initial_xy_mm"] == base["where_initial_xy_mm"]  # the same node, at the nose

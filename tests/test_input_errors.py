@@ -212,6 +212,16 @@ def cup(effects=CONTACT, tools=None, geometry=None, supports=None, thickness=0.8
     (cup(geometry={"ly": 84.0}), "geometry.ly"),  # just at the die's flat top
     (cup(tools={"friction": 0.1}), "tools.friction"),  # friction without the effect
     (cup(effects=CONTACT + ["friction"]), "tools.friction"),  # the effect without friction
+    # friction per tool: each tool's own coefficient, where given, finite and >= 0
+    *[(cup(effects=CONTACT + ["friction"], tools={"friction": 0.1, f"{tool}_friction": bad}), f"tools.{tool}_friction")
+      for tool in ("punch", "die", "holder") for bad in (-0.02, float("inf"), float("nan"), "dry", True)],
+    *[(cup(tools={f"{tool}_friction": 0.05}), f"tools.{tool}_friction")  # without the effect
+      for tool in ("punch", "die", "holder")],
+    # the effect with no tool's coefficient > 0: named tools.friction, or tools.punch_friction where
+    # every tool has its own (and friction is no tool's)
+    (cup(effects=CONTACT + ["friction"], tools={"punch_friction": 0.0}), "tools.friction"),
+    (cup(effects=CONTACT + ["friction"], tools={"friction": 0.1, "punch_friction": 0.0, "die_friction": 0.0,
+                                                 "holder_friction": 0.0}), "tools.punch_friction"),
     (cup(supports={"right": "clamped"}), "supports.right"),
     (cup(supports={"top": "simply_supported"}), "supports.top"),
     (cup(geometry={"region": "full"}), "supports.left"),  # every side of a full blank is outer
@@ -427,6 +437,25 @@ def test_checkpoint_interval_names_its_field(value):
 DEMOS = Path(__file__).resolve().parents[1] / "demos"
 
 
+def test_friction_per_tool_keys():
+    """tools.punch_friction, die_friction and holder_friction: unset (None), each tool carries
+    tools.friction; given, its own (0 too: a lubricated punch with a dry binder); the effect
+    'friction' with friction 0 but one tool's > 0 is valid. An unset key is not written to the
+    resolved TOML, and a change to None unsets it again."""
+    s = scene.from_dict(cup(effects=CONTACT + ["friction"], tools={"friction": 0.1}))
+    assert (s.tools.punch_friction, s.tools.die_friction, s.tools.holder_friction) == (None, None, None)
+    assert s.tools.friction_per_tool() == {"punch": 0.1, "die": 0.1, "holder": 0.1}
+    lubricated = s.changed({"tools.punch_friction": 0, "tools.holder_friction": 0.15})
+    assert lubricated.tools.friction_per_tool() == {"punch": 0.0, "die": 0.1, "holder": 0.15}
+    assert isinstance(lubricated.tools.punch_friction, float)
+    only = scene.from_dict(cup(effects=CONTACT + ["friction"], tools={"die_friction": 0.1}))
+    assert only.tools.friction_per_tool() == {"punch": 0.0, "die": 0.1, "holder": 0.0}
+    text = scene.to_toml(lubricated)
+    assert "punch_friction = 0.0" in text and "die_friction" not in text
+    assert scene.from_dict(tomllib.loads(text)) == lubricated
+    assert lubricated.changed({"tools.punch_friction": None}).tools.punch_friction is None
+
+
 def test_an_implausible_modulus_is_warned_about_naming_the_field():
     """E in GPa with the stresses in MPa (E = 206 for a steel) is valid input but no metal: a
     warning names material.E with the ratio; the demo scenes' materials give none."""
@@ -450,6 +479,8 @@ def test_an_implausible_modulus_is_warned_about_naming_the_field():
      r"tools\.drawbead\[0\]: lies wholly outside the blank"),
     ({"mesh.n": 1}, r"mesh\.n: n = 1"),
     ({"tools.friction": 10.0}, r"tools\.friction: 10 is no friction coefficient of sheet metal"),
+    *[({f"tools.{tool}_friction": 10.0}, rf"tools\.{tool}_friction: 10 is no friction coefficient of sheet metal")
+      for tool in ("punch", "die", "holder")],
 ])
 def test_valid_but_useless_values_are_warned_about_naming_the_field(changes, match):
     """A punch that never reaches the sheet (a gap larger than the stroke: zero force, exit 0), a

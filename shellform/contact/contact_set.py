@@ -168,14 +168,24 @@ class ContactSet(Part):
         """The sum of both faces' normal forces on each node (what friction presses with)."""
         return self.pressure + (self.holder.face if self.holder is not None else 0.0)
 
-    def dp_dnet(self) -> np.ndarray:
-        """d(face forces)/dR0 per node: 1 on a tool where it presses, on a pinched node the
-        closed holder's (its face_slopes: F's spread held fixed), 0 off the tools."""
+    def faces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each node's two faces' normal forces (d, h): its tool's face (the die's on a pinched
+        node; 0 on the open holder's face) and the holder's (the closed holder's on a pinched
+        node, the open one's on its face; 0 elsewhere). face_forces is d + h; friction gives
+        each its own tool's coefficient."""
+        return self.pressure, (self.holder.face if self.holder is not None else np.zeros_like(self.pressure))
+
+    def face_slopes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(dd/dR0, dh/dR0) per node, the faces of ``faces``: on a tool 1 where it presses (to
+        its tool's face), on a pinched node the closed holder's split (its face_slopes: F's
+        spread held fixed), 0 off the tools."""
         on = self.tool != FREE
-        tool = (self.net > 0).astype(float)
+        tool, holder = (self.net > 0).astype(float), np.zeros(self.net.size)
         if self.holder is not None:
-            tool = np.where(self.holder.pinched, self.holder.face_slopes(self.net), tool)
-        return np.where(on, tool, 0.0)
+            die, top = self.holder.face_slopes(self.net)
+            tool = np.where(self.holder.pinched, die, tool)
+            holder = np.where(self.holder.pinched, top, holder)
+        return np.where(on, tool, 0.0), np.where(on, holder, 0.0)
 
     # -- the part's protocol -------------------------------------------------------------------
     def start(self, lam: float, predicting: bool) -> None:

@@ -8,16 +8,16 @@ increment (the history) and the stick stiffness k_t:
                                |f*| >  mu p: slip,  f = mu p f*/|f*|,
                                                     df/ds = -k_t (mu p/|f*|) (I - m m^T),  m = f*/|f*|
 
-with k_t = STICK_STIFFNESS E A_i / h per node (A_i its tributary area, h the cell size), so that
-the elastic slip before sliding, mu p / k_t, is a small fraction of a cell, yet long against
-Newton's steps on a node nearly at rest (docs/contact.md: E A_i / h itself made such a node
-reverse its force within every step). The
-node's residual gets -f in its nodal frame, the tangent -df/ds in the frame's tangent slots.
+with mu the node's coefficient mu_i (friction per tool, below) and k_t = STICK_STIFFNESS E A_i / h
+per node (A_i its tributary area, h the cell size), so that the elastic slip before sliding,
+mu p / k_t, is a small fraction of a cell, yet long against Newton's steps on a node nearly at
+rest (docs/contact.md: E A_i / h itself made such a node reverse its force within every step).
+The node's residual gets -f in its nodal frame, the tangent -df/ds in the frame's tangent slots.
 
 Where Newton's iterates update the normal force p (the contact driver's refresh of p from the
 reactions), the slipping force's dependence on it enters the tangent too:
 
-    d(-f_i)/dq = -mu m_i (dp_i/dR0_i) K_(i,n),   dp/dR0 = 1 on a tool, sign(R0) on a pinched node
+    d(-f_i)/dq = -m_i (d(mu_i p_i)/dR0_i) K_(i,n),   dp/dR0 = 1 on a tool, sign(R0) on a pinched node
 
 (K_(i,n) the node's normal row of the sheet's tangent, R0 its net normal force; non-symmetric),
 on the free tangent rows of every slipping node, in the free columns.
@@ -31,12 +31,36 @@ Aitken's factor (Irons and Tuck), r = p~ - p,
     omega_k = -omega_k-1 r_k-1 . (r_k - r_k-1) / |r_k - r_k-1|^2   in [0.2, 1.5],
 
 which damps a cycling p (a node whose faces swap) and speeds a slow one; the passes go on until
-|mu r| <= friction_rtol |mu p~|. With the driver's predictor, an increment's first p is
-extrapolated from the last two increments, as the carrier is (nodes on the same tool in both).
+|mu r| <= friction_rtol |mu p~| (2-norms over the nodes, each node's term times its own mu_i).
+With the driver's predictor, an increment's first p is extrapolated from the last two
+increments, as the carrier is (nodes on the same tool in both).
+
+Friction per tool. Each tool carries its own coefficient (a lubricated punch, a dry binder): mu is
+one coefficient for every tool, or one per tool of the contact set in its order (punch, die, ...)
+then the holder's, whose face is the last tool (the open holder's face, or a holder held at a
+gap); the closed holder's face on a pinched node and a node off the tools carry the holder's too.
+A node's coefficient follows the faces it lies between, with d_i the normal force of its tool's
+face (the die's on a pinched node) and h_i the holder's face's:
+
+    mu_i = mu_tool + (mu_holder - mu_tool) h_i / (d_i + h_i)   (mu_tool where d_i + h_i = 0)
+
+so that its Coulomb limit mu_i p_i, with p_i = d_i + h_i, is mu_tool d_i + mu_holder h_i: a
+pinched node slips on both faces at once (the die and the holder stand still, the node has one
+slip), so the faces' limits add, each face's normal force times its own tool's coefficient. It is
+read from the contact set's faces at every return mapping (each iterate, each refresh of p), so
+that it follows the face forces as p does. The slipping force's normal-force tangent carries each
+face's own slope,
+
+    d(mu_i p_i)/dR0_i = mu_tool dd_i/dR0_i + mu_holder dh_i/dR0_i,
+
+and the passes' test weighs each node's change of p by its coefficient (|mu_i r_i| against
+|mu_i p~_i|). With every coefficient equal, mu_i = mu exactly and each expression reduces to the one
+coefficient's, bit for bit.
 
 The part owns its history (committed with an increment, forgotten where a node switches tools),
-its normal forces and the forces, stiffness and slip state of the current iterate; the contact
-set (contact_set.py) tells it which nodes rub on which tool and with which face forces.
+its coefficients, its normal forces and the forces, stiffness and slip state of the current
+iterate; the contact set (contact_set.py) tells it which nodes rub on which tool and with which
+face forces.
 """
 
 import numpy as np
@@ -49,16 +73,18 @@ from shellform.results.log import say
 
 
 class CoulombFriction(Part):
-    """Coulomb friction with coefficient mu on n owned nodes (k_stick: their stick stiffness;
-    held: (n, 2) tangent slots a symmetry plane holds, which get no stiffness); contact: the
-    ContactSet whose nodes rub; rtol: friction_rtol."""
+    """Coulomb friction on n owned nodes with mu: one coefficient for every tool, or one per tool
+    of the contact set in its order, then the holder's (module docstring; k_stick: their stick
+    stiffness; held: (n, 2) tangent slots a symmetry plane holds, which get no stiffness);
+    contact: the ContactSet whose nodes rub; rtol: friction_rtol."""
 
     STICK_STIFFNESS = 0.01  # k_t per node over E A_i / h
 
-    def __init__(self, mu: float, k_stick: np.ndarray, held: np.ndarray, contact=None, nodes=None,
+    def __init__(self, mu, k_stick: np.ndarray, held: np.ndarray, contact=None, nodes=None,
                  rtol: float = 1e-4, trace: bool = False):
         n = len(k_stick)
-        self.mu, self.k_stick, self.held = float(mu), k_stick, held
+        self.mu, self.k_stick, self.held = mu, k_stick, held
+        self.coefficient = np.zeros(n)  # mu_i of each node at the last return mapping
         self.contact, self.nodes, self.rtol, self.trace = contact, nodes, rtol, trace
         self.normal = np.zeros(n)  # p, the normal force friction uses (both faces)
         self.committed_normal = self.normal.copy()
@@ -76,9 +102,33 @@ class CoulombFriction(Part):
 
     @property
     def active(self) -> bool:
-        return self.mu > 0
+        return float(np.max(self.mu)) > 0
+
+    def per_tool(self) -> np.ndarray:
+        """mu per tool of the contact set (its order, the holder's last): the scene's one
+        coefficient for each, or its own."""
+        tools = len(self.contact.tools) + (self.contact.holder is not None)
+        mu = np.asarray(self.mu, dtype=float)
+        if mu.ndim == 0:
+            return np.full(tools, float(mu))
+        if mu.shape != (tools,):
+            raise ValueError(f"friction: one coefficient, or one per tool and the holder's ({tools}), got {self.mu!r}")
+        return mu
+
+    def coefficients(self) -> np.ndarray:
+        """mu_i per owned node from the contact set's faces now (module docstring): its tool's
+        (FREE: the holder's), moved towards the holder's by the holder face's share of its normal
+        forces."""
+        c = self.contact
+        table = self.per_tool()
+        tool_mu = table[c.tool]  # FREE (-1): the last, the holder's
+        d, h = c.faces()
+        total = d + h
+        share = np.divide(h, total, out=np.zeros_like(total), where=total > 0)
+        return tool_mu + (table[-1] - tool_mu) * share
 
     def bind(self, driver) -> None:
+        self.per_tool()  # one coefficient per tool, or one for all
         self.comm = driver.model.mesh.comm
         self.normal = self.contact.face_forces()
         self.committed_normal = self.normal.copy()
@@ -151,8 +201,11 @@ class CoulombFriction(Part):
         self._map()
 
     def _map(self):
-        """The return mapping on the rubbing nodes of this iterate with the current p."""
+        """The return mapping on the rubbing nodes of this iterate with the current p and the
+        coefficients of the current faces."""
         idx, shift, x, F = self._rub
+        if self.active:
+            self.coefficient = self.coefficients()
         self.slip(idx, shift, x, self.nodes.x_n, F, self.normal)
 
     def add_residual(self, R: np.ndarray) -> None:
@@ -175,13 +228,26 @@ class CoulombFriction(Part):
         add_tangent_slot_stiffness(K, self.rate)
         if self.refreshing:
             on = self.slipping & self.contact.on_tools() & (self.normal > 0)
-            coef = np.where(on, self.contact.dp_dnet(), 0.0)
+            coef = np.where(on, self.limit_slopes(), 0.0)
             self.add_normal_force_tangent(K, self.contact.nodes.model, coef, self.frames, self.normal, fixed,
                                           self.nodes.n_local)
 
-    def update_normal(self, changes: int):
+    def limit_slopes(self) -> np.ndarray:
+        """d(mu_i p_i)/dR0_i / mu_i per owned node (0 where mu_i = 0): each face's slope
+        (ContactSet.face_slopes) times its own coefficient over the node's (module docstring);
+        the faces' dp/dR0 where the coefficients are equal."""
+        table = self.per_tool()
+        tool_mu = table[self.contact.tool]
+        mu = self.coefficient
+        on = mu > 0
+        d_slope, h_slope = self.contact.face_slopes()
+        own = np.divide(tool_mu, mu, out=np.zeros_like(mu), where=on)
+        holder = np.divide(np.full_like(mu, table[-1]), mu, out=np.zeros_like(mu), where=on)
+        return d_slope * own + h_slope * holder
+
+    def update_normal(self, changes: int, weight=1.0):
         """Between passes: p relaxed towards the faces' new sum (module docstring). Returns
-        (|r|, |p~|)."""
+        (|weight r|, |weight p~|) (weight: per node, or one for all)."""
         c = self.contact
         target = c.face_forces()
         r = target - self.normal
@@ -200,13 +266,17 @@ class CoulombFriction(Part):
         self.normal = np.maximum(self.normal + omega * r, 0.0)
         free = ~c.on_tools()
         self.normal[free] = target[free]  # off the tools: the holder's load only
-        return np.sqrt(dot(r, r)), np.sqrt(dot(target, target))
+        wr, wt = weight * r, weight * target
+        return np.sqrt(dot(wr, wr)), np.sqrt(dot(wt, wt))
 
     def update(self, lam: float, changes: int) -> Change:
-        """After a converged pass: forget the history of the nodes that switched, relax p."""
+        """After a converged pass: forget the history of the nodes that switched, relax p; the
+        passes converge once |mu_i r_i| <= rtol |mu_i p~_i| (the coefficients of the new faces,
+        over the largest mu: a weight of 1 where they are all equal)."""
         self.forget(self.contact.switched)
-        dp, pn = self.update_normal(changes)
-        mu = self.mu
+        mu = float(np.max(self.per_tool()))
+        weight = self.coefficients() / mu if mu > 0 else 1.0
+        dp, pn = self.update_normal(changes, weight)
         return Change(0, 0, bool(mu * dp <= self.rtol * mu * pn),
                       f"friction change |mu dp| {mu * dp:.3e} of |mu p| {mu * pn:.3e}")
 
@@ -214,7 +284,8 @@ class CoulombFriction(Part):
     def slip(self, idx, shift, x, x_n, F, normal) -> None:
         """The return mapping on the rubbing nodes idx at positions x (x_n: at the start of the
         increment; shift: their tool's travel in it, (m, 3); F: their frames, normal F[:, 2]) with the
-        normal forces `normal` (all nodes); every other node carries no friction."""
+        normal forces `normal` and the coefficients self.coefficient (all nodes); every other node
+        carries no friction."""
         self.force[:] = 0.0
         self.rate[:] = 0.0
         self.slipping[:] = False
@@ -229,7 +300,7 @@ class CoulombFriction(Part):
         k = self.k_stick[idx]
         trial = f_old - k[:, None] * ds
         size = np.linalg.norm(trial, axis=1)
-        limit = self.mu * normal[idx]
+        limit = self.coefficient[idx] * normal[idx]
         slip = size > (1 - 1e-6) * limit  # on the cone (a node that slipped): keeps slipping, slip tangent
         ratio = np.where(slip, limit / np.maximum(size, 1e-300), 1.0)
         m2 = np.einsum("nij,nj->ni", F[:, :2], trial) / np.maximum(size, 1e-300)[:, None]

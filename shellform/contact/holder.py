@@ -213,12 +213,15 @@ class PinchingHolder(Part):
         d = np.where(pinched, np.where(band, self.band_ratio * h, s + np.maximum(net, 0.0)), 0.0)
         return d, h
 
-    def face_slopes(self, net: np.ndarray) -> np.ndarray:
-        """d(d_i + h_i)/dR0_i of the pinched nodes at the last split (F's spread held fixed):
-        sign(R0) off the edge's band; on it h_i / H (d_i + h_i = h_i (1 + D / H), D the band's
-        equilibrium total) while the die presses the band, 0 where it is clear."""
+    def face_slopes(self, net: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(dd_i/dR0_i, dh_i/dR0_i) of the pinched nodes at the last split (F's spread held
+        fixed), whose sum is d(d_i + h_i)/dR0_i: off the edge's band the die's 1 where R0 > 0 and
+        the holder's -1 where R0 < 0 (sign(R0) together); on it the die's h_i / H (d_i = h_i D / H,
+        D the band's equilibrium total) while the die presses the band, 0 where it is clear, and
+        the holder's 0 (h_i = s_i + f e_i)."""
         own = self.face / self.band_force if self.band_force > 0 and self.band_ratio > 0 else np.zeros_like(self.face)
-        return np.where(self.band, own, np.sign(net))
+        return (np.where(self.band, own, (net > 0).astype(float)),
+                np.where(self.band, 0.0, -(net < 0).astype(float)))
 
     def face_gap(self, x: np.ndarray, half: np.ndarray):
         """Gap and normal of the open holder's face to the nodes at x with half thicknesses

@@ -50,7 +50,8 @@ class DrawingProblem:
                              1e-2 * s.material.thickness)
         symmetry = s.symmetry_copies
         controls = scene_controls(s)
-        mu = t.friction if "friction" in s.effects else 0.0
+        # the coefficient of each tool of the contact set, in its order: punch, die, the holder's face
+        mu = tuple(t.friction_per_tool().values()) if "friction" in s.effects else 0.0
         beads = tuple(DrawbeadLine(tuple(map(tuple, b.points)), b.restraint, b.uplift) for b in t.drawbead)
         if t.holder == "gap":  # a third rigid tool: the holder's face holder_gap above the die's top
             holder = tools["holder"]

@@ -1,8 +1,9 @@
 """A deep-drawing scene from its TOML to results on disk: scene -> problem -> driver -> files.
 
 Writes into the output folder (forces and draw-in for the whole blank, pictures included):
-    summary.json             stroke_mm, draw_in_mm (DX, DY, DD) and punch_force_kN at every
-                             reported stroke; min_thickness_strain and where; the sheet's
+    summary.json             the friction coefficients the tools carried ("friction": punch, die,
+                             holder; 0 without the effect); stroke_mm, draw_in_mm (DX, DY, DD)
+                             and punch_force_kN at every reported stroke; min_thickness_strain and where; the sheet's
                              volume change (V - V0)/V0 (elastic only, with finite strains); increments,
                              Newton iterations, contact passes, element evaluations (run,
                              reused, and how many computed a tangent); wall_time_s and its split;
@@ -361,6 +362,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             p.driver.progress.note(f"shellform: stopped: {stopped}")
     summary = DrawingSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
+        "friction": {k: v if "friction" in s.effects else 0.0 for k, v in s.tools.friction_per_tool().items()},
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
         "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
         "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],

@@ -40,7 +40,8 @@ class SemiInverseDriver(Driver):
     tools: rigid tools with ``gap(x, offset, dz) -> (gap, normal)`` and ``shape(x, offset, dz)``
     in contact order (e.g. punch, die); ``travel[k]`` is tool k's z-travel at lambda = 1 (punch:
     -stroke); holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool
-    `die` (default: the last tool); friction: mu; drawbeads: DrawbeadLine's (drawbead.py);
+    `die` (default: the last tool); friction: mu, one coefficient for every tool or one per tool
+    in contact order then the holder's (friction.py: CoulombFriction); drawbeads: DrawbeadLine's (drawbead.py);
     holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge);
     ironing: the tools' faces bound the sheet's thickness where two face each other (ironing.py).
     """

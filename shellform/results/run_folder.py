@@ -41,7 +41,8 @@ OUTPUTS = ("summary.json", "reports.json", "history.json", "increments.csv", "fo
            "cup.pvd", "sheet.pvd", "punch.pvd", "die.pvd", "blank_holder.pvd", "vtu", "nodal.bp", "cells.bp", "checkpoint.npz",
            "checkpoint.previous.npz", ".checkpoint.npz.new", "last_converged.rank*.npz")
 # what may change when a run is resumed ("how to continue"; `shellform run --resume`)
-CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force", "effects.friction",
+CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.punch_friction", "tools.die_friction",
+            "tools.holder_friction", "tools.blank_holder_force", "effects.friction",
             "process.initial_step", "process.min_step", "process.max_step", "process.initial_step_mm",
             "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
             "process.rtol", "process.path", "process.report", "process.springback", "process.stop_at_forming_limit",
@@ -49,7 +50,8 @@ CONTINUE = ("title", "tools.stroke", "tools.friction", "tools.blank_holder_force
 # of those, the process inputs that act on the sheet from its first increment: a resume may
 # change them only from a checkpoint before any increment; past it, a run with other ones is
 # another run (refused, naming them)
-PROCESS = ("tools.blank_holder_force", "tools.friction", "effects.friction")
+PROCESS = ("tools.blank_holder_force", "tools.friction", "tools.punch_friction", "tools.die_friction",
+           "tools.holder_friction", "effects.friction")
 
 
 def check_writable(outdir: Path, comm=MPI.COMM_WORLD) -> None:

@@ -19,8 +19,8 @@ from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
-                                    DIAGONALS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE, STROKE_STEP_KEYS,
-                                    YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
+                                    DIAGONALS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE,
+                                    STROKE_STEP_KEYS, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
                                     NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, bounds)
 
 
@@ -236,7 +236,8 @@ def _plausible_stiffness(material) -> None:
             f"2000: are E and the stresses in the same unit (MPa with lengths in mm)?"), stacklevel=2)
 
 
-MAX_FRICTION = 1.0  # tools.friction above this is warned about: sheet metal on tools lies about 0.02 to 0.3
+# tools.friction (or a tool's own) above this is warned about: sheet metal on tools lies about 0.02 to 0.3
+MAX_FRICTION = 1.0
 
 
 def _warn(field: str, message: str) -> None:
@@ -248,19 +249,21 @@ def _warn(field: str, message: str) -> None:
 def _plausible_values(s) -> None:
     """Warn (PlausibilityWarning, naming the field) about values that are valid but make a run
     that computes nothing of use with exit 0: one cell per side (mesh.n = 1 but for a file
-    blank, whose own mesh n refines), a friction
-    coefficient above MAX_FRICTION, a punch whose gap to the sheet is at least its stroke (it
-    never touches the sheet: zero force), a drawbead wholly outside the blank (mirrored across
-    its symmetry lines: it holds nothing)."""
+    blank, whose own mesh n refines), a friction coefficient above MAX_FRICTION (friction, or a
+    tool's own), a punch whose gap to the sheet is at least its stroke (it never touches the
+    sheet: zero force), a drawbead wholly outside the blank (mirrored across its symmetry lines:
+    it holds nothing)."""
     if s.mesh.n == 1 and s.geometry.shape != "file":  # a file's n refines its own mesh
         _warn("mesh.n", "n = 1 makes one cell per side: no answer of such a mesh means anything (a cup needs n "
               ">= 8)")
     t = s.tools
     if t is None:
         return
-    if t.friction > MAX_FRICTION:
-        _warn("tools.friction", f"{t.friction:g} is no friction coefficient of sheet metal on tools (about 0.02 to "
-              "0.3): is it a percentage?")
+    for key in ("friction", *(f"{name}_friction" for name in FRICTION_TOOLS)):
+        v = getattr(t, key)
+        if v is not None and v > MAX_FRICTION:
+            _warn(f"tools.{key}", f"{v:g} is no friction coefficient of sheet metal on tools (about 0.02 to "
+                  "0.3): is it a percentage?")
     if t.shape in ("square", "round") and t.punch_gap >= t.stroke:
         _warn("tools.punch_gap", f"the punch starts {t.punch_gap:g} mm above the sheet and travels {t.stroke:g} mm "
               "(tools.stroke): it never touches the sheet, and the force stays zero")

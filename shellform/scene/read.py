@@ -177,7 +177,9 @@ def _record(cls, data, name):
         if key not in known:
             raise InputError(f"{name}.{key}", f"unknown key; known keys: {', '.join(known)}")
         default = getattr(cls(), key)
-        if isinstance(default, bool):
+        if default is None:  # an optional number (tools.punch_friction): unset (None) or a number
+            value = None if value is None else _number(value, f"{name}.{key}")
+        elif isinstance(default, bool):
             if not isinstance(value, bool):
                 raise InputError(f"{name}.{key}", f"must be true or false, got {value!r}")
         elif isinstance(default, int | float):
@@ -278,7 +280,8 @@ def to_dict(s: Scene) -> dict:
     for name in _SECTIONS:
         section = getattr(s, name)
         if section is not None:
-            data[name] = {f.name: copy.deepcopy(getattr(section, f.name)) for f in fields(section)}
+            data[name] = {f.name: copy.deepcopy(getattr(section, f.name)) for f in fields(section)
+                          if getattr(section, f.name) is not None}  # unset: not given (TOML has no null)
     if s.tools is not None:
         data["tools"]["drawbead"] = [asdict(b) for b in s.tools.drawbead]
     data["output"]["probe"] = [asdict(p) for p in s.output.probe]

@@ -19,5 +19,6 @@ def keys_of_effects(s, section: str) -> None:
             if e.name in s.effects or table != section or not name or getattr(s, table) is None:
                 continue
             value, default = getattr(getattr(s, table), name), getattr(type(getattr(s, table))(), name)
+            leave = "leave it unset" if default is None else f"leave the default {default!r}"
             require(value == default, key, f"{value!r} takes a meaning only with the effect {e.name!r}: switch it "
-                    f"on, or leave the default {default!r}")
+                    f"on, or {leave}")

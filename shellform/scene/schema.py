@@ -206,6 +206,16 @@ def _complete_tools(self):
         tool_kinds.kind(self.shape).complete(self)
 
 
+FRICTION_TOOLS = ("punch", "die", "holder")  # each has its own key NAME_friction (unset: `friction`)
+
+
+def _friction_per_tool(self) -> dict[str, float]:
+    """Each tool's Coulomb coefficient, punch, die and holder in that order: its own key
+    (punch_friction, die_friction, holder_friction), or `friction` where that is unset (None)."""
+    own = {name: getattr(self, f"{name}_friction") for name in FRICTION_TOOLS}
+    return {name: self.friction if v is None else v for name, v in own.items()}
+
+
 # Rigid tools of cup deep drawing: tools.shape names their kind (shellform.tools.kinds: square,
 # round, cad), whose keys (FIELDS) come first, then the keys every kind takes.
 ToolsSpec = make_dataclass("ToolsSpec", [
@@ -217,12 +227,16 @@ ToolsSpec = make_dataclass("ToolsSpec", [
     ("holder_gap", float, field(default=0.0)),  # mm, holder = "gap": the face's distance from the die's top (>= t)
     ("blank_holder_force", float, field(default=19600.0)),  # N, on the whole blank (a quarter model carries a quarter)
     ("friction", float, field(default=0.0)),  # Coulomb coefficient (> 0 needs the effect 'friction')
+    # a tool's own coefficient (None: unset, `friction`): a lubricated punch, a dry binder
+    *[(f"{name}_friction", float | None, field(default=None)) for name in FRICTION_TOOLS],
     ("stroke", float, field(default=30.0)),  # punch travel, mm
     ("holder_spread", str, field(default="area")),  # how the closed holder spreads its force: "area" or "rigid"
     ("drawbead", list[Drawbead], field(default_factory=list, metadata={"items": "tables"})),  # [[tools.drawbead]]
-], namespace={"__post_init__": _complete_tools, "__doc__": """Rigid tools of cup deep drawing: tools.shape
+], namespace={"__post_init__": _complete_tools, "friction_per_tool": _friction_per_tool,
+              "__doc__": """Rigid tools of cup deep drawing: tools.shape
     names their kind (shellform.tools.kinds), whose keys come first (each kind's FIELDS), then
-    the holder's, the force, friction, stroke and drawbeads every kind takes."""}, module=__name__)
+    the holder's, the force, friction (for all tools, and each tool's own: an optional number,
+    None where unset), stroke and drawbeads every kind takes."""}, module=__name__)
 
 
 @dataclass

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from shellform.scene.rules import keys_of_effects, require
-from shellform.scene.schema import HOLDERS, SIDES, SPREADS, TOOL_SHAPES
+from shellform.scene.schema import FRICTION_TOOLS, HOLDERS, SIDES, SPREADS, TOOL_SHAPES
 from shellform.tools import kinds as tool_kinds
 from shellform.tools.analytic import rounded_square_sdf
 
@@ -59,6 +59,7 @@ def validate_tools(s) -> None:
     require(t.stroke > 0, "tools.stroke", f"must be > 0, got {t.stroke}")
     for name in ("blank_holder_force", "friction"):
         require(getattr(t, name) >= 0, f"tools.{name}", f"must be >= 0, got {getattr(t, name)}")
+    _validate_friction_per_tool(s, t)
     flat, corner, what = tool_kinds.kind(t.shape).check(s)
     g = s.geometry
     if g.shape == "rectangle":
@@ -70,7 +71,6 @@ def validate_tools(s) -> None:
         require(g.radius > flat, "geometry.radius",
                 f"the blank does not reach the blank holder and the die's flat top: its radius {g.radius} "
                 f"must exceed {what} = {flat}")
-    require(t.friction > 0 or "friction" not in s.effects, "tools.friction", "the effect 'friction' needs friction > 0")
     require(bool(t.drawbead) or "drawbeads" not in s.effects, "tools.drawbead",
             "the effect 'drawbeads' needs at least one [[tools.drawbead]]")
     points = sum(len(bead.points) for bead in t.drawbead)
@@ -87,6 +87,24 @@ def validate_tools(s) -> None:
         v = s.supports.get(side, "free")
         require(v == "free", f"supports.{side}",
                 f"the tools hold the blank: its outer edges must be 'free', got {v!r}")
+
+
+def _validate_friction_per_tool(s, t) -> None:
+    """Each tool's own coefficient, where given: finite and >= 0; the effect 'friction' needs
+    one > 0 among the coefficients the tools carry (the error names tools.friction, or
+    tools.punch_friction where every tool has its own and `friction` is used by none)."""
+    for name in FRICTION_TOOLS:
+        key = f"{name}_friction"
+        v = getattr(t, key)
+        if v is None:
+            continue
+        require(isinstance(v, (int, float)) and math.isfinite(v), f"tools.{key}", f"must be finite, got {v}")
+        require(v >= 0, f"tools.{key}", f"must be >= 0, got {v}")
+    own = all(getattr(t, f"{name}_friction") is not None for name in FRICTION_TOOLS)
+    mu = t.friction_per_tool()
+    require(max(mu.values()) > 0 or "friction" not in s.effects, "tools.punch_friction" if own else "tools.friction",
+            "the effect 'friction' needs friction > 0 on at least one tool (friction, or a tool's own punch_friction, "
+            f"die_friction, holder_friction), got {', '.join(f'{k} {v:g}' for k, v in mu.items())}")
 
 
 def _validate_holder(s, t) -> None:
