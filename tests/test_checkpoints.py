@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from plastic_strip import strip_scene
 from resume_cup import cup, killed_after_first_report
 
 from shellform import cli
@@ -297,35 +298,8 @@ def test_a_full_disk_met_by_rank_0_alone_stops_both_ranks(tmp_path):
                                        "--resume continues from it once there is room")
 
 
-SHEET = """title = "strip with a full disk"
-effects = ["bending", "membrane", "plasticity"]
-[geometry]
-lx = 1.0
-ly = 0.125
-[mesh]
-n = 4
-[material]
-E = 1000.0
-nu = 0.3
-thickness = 0.02
-hardening = "swift"
-K = 1.0
-eps0 = 1.0
-n = 0.0
-[supports]
-left = "clamped"
-top = "symmetry"
-bottom = "symmetry"
-[loads]
-pressure = 1.0e-4
-[process]
-initial_step = 0.25
-report = [0.5]
-[output]
-vtx = true
-vtu = true
-png = false
-"""
+SHEET = strip_scene("strip with a full disk", 4, 1.0e-4, "initial_step = 0.25\nreport = [0.5]",
+                    "vtx = true\nvtu = true\npng = false")
 
 
 @pytest.mark.timeout(120)
@@ -549,6 +523,7 @@ import json, sys
 sys.path.insert(0, "TESTS")
 import shellform
 from mpi4py import MPI
+from plastic_strip import strip_scene
 from resume_cup import cup, killed_after_first_report
 from shellform.contact import run as contact_run
 if "MODE" == "kill":

@@ -9,36 +9,11 @@ from pathlib import Path
 
 import pytest
 
+from plastic_strip import strip_scene
+
 from shellform.studies.common import mpiexec
 
-STRIP = """title = "strip stepped slowly"
-effects = ["bending", "membrane", "plasticity"]
-[geometry]
-lx = 1.0
-ly = 0.125
-[mesh]
-n = 8
-[material]
-E = 1000.0
-nu = 0.3
-thickness = 0.02
-hardening = "swift"
-K = 1.0
-eps0 = 1.0
-n = 0.0
-[supports]
-left = "clamped"
-top = "symmetry"
-bottom = "symmetry"
-[loads]
-pressure = 2.0e-4
-[process]
-initial_step = 0.002
-max_step = 0.002
-[output]
-vtx = false
-png = false
-"""
+STRIP = strip_scene("strip stepped slowly", 8, 2.0e-4, "initial_step = 0.002\nmax_step = 0.002", "vtx = false\npng = false")
 
 
 def interrupted_run(tmp_path: Path, scene_text: str, signum: int, after: int, name="scene.toml", ranks=1):
