@@ -295,6 +295,22 @@ class System:
         rotate_cell_arrays(m.dofs, turn, G, m.forms.vectors, m.forms.matrices, tangent)
         self._array_frames = (self.rotated.copy(), self.frames.copy())
 
+    def free_tangent(self, lam: float):
+        """The tangent at the current q on its free rows, K_ff (scipy CSR), and those rows (the
+        unknowns of the nodes' frames: x, y, z and the slopes of a free node; a tool's normal and
+        tangents of a node on it), as a Newton iterate at lam sees them: for studying the
+        tangent's spectrum (scripts/tangent_modes.py). One rank."""
+        import scipy.sparse as sp
+
+        if self.model.mesh.comm.size > 1:
+            raise RuntimeError("free_tangent gathers nothing: run it on one rank")
+        self.linearize(lam)
+        self.assemble_tangent()
+        indptr, indices, values = self.A.getValuesCSR()
+        K = sp.csr_matrix((values, indices, indptr), shape=self.A.getSize())
+        free = np.setdiff1d(np.arange(K.shape[0]), self.bc_dofs)
+        return K[free][:, free], free
+
     def apply_tangent(self, v: np.ndarray) -> np.ndarray:
         """K v on the owned rows with the element tangents as they are (no Dirichlet rows; v a
         local array with ghosts): the change of the residual, reactions included, along v."""
