@@ -1,9 +1,11 @@
 # shellform: `make demo` runs the main job, `make test` the fast lane of the test suite (all but the
-# tests marked slow), `make test-slow` the slow lane; CI (.ci/run) runs both.
-# Both create .venv with a Python >= 3.12 and install the project on first use.
+# tests marked slow), `make test-slow` the slow lane; CI (.ci/run) runs both; `make docs` the docs site.
+# All create .venv with a Python >= 3.12 and install the project on first use (make docs adds the
+# docs extra: MkDocs and its plugins, pinned in pyproject.toml).
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+DOCSTAMP := $(VENV)/.docs-installed
 OUT    ?= results/square_cup
 # test processes (pytest-xdist): one per core of the 2-core machines the suite is sized for
 NPROC  ?= 2
@@ -39,5 +41,16 @@ test: $(STAMP)
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -n $(NPROC) --dist loadfile -m slow tests
 
+# the site from docs/ (mkdocs.yml) into site/: first the check that the studies' tables the pages
+# include are their files (scripts/docs_include.py), then MkDocs with every warning an error
+docs: $(DOCSTAMP)
+	$(PY) scripts/docs_include.py --check
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict
+	@echo "shellform: the docs site is in site/ (open site/index.html)"
+
+$(DOCSTAMP): $(STAMP)
+	$(PY) -m pip install -q -e '.[docs]'
+	@touch $(DOCSTAMP)
+
 clean:
-	rm -rf $(VENV) results
+	rm -rf $(VENV) results site
