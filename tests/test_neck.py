@@ -231,12 +231,13 @@ def _force_stroke(summary) -> list[dict]:
 
 
 def test_the_watch_bounds_the_step_ahead_of_the_predicted_onset():
-    """Least stabilities 50, 30 and 10 at 1.0, 1.1 and 1.2 (a steady fall) predict 0 at 1.25:
-    a next step of 0.1 is bounded to half the distance, 0.025 (the first step bounded, whose
-    quarter, 0.025, is the floor from then on), a step of 0.4 then to 0.025 too; a first bound
-    of 0.4 to its quarter, 0.1; a step that does not reach 1.25 (0.04) is left as it is. A fall that slows to less than a quarter of its rate
-    (800, 40, 20: the elastic-plastic transition, which a line would see reach 0 at 1.3), a
-    rising stability and a neck already found bound nothing."""
+    """After an elastic first increment (least stability 5,000), 30 and 10 at 1.1 and 1.2 (below
+    a hundredth of 5,000: the plastic scale) predict 0 at 1.25: a next step of 0.1 is bounded to
+    half the distance, 0.025 (the first step bounded, whose quarter, 0.025, is the floor from
+    then on), a step of 0.4 then to 0.025 too; a first bound of 0.4 to its quarter, 0.1; a step
+    that does not reach 1.25 (0.04) is left as it is. The elastic-plastic transition (5,000,
+    4,000, 1,000: a line through the last two reaches 0 at 1.233), a rising stability and a
+    neck already found bound nothing."""
     centres = np.array([[0.5, 0.5]])
 
     def watched(values, at=(1.0, 1.1, 1.2)):
@@ -245,15 +246,15 @@ def test_the_watch_bounds_the_step_ahead_of_the_predicted_onset():
             watch.reached(a, np.array([m]), np.array([-0.05]), centres)
         return watch
 
-    assert watched([50.0, 30.0]).ahead(0.1) == 0.1  # two increments: no trend yet
-    watch = watched([50.0, 30.0, 10.0])
+    assert watched([30.0]).ahead(0.1) == 0.1  # one increment: nothing to extrapolate
+    watch = watched([5000.0, 30.0, 10.0])
     assert watch.ahead(0.04) == 0.04
     assert watch.ahead(0.1) == pytest.approx(0.025, rel=1e-12)
     assert watch.ahead(0.4) == pytest.approx(0.025, rel=1e-12)
-    assert watched([50.0, 30.0, 10.0]).ahead(0.4) == pytest.approx(0.1, rel=1e-12)  # the floor, a quarter of 0.4
-    assert watched([800.0, 40.0, 20.0]).ahead(0.1) == 0.1
-    assert watched([50.0, 30.0, 35.0]).ahead(0.1) == 0.1
-    necked = watched([50.0, 30.0, 10.0, -1.0], at=(1.0, 1.1, 1.2, 1.3))
+    assert watched([5000.0, 30.0, 10.0]).ahead(0.4) == pytest.approx(0.1, rel=1e-12)  # the floor, a quarter of 0.4
+    assert watched([5000.0, 4000.0, 1000.0]).ahead(0.1) == 0.1
+    assert watched([5000.0, 30.0, 35.0]).ahead(0.1) == 0.1
+    necked = watched([5000.0, 30.0, 10.0, -1.0], at=(1.0, 1.1, 1.2, 1.3))
     assert necked.onset is not None and necked.ahead(0.1) == 0.1
 
 

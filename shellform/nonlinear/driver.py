@@ -76,9 +76,7 @@ class Driver(Newton):
         self.known_tolerance = max([0.0] + [p.known_tolerance for p in self.parts])
         self.swap_line_search = all(np.isinf(p.largest_move()) for p in self.parts)
         self.checkpoint_dir = Path(checkpoint_dir) if checkpoint_dir else None
-        # the room kept on the checkpoints' disk (results/disk.py): each checkpoint, and the run's
-        # series written there, refused before it starts where it might not fit
-        self.room = Room(self.checkpoint_dir, model.mesh.comm) if self.checkpoint_dir else None
+        self._room = None  # the checkpoint folder's Room (the property room)
         self.verbose, self.trace = verbose, trace
         self.progress = Progress()  # a run sets its own (label, total, unit)
         self.stops = StopRequests(model.mesh.comm)  # Ctrl-C and SIGTERM while it steps (interrupt.py)
@@ -171,6 +169,17 @@ class Driver(Newton):
             self.searching = not self.searching
             self.cause = f"{cause}; with the line search {'on' if self.searching else 'off'}: {self.cause}"
         return ok, its + its2, res, ev
+
+    @property
+    def room(self) -> Room | None:
+        """The room kept on the checkpoints' disk (results/disk.py): each checkpoint, and the
+        run's series written there, refused before it starts where it might not fit; one per
+        checkpoint_dir (which a caller may set after construction), None without one."""
+        if self.checkpoint_dir is None:
+            return None
+        if self._room is None or self._room.folder != Path(self.checkpoint_dir):
+            self._room = Room(Path(self.checkpoint_dir), self.model.mesh.comm)
+        return self._room
 
     @property
     def next_step(self) -> float | None:

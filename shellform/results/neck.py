@@ -16,13 +16,12 @@ last two increments it extrapolates linearly where it reaches 0, and where the n
 go past that, the step is bounded to half the distance to it, but not below a quarter of the
 step it first bounded, so that the onset falls into a short increment (its interpolation the
 more accurate, the neck's first increments the easier for Newton) and the approach takes a few
-increments, not a halving without end. A fall that slows to less than a quarter of its rate
-at the increment before is not extrapolated: that is the elastic-plastic transition (a cup's
-least stability falls from some 36,000 to 8,000 MPa in its first plastic increment, then by
-1,000 in the next), which a straight line through the last two would see reach 0 within a
-step. After it the least stability decays about exponentially (halving every few millimetres of
-a cup's stroke), which the line sees reach 0 at about a step ahead, and which bounds nothing
-while the steps are shorter than its decay.
+increments, not a halving without end. Only a least stability below PLASTIC of the first
+increment's (an elastic sheet's) is extrapolated: above it its fall is the transition from
+elastic to plastic (a cup's least stability falls from some 36,000 MPa at its first increment
+to 8,000 in its first plastic one), which a straight line through two increments would see
+reach 0 within a step; near a neck it is a few hundred MPa or less (Considere's d sigma / d eps
+- sigma, against E).
 
 The watch is told the sheet's state after every converged increment (a run's on_increment;
 the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
@@ -37,7 +36,7 @@ reports it (summary.json "neck", null without a neck).
 
 import numpy as np
 
-SLOWING = 0.25  # a fall of the least stability slowing below this fraction of its rate before is not extrapolated
+PLASTIC = 0.01  # of the first increment's least stability: below it, its fall is extrapolated to a neck
 
 
 class NeckReached(Exception):
@@ -54,7 +53,8 @@ class NeckWatch:
         self.last = None  # (load measure, least stability) of the last increment
         self.thickness = None  # the local cells' thickness strains at the last increment
         self.onset = None  # {at, "increment_" + at, place, "thickness_strain", "stability"}, or None
-        self.trend = []  # (load measure, least stability) of the last three increments
+        self.before = None  # (load measure, least stability) of the increment before the last
+        self.first = None  # the least stability at the first increment with a thinned cell (an elastic sheet's)
         self.shortest = None  # the least step `ahead` bounds to: a quarter of the first it bounded
 
     def carry(self, onset: dict | None, at: float) -> None:
@@ -88,22 +88,23 @@ class NeckWatch:
             xy, t = self.comm.bcast(where, root=owner)
             self.onset = {self.at: float(start), f"increment_{self.at}": float(at), self.place: xy,
                           "thickness_strain": float(t), "stability": float(least)}
-        self.last = (float(at), float(least))
-        self.trend = (self.trend + [self.last])[-3:]
+        self.before, self.last = self.last, (float(at), float(least))
+        if self.first is None and np.isfinite(least):  # the first increment with a thinned cell
+            self.first = float(least)
         self.thickness = np.array(thickness_strain, dtype=float, copy=True)
         return self.onset is not None
 
     def ahead(self, step: float) -> float:
         """The longest next step (in the load measure) that does not overrun the onset the last
         two increments predict (module docstring): step itself where no onset is predicted
-        within it (fewer than three increments seen, the stability not falling, its fall slowing
-        below SLOWING of its rate before, or the neck already started)."""
-        if self.onset is not None or len(self.trend) < 3:
+        within it (one increment seen, the stability above PLASTIC of the first increment's or not
+        falling, or the neck already started)."""
+        if self.onset is not None or self.before is None:
             return step
-        (a_, m_), (a0, m0), (a1, m1) = self.trend
-        if not np.all(np.isfinite([m_, m0, m1])) or m1 <= 0.0 or m1 >= m0 or a1 == a0 or a0 == a_:
+        (a0, m0), (a1, m1) = self.before, self.last
+        if not (np.isfinite(m0) and np.isfinite(m1)) or m1 <= 0.0 or m1 >= m0 or a1 == a0:
             return step
-        if (m0 - m1) / abs(a1 - a0) < SLOWING * (m_ - m0) / abs(a0 - a_):  # the elastic-plastic transition
+        if not m1 < PLASTIC * self.first:  # the elastic-plastic transition, not a neck's approach
             return step
         distance = m1 * abs(a1 - a0) / (m0 - m1)  # to the linear extrapolation's zero
         if distance >= step:

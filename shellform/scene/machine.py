@@ -65,9 +65,11 @@ def check_size(s) -> None:
             f"{layers:,} points through the thickness on {cells:,} cells need about {need / 1e9:.3g} GB; "
             f"this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
     own = outline.file_own_size(s.geometry, m.n) if need > have and s.geometry.shape == "file" else None
-    if own is not None:
+    unrefined = outline.file_cells(s.geometry, m.n, 0) if own is not None else 0
+    if own is not None and budget.estimated_bytes(unrefined, e["nonlinear"], layers=layers) > have:  # not mesh.refine's
         raise InputError("geometry.file", f"its own mesh sizes (gmsh meshes its curves at a median {own:.3g} mm) "
-                         f"make about {cells:,} cells (refine {m.refine}), which need about {need / 1e9:.3g} GB; "
+                         f"make about {unrefined:,} cells, which need about "
+                         f"{budget.estimated_bytes(unrefined, e['nonlinear'], layers=layers) / 1e9:.3g} GB; "
                          f"this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
     require(need <= have, "mesh.n", f"n = {m.n} (refine {m.refine}) makes about {cells:,} cells, which need about "
             f"{need / 1e9:.3g} GB; this machine allows {have / 1e9:.3g} GB (shellform/mesh/budget.py)")
