@@ -259,10 +259,15 @@ def test_the_watch_bounds_the_step_ahead_of_the_predicted_onset():
 
 
 def test_without_stop_at_neck_the_run_goes_on_and_reports_the_neck(stretched):
-    """The same onset, and the stroke drawn to its end (30 mm), thinning past it."""
+    """The stroke drawn to its end (30 mm), thinning past the onset, which it reports in the same
+    cell. Its steps are the scene's throughout (only a run that stops at the neck shortens them):
+    the onset lies between its increments at 18 and 19.5 mm, at 19.41 mm, earlier than the
+    shortened steps put it (the step's error)."""
     on, off = stretched[True], stretched[False]
     assert off["stroke_mm"] == pytest.approx(30.0)
-    assert off["neck"] == on["neck"]
+    assert off["neck"]["initial_xy_mm"] == on["neck"]["initial_xy_mm"]
+    assert off["neck"]["increment_stroke_mm"] == pytest.approx(19.5)
+    assert 18.0 < off["neck"]["stroke_mm"] < on["neck"]["stroke_mm"]
     assert off["min_thickness_strain"] < on["neck"]["thickness_strain"] - 0.05
 
 

@@ -226,8 +226,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             necked = necks.reached(p.stroke, p.model.membrane_stability(), p.model.thickness_strain(), centres)
             if necked and before is None and not s.process.stop_at_neck:
                 p.driver.progress.note(f"shellform: the sheet starts to neck: {neck.words(necks.onset)}")
-            if d.next_step is not None:  # shorter steps ahead of the onset (mm of travel per load factor)
-                d.bound_next_step(necks.ahead(d.next_step * s.tools.stroke) / s.tools.stroke)
+            if s.process.stop_at_neck and d.next_step is not None:  # shorter steps ahead of the run's end
+                d.bound_next_step(necks.ahead(d.next_step * s.tools.stroke) / s.tools.stroke)  # mm per load factor
         if paths is not None or watch is not None:
             f = p.model.cell_fields()
             if paths is not None:

@@ -139,7 +139,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             if before is None:
                 p.driver.progress.note(f"shellform: the sheet starts to neck: "
                                        f"{neck.words(necks.onset, 'load_factor', 'initial_xy')}")
-        if d.next_step is not None:  # shorter steps ahead of the onset
+        if s.process.stop_at_neck and d.next_step is not None:  # shorter steps ahead of the run's end
             d.bound_next_step(necks.ahead(d.next_step))
 
     full = None  # the DiskFull that stopped the run

@@ -11,7 +11,8 @@ watched. Where the sheet thickens, compressed in the mean (a cup's flange and it
 a rim ironed between the tools), the membrane tangent may turn indefinite too, but that is the
 membrane's own wrinkling, which the shell's bending resists, or the faces' pressure, not a neck.
 
-Ahead of the onset the watch shortens the steps (`ahead`): from the least stability at the
+Where the run stops at the neck ([process] stop_at_neck), the watch shortens the steps ahead
+of the onset (`ahead`), so that the run ends close to it: from the least stability at the
 last two increments it extrapolates linearly where it reaches 0, and where the next step would
 go past that, the step is bounded to half the distance to it, but not below a quarter of the
 step it first bounded, so that the onset falls into a short increment (its interpolation the
