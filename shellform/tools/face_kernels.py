@@ -59,13 +59,19 @@ def _arc1(phi, lo, hi, tol):
     return (hi, False) if after - span < before else (lo, False)
 
 
+@njit(inline="always")
+def _along(dx, dy, dz, q, a):
+    """(dx, dy, dz) along the unit vector q[a:a + 3] of a face's row: a coordinate in its frame."""
+    return dx * q[a] + dy * q[a + 1] + dz * q[a + 2]
+
+
 @njit
 def _planes_nearest(y, j, rows, uv, d, inside):
     for p in range(len(j)):
         q = rows[j[p]]
         dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
-        u, iu = _interval1(dx * q[3] + dy * q[4] + dz * q[5], q[9], q[11], q[13])
-        v, iv = _interval1(dx * q[6] + dy * q[7] + dz * q[8], q[10], q[12], q[14])
+        u, iu = _interval1(_along(dx, dy, dz, q, 3), q[9], q[11], q[13])
+        v, iv = _interval1(_along(dx, dy, dz, q, 6), q[10], q[12], q[14])
         rx, ry, rz = dx - (u * q[3] + v * q[6]), dy - (u * q[4] + v * q[7]), dz - (u * q[5] + v * q[8])
         uv[p, 0], uv[p, 1], d[p], inside[p] = u, v, np.sqrt(rx * rx + ry * ry + rz * rz), iu and iv
 
@@ -85,8 +91,7 @@ def _cylinders_nearest(y, j, rows, uv, d, inside):
     for p in range(len(j)):
         q = rows[j[p]]
         dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
-        qx, qy, qz = dx * q[3] + dy * q[4] + dz * q[5], dx * q[6] + dy * q[7] + dz * q[8], \
-            dx * q[9] + dy * q[10] + dz * q[11]
+        qx, qy, qz = _along(dx, dy, dz, q, 3), _along(dx, dy, dz, q, 6), _along(dx, dy, dz, q, 9)
         phi = np.arctan2(qy, qx)
         u, iu = _arc1(phi, q[13], q[15], q[17])
         v, iv = _interval1(qz, q[14], q[16], q[18])
@@ -112,8 +117,7 @@ def _revolutions_nearest(y, j, rows, uv, d, inside):
     for p in range(len(j)):
         q = rows[j[p]]
         dx, dy, dz = y[p, 0] - q[0], y[p, 1] - q[1], y[p, 2] - q[2]
-        qw, qb, qa = dx * q[12] + dy * q[13] + dz * q[14], dx * q[15] + dy * q[16] + dz * q[17], \
-            dx * q[18] + dy * q[19] + dz * q[20]  # y along w_0, b_0 and a
+        qw, qb, qa = _along(dx, dy, dz, q, 12), _along(dx, dy, dz, q, 15), _along(dx, dy, dz, q, 18)  # w_0, b_0, a
         rho, phi = np.hypot(qw, qb), np.arctan2(qb, qw)
         u, iu = _arc1(phi, q[28], q[30], q[32])
         turn = u - phi
