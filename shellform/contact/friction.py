@@ -85,6 +85,7 @@ class CoulombFriction(Part):
         n = len(k_stick)
         self.mu, self.k_stick, self.held = mu, k_stick, held
         self.coefficient = np.zeros(n)  # mu_i of each node at the last return mapping
+        self.table = None  # mu per tool of the contact set, the holder's last (bind)
         self.contact, self.nodes, self.rtol, self.trace = contact, nodes, rtol, trace
         self.normal = np.zeros(n)  # p, the normal force friction uses (both faces)
         self.committed_normal = self.normal.copy()
@@ -119,8 +120,7 @@ class CoulombFriction(Part):
         """mu_i per owned node from the contact set's faces now (module docstring): its tool's
         (FREE: the holder's), moved towards the holder's by the holder face's share of its normal
         forces."""
-        c = self.contact
-        table = self.per_tool()
+        c, table = self.contact, self.table
         tool_mu = table[c.tool]  # FREE (-1): the last, the holder's
         d, h = c.faces()
         total = d + h
@@ -128,7 +128,7 @@ class CoulombFriction(Part):
         return tool_mu + (table[-1] - tool_mu) * share
 
     def bind(self, driver) -> None:
-        self.per_tool()  # one coefficient per tool, or one for all
+        self.table = self.per_tool()  # mu per tool, the holder's last (checked here, once)
         self.comm = driver.model.mesh.comm
         self.normal = self.contact.face_forces()
         self.committed_normal = self.normal.copy()
@@ -236,7 +236,7 @@ class CoulombFriction(Part):
         """d(mu_i p_i)/dR0_i / mu_i per owned node (0 where mu_i = 0): each face's slope
         (ContactSet.face_slopes) times its own coefficient over the node's (module docstring);
         the faces' dp/dR0 where the coefficients are equal."""
-        table = self.per_tool()
+        table = self.table
         tool_mu = table[self.contact.tool]
         mu = self.coefficient
         on = mu > 0
@@ -274,7 +274,7 @@ class CoulombFriction(Part):
         passes converge once |mu_i r_i| <= rtol |mu_i p~_i| (the coefficients of the new faces,
         over the largest mu: a weight of 1 where they are all equal)."""
         self.forget(self.contact.switched)
-        mu = float(np.max(self.per_tool()))
+        mu = float(np.max(self.table))
         weight = self.coefficients() / mu if mu > 0 else 1.0
         dp, pn = self.update_normal(changes, weight)
         return Change(0, 0, bool(mu * dp <= self.rtol * mu * pn),

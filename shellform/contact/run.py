@@ -266,13 +266,17 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                 series.write(p.stroke)
             write_json(outdir / "reports.json", reports)  # what a resumed run takes over
 
-    def disk_full(err: DiskFull, when: str) -> str:
-        """A full disk's stop in one sentence: where, why, and which checkpoint is kept."""
+    def stop_for_full_disk(err: DiskFull, when: str) -> None:
+        """A full disk stops the run: `stopped` (after a stop before it) says in one sentence
+        where, why, and which checkpoint is kept."""
+        nonlocal stopped
         found = comm.bcast(checkpoint.last_complete(outdir) if comm.rank == 0 else None, root=0)
         g = found[1] if found else {}
         at = f" at {_stroke_of(g['lam'], g['contact_travel']):.4g} mm" if "lam" in g and "contact_travel" in g else ""
         resume = ": --resume continues from it once there is room" if found else ""
-        return f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}{resume}"
+        stopped = (f"{stopped}; " if stopped else "") + \
+            f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}{resume}"
+        p.driver.progress.note(f"shellform: stopped: {stopped}")
 
     def after_the_stroke():
         """The tables and pictures of the drawn cup, then the springback: (rim, limits, sprung);
@@ -343,8 +347,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             reports.append(state())  # in the summary only: a resumed run reports where the scene says
     except DiskFull as err:  # after the increment under way; nothing more is written but the summary
         full = err
-        stopped = (f"{stopped}; " if stopped else "") + disk_full(err, f"at {p.stroke:.4g} mm")
-        p.driver.progress.note(f"shellform: stopped: {stopped}")
+        stop_for_full_disk(err, f"at {p.stroke:.4g} mm")
         if not reports or reports[-1]["stroke_mm"] != p.stroke:
             reports.append(state())  # in the summary only, as at a signal
     p.driver.progress.close()
@@ -357,9 +360,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
             d.room.check("the tables and pictures")
             rim, limits, sprung = after_the_stroke()
         except DiskFull as err:
-            stopped = (f"{stopped}; " if stopped else "") + disk_full(err, "writing the tables and pictures "
-                                                                           f"at {p.stroke:.4g} mm")
-            p.driver.progress.note(f"shellform: stopped: {stopped}")
+            stop_for_full_disk(err, f"writing the tables and pictures at {p.stroke:.4g} mm")
     summary = DrawingSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "friction": {k: v if "friction" in s.effects else 0.0 for k, v in s.tools.friction_per_tool().items()},

@@ -123,11 +123,15 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             with p.driver.room.write("the report"):
                 series.write(p.driver.lam, p.driver.q, p.model.components, p.model.cell_fields())
 
-    def disk_full(err: DiskFull, when: str) -> str:
-        """A full disk's stop in one sentence: where, why, and which checkpoint is kept."""
+    def stop_for_full_disk(err: DiskFull, when: str) -> None:
+        """A full disk stops the run: `stopped` (after a stop before it) says in one sentence
+        where, why, and which checkpoint is kept."""
+        nonlocal stopped
         found = comm.bcast(checkpoint.last_complete(outdir) if comm.rank == 0 else None, root=0)
         at = f" at load factor {float(found[1]['lam']):.6g}" if found and "lam" in found[1] else ""
-        return f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}"
+        stopped = (f"{stopped}; " if stopped else "") + \
+            f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}"
+        p.driver.progress.note(f"shellform: stopped: {stopped}")
 
     def on_increment(d):
         if necks is None:
@@ -165,8 +169,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             record()  # the last converged state, which the driver restored
     except DiskFull as err:  # after the increment under way; nothing more is written but the summary
         full = err
-        stopped = (f"{stopped}; " if stopped else "") + disk_full(err, f"at load factor {p.driver.lam:.6g}")
-        p.driver.progress.note(f"shellform: stopped: {stopped}")
+        stop_for_full_disk(err, f"at load factor {p.driver.lam:.6g}")
         if not reports or reports[-1]["load_factor"] != p.driver.lam:
             reports.append(_record(p, s))  # in the summary only
     p.driver.progress.close()
@@ -184,9 +187,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             if s.output.png:
                 fields.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
         except DiskFull as err:
-            stopped = (f"{stopped}; " if stopped else "") + disk_full(err, "writing the tables and fields at "
-                                                                           f"load factor {d.lam:.6g}")
-            p.driver.progress.note(f"shellform: stopped: {stopped}")
+            stop_for_full_disk(err, f"writing the tables and fields at load factor {d.lam:.6g}")
     summary = SheetSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global,
