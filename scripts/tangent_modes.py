@@ -3,7 +3,8 @@
     python scripts/tangent_modes.py SCENE OUT [--set key=value ...] [-k K]
 
 OUT: a `shellform run` folder with its checkpoint (the scene and the --set values it was run
-with). The tangent on the free rows (System.free_tangent) at the checkpoint's state; the K
+with). The tangent on the free rows (System.free_tangent, their count in each row) at the
+checkpoint's state; the K
 smallest eigenvalues of its symmetric part (shift-invert about 0, so a negative one is found
 first: a tangent that is not positive definite, an unstable equilibrium), and for each mode the
 nodes that carry 90 % of it, its dominant unknown (0, 1, 2: x, y, z of a free node) and the
@@ -46,7 +47,7 @@ def modes(s, out, k: int) -> list[dict]:
         top = order[0]
         c = int(np.argmax(np.abs(V[top])))
         share = np.cumsum(amp[order] ** 2) / np.sum(amp ** 2)
-        rows.append({"stroke_mm": p.stroke, "eigenvalue": float(values[i]), "of_the_median_diagonal": float(values[i] / scale),
+        rows.append({"stroke_mm": p.stroke, "free_rows": len(free), "eigenvalue": float(values[i]), "of_the_median_diagonal": float(values[i] / scale),
                      "nodes_for_90_percent": int(np.searchsorted(share, 0.9) + 1), "dominant_unknown": c,
                      "largest": [{"initial_xy": x0[j, :2].round(2).tolist(), "current_xyz": x[j].round(2).tolist(),
                                   "value": round(float(V[j, c] / V[top, c]), 3)} for j in order[:8]]})
