@@ -41,10 +41,12 @@ test: $(STAMP)
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -n $(NPROC) --dist loadfile -m slow tests
 
-# the site from docs/ (mkdocs.yml) into site/: first the check that the studies' tables the pages
-# include are their files (scripts/docs_include.py), then MkDocs with every warning an error
+# the site from docs/ (mkdocs.yml) into site/: first the checks that the studies' tables the pages
+# include are their files (scripts/docs_include.py) and that the numbers the prose cites from them
+# are theirs (scripts/docs_numbers.py), then MkDocs with every warning an error
 docs: $(DOCSTAMP)
 	$(PY) scripts/docs_include.py --check
+	$(PY) scripts/docs_numbers.py
 	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict
 	@echo "shellform: the docs site is in site/ (open site/index.html)"
 

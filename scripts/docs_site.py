@@ -8,9 +8,10 @@
 - a page per module of the API reference, api/<module>.md: mkdocstrings' `::: <module>`, for
   every api/ entry of mkdocs.yml's nav (the nav is the one list of the reference's modules; a
   package's page shows its modules too);
-- and before the build, the include check of scripts/docs_include.py: a page whose included
-  table differs from its study's file is a warning, which `mkdocs build --strict` (make docs)
-  turns into a failure.
+- and before the build, the include check of scripts/docs_include.py and the cites check of
+  scripts/docs_numbers.py: a page whose included table differs from its study's file, or whose
+  prose cites a number its file does not hold, is a warning, which `mkdocs build --strict`
+  (make docs) turns into a failure.
 
 Every page is generated in memory (mkdocs' File.generated): nothing is written into docs/.
 """
@@ -25,9 +26,17 @@ from mkdocs.structure.files import File
 ROOT = Path(__file__).resolve().parents[1]
 log = logging.getLogger("mkdocs.hooks.docs_site")
 
-_spec = importlib.util.spec_from_file_location("docs_include", ROOT / "scripts" / "docs_include.py")
-docs_include = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(docs_include)
+
+def _script(name: str):
+    """A module of scripts/ (not a package) loaded from its file."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+docs_include = _script("docs_include")
+docs_numbers = _script("docs_numbers")
 
 LINK = re.compile(r"(!?)\[([^\]]*)\]\((?!https?://|#)([^)\s]+)\)")
 
@@ -84,6 +93,8 @@ def nav_entries(nav):
 def on_pre_build(config):
     for problem in docs_include.check(Path(config["docs_dir"])):
         log.warning(f"docs_include: {problem}")
+    for problem in docs_numbers.check(Path(config["docs_dir"])):
+        log.warning(f"docs_numbers: {problem}")
 
 
 def on_files(files, config):

@@ -1,6 +1,7 @@
 """The docs' numbers come from the runs: every results table a page shows is included from the
 file its study wrote (scripts/docs_include.py), that file is what the study's own `markdown`
-makes of its CSV, and the site (mkdocs.yml, make docs) builds without a warning."""
+makes of its CSV, every number the prose cites from a study's file is that file's
+(scripts/docs_numbers.py), and the site (mkdocs.yml, make docs) builds without a warning."""
 
 import csv
 import importlib.util
@@ -17,9 +18,17 @@ from shellform.studies import cup_convergence, esaform_cup, nakajima, numisheet_
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
-spec = importlib.util.spec_from_file_location("docs_include", ROOT / "scripts" / "docs_include.py")
-docs_include = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(docs_include)
+
+
+def _script(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+docs_include = _script("docs_include")
+docs_numbers = _script("docs_numbers")
 
 
 def test_the_pages_tables_are_their_studies_files():
@@ -60,6 +69,71 @@ def test_a_section_include_a_missing_file_and_a_block_without_end(tmp_path):
 
 def _line(text: str, target: str) -> int:
     return next(i for i, line in enumerate(text.splitlines(), 1) if line.startswith("<!-- include:") and target in line)
+
+
+def test_the_numbers_the_pages_cite_are_their_files():
+    """Every `<!-- cites: ... -->` of docs/*.md holds: the pages whose prose quotes the studies cite them."""
+    assert docs_numbers.check() == []
+    cited = {p.name: sum(1 for _, c, _ in docs_numbers.cites(p) if c) for p in (ROOT / "docs").glob("*.md")}
+    for page in ("cost.md", "cup-convergence.md", "cup.md", "results.md"):
+        assert cited[page] >= 5, (page, cited[page])
+
+
+def _cited_page(tmp_path: Path) -> Path:
+    """A docs folder with a CSV, a JSON summary and a Markdown table, and a page citing all three."""
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "t.csv").write_text("case,n,force,share\nal,16,48.0721,0.0456711\nal,24,47.6325,nan\n")
+    (tmp_path / "results" / "s.json").write_text('{"draw_in_mm": [{"stroke_mm": 15.0, "DX": 5.0945}], "balance": 1.4043e-06}')
+    (tmp_path / "results" / "t.md").write_text("## a\n\n| run | DX | note |\n|---|---|---|\n| n 16 | 5.122 | 1.2 % |\n")
+    page = tmp_path / "p.md"
+    page.write_text("# P\n\nThe force is 48.1 kN on n = 16 <!-- cites: 48.1 = results/t.csv case=al n=16 force -->\n"
+                    "and 47.6 on 24, DX 5.09 mm, 4.6 % <!-- cites: 47.6 = results/t.csv n=24 force; 4.6 = n=16 share *100; "
+                    "5.09 = results/s.json draw_in_mm[stroke_mm=15].DX -->\n\n"
+                    "- balance 1.4e-6, DX -5.122 <!-- cites: 1.4e-6 = results/s.json balance; 5.122 = results/t.md#a run=\"n 16\" DX -->\n")
+    return page
+
+
+def test_a_cited_number_its_file_does_not_hold_fails_naming_it(tmp_path):
+    page = _cited_page(tmp_path)
+    assert docs_numbers.check(tmp_path) == []
+    text = page.read_text()
+    page.write_text(text.replace("48.1", "48.2"))  # the text and its cite, both wrong
+    assert docs_numbers.check(tmp_path) == ["p.md:3: 48.2 = results/t.csv case=al n=16 force: the file holds 48.0721, not 48.2"]
+    assert docs_numbers.main(["--docs", str(tmp_path)]) == 1
+    page.write_text(text.replace("48.1 kN", "48.2 kN"))  # the text edited, its cite not
+    assert docs_numbers.check(tmp_path) == ["p.md:3: 48.1 = results/t.csv case=al n=16 force: the text before the comment does not show 48.1"]
+    for shown, ok in (("48.07", True), ("48", True), ("48.072", True), ("48.08", False), ("-48.1", False), ("+48.1", True)):
+        page.write_text(text.replace("48.1", shown))  # to the digits shown; a sign must match
+        assert (docs_numbers.check(tmp_path) == []) is ok, shown
+    page.write_text(text.replace("DX 5.09 mm", "DX 5.1 mm").replace("5.09 = ", "5.1 = "))
+    assert docs_numbers.check(tmp_path) == []
+    page.write_text(text.replace("DX 5.09 mm", "DX 5.2 mm").replace("5.09 = ", "5.2 = "))
+    assert docs_numbers.check(tmp_path) == ["p.md:4: 5.2 = results/s.json draw_in_mm[stroke_mm=15].DX: the file holds 5.0945, not 5.2"]
+
+
+def test_a_cite_that_cannot_be_read_is_a_clear_error(tmp_path):
+    page = _cited_page(tmp_path)
+    text = page.read_text()
+    for old, new, message in (
+            ("results/t.csv case=al n=16 force", "results/u.csv case=al n=16 force", "no file results/u.csv"),
+            ("n=16 force -->", "n=16 forse -->", "results/t.csv: no column 'forse'"),
+            ("case=al n=16 force", "case=al force", "results/t.csv: 2 rows with case=al, not one"),
+            ("n=24 force", "n=24 share", "results/t.csv n=24 share is 'nan', not a number"),
+            ("draw_in_mm[stroke_mm=15].DX", "draw_in_mm[stroke_mm=40].DX", "0 entries of 'draw_in_mm[stroke_mm=40].DX'"),
+            ("s.json balance", "s.json balanse", "results/s.json: no 'balanse'"),
+            ("t.md#a run", "t.md#b run", "results/t.md#b: no heading 'b'"),
+            ("run=\"n 16\" DX", "run=\"n 16\" note", None),
+            ("48.1 = results", "48.1 results", "not SHOWN = FILE [KEY=VALUE ...] FIELD")):
+        page.write_text(text.replace(old, new))
+        problems = docs_numbers.check(tmp_path)
+        if message is None:  # "1.2 %" is a number: the cite is wrong, not unreadable
+            assert len(problems) == 1 and "the file holds 1.2, not 5.122" in problems[0]
+        else:
+            assert len(problems) == 1 and message in problems[0], (message, problems)
+    page.write_text(text.replace(" <!-- cites: 48.1", "\n<!-- cites: 48.1"))  # alone on its line: ends the paragraph
+    assert docs_numbers.check(tmp_path) == ["p.md:4: a cites comment follows the text on its line (alone, it ends the paragraph or list)"]
+    page.write_text(text.replace("n=16 force -->", "n=16 force\n-->"))
+    assert docs_numbers.check(tmp_path) == ["p.md:3: a cites comment ends on its own line (-->)"]
 
 
 def _value(s: str):
