@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import cup_convergence, esaform_cup, nakajima, numisheet_cost
+from shellform.studies import cup_convergence, cup_paper, esaform_cup, nakajima, numisheet_cost
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -34,7 +34,8 @@ docs_numbers = _script("docs_numbers")
 def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
-    assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "esaform_cup", "nakajima", "numisheet_cost")}
+    assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "cup_paper", "esaform_cup", "nakajima",
+                                                                  "numisheet_cost")}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):
@@ -75,7 +76,7 @@ def test_the_numbers_the_pages_cite_are_their_files():
     """Every `<!-- cites: ... -->` of docs/*.md holds: the pages whose prose quotes the studies cite them."""
     assert docs_numbers.check() == []
     cited = {p.name: sum(1 for _, c, _ in docs_numbers.cites(p) if c) for p in (ROOT / "docs").glob("*.md")}
-    for page in ("cost.md", "cup-convergence.md", "cup.md", "results.md"):
+    for page in ("cost.md", "cup-convergence.md", "cup.md"):
         assert cited[page] >= 5, (page, cited[page])
 
 
@@ -158,8 +159,9 @@ def _rows(path: Path, drop_empty: bool = False) -> list[dict]:
 
 
 def test_the_studies_tables_are_their_csvs():
-    """Each table docs/results/<study>/<study>.md is the study's `markdown` of its CSV files: the
-    numbers a page includes are the runs' (to the CSV's six digits, which every table rounds)."""
+    """Each table docs/results/<study>/<study>.md is the study's `markdown` of its CSV files (and
+    cup-paper's of the thickness lines and force_stroke.csv of the runs it draws on): the numbers
+    a page includes are the runs' (to the CSV's six digits, which every table rounds)."""
     made = {
         "nakajima": nakajima.markdown(_rows(RESULTS / "nakajima" / "nakajima.csv")),
         "cup_convergence": cup_convergence.markdown(
@@ -172,6 +174,8 @@ def test_the_studies_tables_are_their_csvs():
             {r["answer"]: (r["value"], r["uncertainty"], r["source"])
              for r in _rows(RESULTS / "numisheet_cost" / "numisheet_cost_reference.csv")},
             _rows(RESULTS / "numisheet_cost" / "numisheet_cost_picks.csv")),
+        "cup_paper": cup_paper.markdown(_rows(RESULTS / "cup_paper" / "cup_paper.csv"), RESULTS / "cup_mesh",
+                                        RESULTS / "cup_hard"),
     }
     assert not (RESULTS / "esaform_cup" / "esaform_cup_estimates.csv").exists()  # else markdown takes them
     for study, text in made.items():

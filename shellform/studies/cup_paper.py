@@ -13,8 +13,9 @@ demos/square_cup.toml (BHF 2 t = 19.6 kN, mu 0.1, r 1.5, die radius 5 mm, 30 mm)
   without the effect friction).
 - Fig. 8: the diagonal profile with BHF 4 t and die radius 20 mm (cup-hard's run) beside the
   2 t / 5 mm one.
-Writes cup_paper.csv (Fig. 7's table) and fig5_diagonal.png, fig6_transverse.png,
-fig7_friction.png, fig8_diagonal.png.
+Writes cup_paper.csv (Fig. 7's runs), cup_paper.md (the four figures' tables, which docs/cup.md
+includes: `markdown`) and fig5_diagonal.png, fig6_transverse.png, fig7_friction.png,
+fig8_diagonal.png.
 """
 
 import csv
@@ -87,8 +88,50 @@ def figures(out: Path, meshes: Path, hard: Path) -> list[dict]:
                      "newton_iterations": s["newton_iterations"], "wall_s": s["wall_time_s"]["total"],
                      "stopped": s["stopped"] or "", "run": _shown(d)})
     write_csv(out / "cup_paper.csv", rows, COLUMNS)
+    (out / "cup_paper.md").write_text(markdown(rows, meshes, hard))
     _plots(out, meshes, hard, rows)
     return rows
+
+
+def _profile(run_dir: Path) -> dict:
+    """What the tables show of one run: per line its strain at the centre, its most negative and
+    its largest strain with their initial positions, its strain at the blank's edge; and the peak
+    punch force (force_stroke.csv)."""
+    out = {}
+    for which in ("diagonal", "transverse"):
+        x, e = _line(run_dir, which)
+        low, high = min(range(len(e)), key=e.__getitem__), max(range(len(e)), key=e.__getitem__)
+        out[which] = {"centre": e[0], "thinning": f"{e[low]:.3f} at {x[low]:.0f} mm",
+                      "thickening": f"{e[high]:+.3f} at {x[high]:.0f} mm", "edge": e[-1]}
+    with open(run_dir / "force_stroke.csv") as f:
+        out["peak_force"] = max(float(r["punch_force_kN"]) for r in csv.DictReader(f))
+    return out
+
+
+def markdown(rows: list[dict], meshes: Path, hard: Path) -> str:
+    """The four figures' tables (cup_paper.md, included by docs/cup.md), one section each: Figs. 5
+    and 6 from the meshes' thickness lines, Fig. 7 from the friction runs' rows (cup_paper.csv),
+    Fig. 8 from the 2 t / 5 mm and 4 t / 20 mm runs' diagonals."""
+    runs = {name: _profile(folder(meshes, name)) for name in MESHES}
+    label = {name: f"{name.split()[1]} x {name.split()[1]}" for name in MESHES}
+    fig5 = ("| mesh | bottom centre | peak thinning, at | peak thickening (flange), at |\n" + "|---" * 4 + "|\n"
+            + "".join(f"| {label[n]} | {p['diagonal']['centre']:.3f} | {p['diagonal']['thinning']} | "
+                      f"{p['diagonal']['thickening']} |\n" for n, p in runs.items()))
+    fig6 = ("| mesh | peak thinning, at | flange edge (75 mm) |\n" + "|---" * 3 + "|\n"
+            + "".join(f"| {label[n]} | {p['transverse']['thinning']} | {p['transverse']['edge']:+.3f} |\n"
+                      for n, p in runs.items()))
+    fig7 = ("| friction | " + " | ".join(format(r["friction"], "g") for r in rows) + " |\n" + "|---" * (len(rows) + 1) + "|\n"
+            + "| peak thickness strain | " + " | ".join(f"{r['min_thickness_strain']:.3f}" for r in rows) + " |\n"
+            + "| where (initial x, y mm) | " + " | ".join(", ".join(str(r["where_initial_xy_mm"]).split()) for r in rows) + " |\n"
+            + "| punch force at 30 mm | " + " | ".join(f"{r['punch_force_30_kN']:.1f} kN" for r in rows) + " |\n"
+            + "| draw-in DX, DD | " + " | ".join(f"{r['DX']:.2f}, {r['DD']:.2f} mm" for r in rows) + " |\n")
+    fig8 = ("| | bottom centre | peak thinning, at | peak thickening (flange), at | punch force, peak |\n" + "|---" * 5 + "|\n"
+            + "".join(f"| {name} | {p['diagonal']['centre']:.3f} | {p['diagonal']['thinning']} | "
+                      f"{p['diagonal']['thickening']} | {p['peak_force']:.1f} kN |\n"
+                      for name, p in (("BHF 2 t, die radius 5 mm", runs["n 16"]),
+                                      ("BHF 4 t, die radius 20 mm", _profile(folder(hard, "BHF 4t, die radius 20 mm"))))))
+    return "".join(f"### {name}\n\n{table}\n" for name, table in (
+        ("fig5_diagonal", fig5), ("fig6_transverse", fig6), ("fig7_friction", fig7), ("fig8_diagonal", fig8))).rstrip("\n") + "\n"
 
 
 def _plots(out: Path, meshes: Path, hard: Path, rows: list[dict]) -> None:
