@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import cup_convergence, cup_paper, esaform_cup, nakajima, numisheet_cost, plate
+from shellform.studies import cup_convergence, cup_paper, esaform_cup, nakajima, numisheet_cost, plate, shell
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -35,7 +35,8 @@ def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "cup_paper", "esaform_cup", "nakajima",
-                                                                  "numisheet_cost")} | {"results/plate/plate_convergence.md"}
+                                                                  "numisheet_cost")} | {
+        "results/plate/plate_convergence.md", "results/shell/shell_convergence.md"}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):
@@ -180,8 +181,9 @@ def test_the_studies_tables_are_their_csvs():
     assert not (RESULTS / "esaform_cup" / "esaform_cup_estimates.csv").exists()  # else markdown takes them
     for study, text in made.items():
         assert text == (RESULTS / study / f"{study}.md").read_text(), study
-    assert plate.markdown(_rows(RESULTS / "plate" / "plate_convergence.csv")) == \
-        (RESULTS / "plate" / "plate_convergence.md").read_text()
+    for study, name in ((plate, "plate"), (shell, "shell")):
+        assert study.markdown(_rows(RESULTS / name / f"{name}_convergence.csv")) == \
+            (RESULTS / name / f"{name}_convergence.md").read_text(), name
 
 
 def _nav_files(nav) -> list[str]:

@@ -64,6 +64,25 @@ def coefficient(R, n, kind="structured", refine=0) -> dict:
             "coefficient": c, **res.timings}
 
 
+def markdown(rows: list[dict]) -> str:
+    """The two tables docs/shell.md includes (shell_convergence.md): the convergence against the
+    overkill (the rows without a Navier value) and the flat-plate limit against Navier's."""
+    def blank(v) -> bool:
+        return v is None or v == "" or (isinstance(v, float) and math.isnan(v))
+
+    mesh = [r for r in rows if blank(r.get("navier"))]
+    limit = [r for r in rows if not blank(r.get("navier"))]
+    n = round(math.sqrt(limit[0]["cells"] / 2)) if limit else 0
+    return ("### convergence\n\n| mesh | cells | w D/(q a^4) | rel. error vs overkill | rate | total [s] |\n"
+            + "|---" * 6 + "|\n"
+            + "".join(f"| {r['mesh']} | {r['cells']} | {r['coefficient']:.8f} | {r['rel_error']:.2e} | "
+                      f"{'' if blank(r['rate']) else format(r['rate'], '.2f')} | {r['total_s']:.3f} |\n" for r in mesh)
+            + f"\n### flat_plate_limit\n\n| R | w D/(q a^4), {n} x {n} x 2 | Navier (Donnell) | rel. difference |\n"
+            + "|---" * 4 + "|\n"
+            + "".join(f"| {float(r['R']):g} | {r['coefficient']:.8f} | {r['navier']:.8f} | {r['rel_error']:.2e} |\n"
+                      for r in limit))
+
+
 def run(outdir: Path, R=5.0, levels=LEVELS, overkill=OVERKILL, radii=RADII) -> list[dict]:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -94,6 +113,8 @@ def run(outdir: Path, R=5.0, levels=LEVELS, overkill=OVERKILL, radii=RADII) -> l
         say(f"R = {radius:8g}: coefficient {r['coefficient']:.8f}, Navier {r['navier']:.8f} "
             f"(relative difference {r['rel_error']:.2e}; flat plate {PLATE})")
     write_csv(outdir / "shell_convergence.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (outdir / "shell_convergence.md").write_text(markdown(as_written))  # the CSV's digits, as docs/shell.md includes it
     plot_error_time(outdir / "shell_error_time.png", series,
                     f"Shallow shell block (R = {R}): error against wall time (overkill reference)")
     return rows
