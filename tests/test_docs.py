@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import cup_convergence, cup_paper, esaform_cup, nakajima, numisheet_cost, plate, shell
+from shellform.studies import (cup_convergence, cup_paper, esaform_cup, nakajima, numisheet_cost, outlines, plate,
+                               shell)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -36,7 +37,7 @@ def test_the_pages_tables_are_their_studies_files():
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "cup_paper", "esaform_cup", "nakajima",
                                                                   "numisheet_cost")} | {
-        "results/plate/plate_convergence.md", "results/shell/shell_convergence.md"}
+        "results/plate/plate_convergence.md", "results/shell/shell_convergence.md", "results/outlines/outlines.md"}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):
@@ -184,6 +185,7 @@ def test_the_studies_tables_are_their_csvs():
     for study, name in ((plate, "plate"), (shell, "shell")):
         assert study.markdown(_rows(RESULTS / name / f"{name}_convergence.csv")) == \
             (RESULTS / name / f"{name}_convergence.md").read_text(), name
+    assert outlines.markdown(_rows(RESULTS / "outlines" / "outlines.csv")) == (RESULTS / "outlines" / "outlines.md").read_text()
 
 
 def _nav_files(nav) -> list[str]:

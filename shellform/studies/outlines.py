@@ -105,6 +105,22 @@ def row(case: str, scene: Scene) -> dict:
             "compile_s": result.timings["compile_s"]}
 
 
+LABELS = {"simply_supported": "disc, simply supported", "clamped": "disc, clamped",
+          "triangle": "triangle, simply supported"}
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table docs/outlines.md includes (outlines.md): a row per mesh, each case named on its
+    first row, w_center to the CSV's six digits."""
+    out = "| case | cells | w_center | rel. error | rate | time (s) |\n" + "|---" * 6 + "|\n"
+    for i, r in enumerate(rows):
+        first = i == 0 or rows[i - 1]["case"] != r["case"]
+        rate = "-" if math.isnan(r["rate"]) else f"{r['rate']:.2f}"
+        out += (f"| {LABELS.get(r['case'], r['case']) if first else ''} | {r['cells']:,} | {r['w_center']:#.6g} | "
+                f"{r['rel_error']:.2e} | {rate} | {r['total_s']:.3f} |\n")
+    return out
+
+
 def run(outdir: Path, levels=LEVELS) -> list[dict]:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -125,6 +141,8 @@ def run(outdir: Path, levels=LEVELS) -> list[dict]:
         rows += part
         series[{"triangle": "triangle, simply supported (oblique edges)"}.get(case, f"disc, {case} rim")] = part
     write_csv(outdir / "outlines.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (outdir / "outlines.md").write_text(markdown(as_written))  # the CSV's digits, as docs/outlines.md includes it
     plot_error_time(outdir / "outlines_error_time.png", series,
                     "Plates of other outlines, centre deflection: error against wall time")
     sheet = nonlinear_rows(DISC_N[: max(1, len(levels) - 2)])
