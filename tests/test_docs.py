@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import (cup_convergence, cup_paper, esaform_cup, nakajima, numisheet_cost, outlines, plate,
-                               shell)
+from shellform.studies import (cup_convergence, cup_paper, esaform_cup, levy, nakajima, numisheet_cost, outlines,
+                               plate, rollup, shell)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -35,9 +35,10 @@ docs_numbers = _script("docs_numbers")
 def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
-    assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "cup_paper", "esaform_cup", "nakajima",
-                                                                  "numisheet_cost")} | {
-        "results/plate/plate_convergence.md", "results/shell/shell_convergence.md", "results/outlines/outlines.md"}
+    assert included == {f"results/{s}.md" for s in (
+        "cup_convergence/cup_convergence", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
+        "nakajima/nakajima", "numisheet_cost/numisheet_cost", "outlines/outlines", "plate/plate_convergence",
+        "rollup/rollup", "shell/shell_convergence")}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):
@@ -182,10 +183,9 @@ def test_the_studies_tables_are_their_csvs():
     assert not (RESULTS / "esaform_cup" / "esaform_cup_estimates.csv").exists()  # else markdown takes them
     for study, text in made.items():
         assert text == (RESULTS / study / f"{study}.md").read_text(), study
-    for study, name in ((plate, "plate"), (shell, "shell")):
-        assert study.markdown(_rows(RESULTS / name / f"{name}_convergence.csv")) == \
-            (RESULTS / name / f"{name}_convergence.md").read_text(), name
-    assert outlines.markdown(_rows(RESULTS / "outlines" / "outlines.csv")) == (RESULTS / "outlines" / "outlines.md").read_text()
+    for study, table in ((plate, "plate/plate_convergence"), (shell, "shell/shell_convergence"),
+                         (outlines, "outlines/outlines"), (levy, "levy/levy"), (rollup, "rollup/rollup")):  # one CSV each
+        assert study.markdown(_rows(RESULTS / f"{table}.csv")) == (RESULTS / f"{table}.md").read_text(), table
 
 
 def _nav_files(nav) -> list[str]:

@@ -65,6 +65,19 @@ def solve(n, stations=STATIONS, step=0.05, thickness=T, assumed_membrane=False) 
             "total_s": time.perf_counter() - t0}
 
 
+def markdown(rows: list[dict]) -> str:
+    """The table docs/rollup.md includes (rollup.md): a row per mesh; the first run's wall time
+    holds the kernels' compilation; errors as 8.9e-2."""
+    def short(v: float) -> str:
+        return f"{v:.1e}".replace("e-0", "e-").replace("e+0", "e+")
+
+    return ("| elements along the strip | cells | max tip error / L over lambda in (0, 1] | at the full circle | wall time |\n"
+            + "|---" * 5 + "|\n"
+            + "".join(f"| {r['n']} | {r['cells']} | {short(r['max_tip_error'])} | {short(r['full_circle_error'])} | "
+                      f"{r['total_s']:.1f} s{' (with compilation, numba cached)' if i == 0 else ''} |\n"
+                      for i, r in enumerate(rows)))
+
+
 def run(outdir: Path, levels=LEVELS) -> list[dict]:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -76,6 +89,8 @@ def run(outdir: Path, levels=LEVELS) -> list[dict]:
             f"{r['increments']:10d} {r['total_s']:7.2f}")
         rows.append(r)
     write_csv(outdir / "rollup.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (outdir / "rollup.md").write_text(markdown(as_written))  # the CSV's digits, as docs/rollup.md includes it
     plot_error_time(outdir / "rollup_error_time.png", {"roll-up": rows},
                     "Strip rolled into a full circle: tip error", error="max_tip_error",
                     ylabel="max over the path of |tip - exact| / L")
