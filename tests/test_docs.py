@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from shellform.studies import (cup_convergence, cup_paper, esaform_cup, levy, nakajima, numisheet_cost, outlines,
-                               plate, rollup, shell)
+                               plastic, plate, rollup, shell)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -37,8 +37,8 @@ def test_the_pages_tables_are_their_studies_files():
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}.md" for s in (
         "cup_convergence/cup_convergence", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
-        "nakajima/nakajima", "numisheet_cost/numisheet_cost", "outlines/outlines", "plate/plate_convergence",
-        "rollup/rollup", "shell/shell_convergence")}
+        "nakajima/nakajima", "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic",
+        "plate/plate_convergence", "rollup/rollup", "shell/shell_convergence")}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):
@@ -184,7 +184,8 @@ def test_the_studies_tables_are_their_csvs():
     for study, text in made.items():
         assert text == (RESULTS / study / f"{study}.md").read_text(), study
     for study, table in ((plate, "plate/plate_convergence"), (shell, "shell/shell_convergence"),
-                         (outlines, "outlines/outlines"), (levy, "levy/levy"), (rollup, "rollup/rollup")):  # one CSV each
+                         (outlines, "outlines/outlines"), (levy, "levy/levy"), (rollup, "rollup/rollup"),
+                         (plastic, "plastic/plastic")):  # one CSV each
         assert study.markdown(_rows(RESULTS / f"{table}.csv")) == (RESULTS / f"{table}.md").read_text(), table
 
 
