@@ -7,7 +7,7 @@ nor the site shows:
     n = 16 (512 cells, 69 s) is within 5 % <!-- cites: 512 = results/numisheet_cost/numisheet_cost.csv case="n 16" cells; 69 = case="n 16" cpu_s -->
 
 The comment stands after text on its line and on one line: alone on a line, Python-Markdown
-would end the paragraph or list there. Each cite is `SHOWN = FILE [KEY=VALUE ...] FIELD [*K|/K]`,
+would end the paragraph or list there; in a table row it stands inside a cell. Each cite is `SHOWN = FILE [KEY=VALUE ...] FIELD [*K|/K]`,
 cites separated by `;`, the words split as a shell does (quote a value with spaces); a cite
 without FILE reads the previous cite's file in the same comment:
 
@@ -193,13 +193,18 @@ def cites(page: Path):
     start = 0
     for m in OPEN.finditer(text):
         line = text.count("\n", 0, m.start()) + 1
+        if text[text.rfind("\n", 0, m.start()) + 1:m.start()].count("`") % 2:
+            continue  # in a code span: an example, not a cite
         end = COMMENT.match(text, m.start())
         if not end:
             yield line, None, "a cites comment ends on its own line (-->)"
             continue
         line_start = text.rfind("\n", 0, m.start()) + 1
-        if not text[line_start:m.start()].strip(" \t-*>|"):
+        lead = text[line_start:m.start()]
+        if not lead.strip(" \t-*>|"):
             yield line, None, "a cites comment follows the text on its line (alone, it ends the paragraph or list)"
+        elif lead.lstrip().startswith("|") and lead.rstrip().endswith("|"):
+            yield line, None, "a cites comment in a table row stands inside a cell (after the last |, it is dropped)"
         para = max((p.end() for p in PARAGRAPH.finditer(text, 0, m.start())), default=0)
         before = COMMENT.sub(" ", text[max(start, para):m.start()])
         file = None

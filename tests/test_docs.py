@@ -136,6 +136,11 @@ def test_a_cite_that_cannot_be_read_is_a_clear_error(tmp_path):
             assert len(problems) == 1 and message in problems[0], (message, problems)
     page.write_text(text.replace(" <!-- cites: 48.1", "\n<!-- cites: 48.1"))  # alone on its line: ends the paragraph
     assert docs_numbers.check(tmp_path) == ["p.md:4: a cites comment follows the text on its line (alone, it ends the paragraph or list)"]
+    page.write_text(text + "\n| a | b |\n|---|---|\n| 1 | 48.1 | <!-- cites: 48.1 = results/t.csv n=16 force -->\n")
+    assert docs_numbers.check(tmp_path) == ["p.md:10: a cites comment in a table row stands inside a cell "
+                                            "(after the last |, it is dropped)"]
+    page.write_text(text + "\n| a | b |\n|---|---|\n| 1 | 48.1 <!-- cites: 48.1 = results/t.csv n=16 force --> |\n")
+    assert docs_numbers.check(tmp_path) == []
     page.write_text(text.replace("n=16 force -->", "n=16 force\n-->"))
     assert docs_numbers.check(tmp_path) == ["p.md:3: a cites comment ends on its own line (-->)"]
 
