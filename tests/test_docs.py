@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import (cup_convergence, cup_paper, esaform_cup, levy, nakajima, numisheet_cost, outlines,
-                               plastic, plate, rollup, shell)
+from shellform.studies import (cup_convergence, cup_mesh, cup_paper, esaform_cup, levy, nakajima, numisheet,
+                               numisheet_cost, outlines, plastic, plate, rollup, shell)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -36,8 +36,8 @@ def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}.md" for s in (
-        "cup_convergence/cup_convergence", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
-        "nakajima/nakajima", "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic",
+        "cup_convergence/cup_convergence", "cup_mesh/cup_mesh", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
+        "nakajima/nakajima", "numisheet93/numisheet", "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic",
         "plate/plate_convergence", "rollup/rollup", "shell/shell_convergence")}
 
 
@@ -99,6 +99,8 @@ def _cited_page(tmp_path: Path) -> Path:
 
 def test_a_cited_number_its_file_does_not_hold_fails_naming_it(tmp_path):
     page = _cited_page(tmp_path)
+    assert docs_numbers.check(tmp_path) == []
+    page.write_text(page.read_text() + "\nAn example: `5 <!-- cites: 5 = results/none.csv x -->` (code, not a cite).\n")
     assert docs_numbers.check(tmp_path) == []
     text = page.read_text()
     page.write_text(text.replace("48.1", "48.2"))  # the text and its cite, both wrong
@@ -190,7 +192,8 @@ def test_the_studies_tables_are_their_csvs():
         assert text == (RESULTS / study / f"{study}.md").read_text(), study
     for study, table in ((plate, "plate/plate_convergence"), (shell, "shell/shell_convergence"),
                          (outlines, "outlines/outlines"), (levy, "levy/levy"), (rollup, "rollup/rollup"),
-                         (plastic, "plastic/plastic")):  # one CSV each
+                         (plastic, "plastic/plastic"), (numisheet, "numisheet93/numisheet"),
+                         (cup_mesh, "cup_mesh/cup_mesh")):  # one CSV each
         assert study.markdown(_rows(RESULTS / f"{table}.csv")) == (RESULTS / f"{table}.md").read_text(), table
 
 

@@ -7,8 +7,8 @@ meshes (n = 12, 16, 24; the demo uses 16), and with half the demo's largest incr
 demo's mesh. Writes cup_mesh.csv: the stroke each run reached (and why it stopped), its wall
 time, increments, Newton iterations and peak punch force, and at 15 mm (which every run
 reaches) and at 30 mm the punch force, the draw-in DX and DD and the peak thinning, each with
-its difference from the finest run (n = 24); cup_mesh_picks.csv (the cheapest run within 1, 5
- and 10 % of it) and cup_mesh_error_time.png.
+its difference from the finest run (n = 24); cup_mesh.md (its table in docs/contact.md);
+cup_mesh_picks.csv (the cheapest run within 1, 5 and 10 % of it) and cup_mesh_error_time.png.
 """
 
 from pathlib import Path
@@ -45,4 +45,21 @@ def table(out: Path, runs, finest: str) -> list[dict]:
     rows, _ = cup_accuracy.write(out, "cup_mesh", runs, finest, REPORTS,
                                  "Square cup (paper's case) at 15 and 30 mm: accuracy against the time of the whole run",
                                  MEASURES)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (Path(out) / "cup_mesh.md").write_text(markdown(as_written))  # the CSV's digits, as docs/contact.md includes it
     return rows
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table docs/contact.md includes (cup_mesh.md): a row per run, the demo's mesh in bold."""
+    def at(r, mm):
+        return (f"{r[f'force_{mm}']:.1f} kN, {r[f'DX_{mm}']:.2f}, {r[f'DD_{mm}']:.2f} mm, "
+                f"{r[f'thinning_{mm}']:.3f}")
+
+    out = ("| run | stroke | increments, iterations, cut-backs | wall | at 15 mm: punch force, DX, DD, peak thinning "
+           "| at 30 mm: force, DX, DD, peak thinning |\n" + "|---" * 6 + "|\n")
+    for r in rows:
+        name = "**n 16 (demo)**" if r["case"] == "n 16" else r["case"]
+        out += (f"| {name} | {float(r['stroke_mm']):g} mm | {r['increments']}, {r['newton_iterations']}, {r['cutbacks']} | "
+                f"{r['wall_s']:.0f} s | {at(r, 15)} | {at(r, 30)} |\n")
+    return out

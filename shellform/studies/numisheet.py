@@ -3,8 +3,8 @@
     shellform study numisheet --out docs/results/numisheet93
 
 demos/numisheet93_aluminium.toml and demos/numisheet93_steel.toml as they are (16 x 16
-quarter mesh; every input and choice is stated in the scene files). Writes numisheet.csv: at
-15 and 40 mm the draw-in DX, DY and DD, the punch force, the peak thinning and where it is, the
+quarter mesh; every input and choice is stated in the scene files). Writes numisheet.csv (and
+numisheet.md, its table in docs/contact.md): at 15 and 40 mm the draw-in DX, DY and DD, the punch force, the peak thinning and where it is, the
 smallest margin to the forming-limit curve (at 40 mm); with increments, Newton iterations, cut-backs and
 wall time. Each run's folder holds its thickness strain along the diagonal and the transverse
 centre line (thickness_diagonal.csv, thickness_transverse.csv), force_stroke.csv/.png, cup.png
@@ -47,4 +47,22 @@ def table(out: Path) -> list[dict]:
                          "newton_iterations": s["newton_iterations"], "cutbacks": s["cutbacks"],
                          "wall_s": s["wall_time_s"]["total"], "stopped": s["stopped"] or ""})
     write_csv(out / "numisheet.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (out / "numisheet.md").write_text(markdown(as_written))  # the CSV's digits, as docs/contact.md includes it
     return rows
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table docs/contact.md includes (numisheet.md): a row per cup, its answers at each report."""
+    cups = list(dict.fromkeys(r["cup"] for r in rows))
+    strokes = list(dict.fromkeys(r["stroke_mm"] for r in rows))
+    out = ("| cup | " + " | ".join(f"at {float(s):g} mm: DX, DD, punch force, peak thinning" for s in strokes)
+           + " | increments, iterations, cut-backs, wall |\n" + "|---" * (len(strokes) + 2) + "|\n")
+    for cup in cups:
+        at = {r["stroke_mm"]: r for r in rows if r["cup"] == cup}
+        last = at[strokes[-1]]
+        out += (f"| {cup} | " + " | ".join(
+            f"{at[s]['DX']:.2f} (DY {at[s]['DY']:.2f}), {at[s]['DD']:.2f} mm, {at[s]['punch_force_kN']:.1f} kN, "
+            f"{at[s]['min_thickness_strain']:.3f}" for s in strokes)
+            + f" | {last['increments']}, {last['newton_iterations']}, {last['cutbacks']}, {last['wall_s']:.0f} s |\n")
+    return out
