@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import (cup_convergence, cup_mesh, cup_paper, esaform_cup, levy, nakajima, numisheet,
+from shellform.studies import (cup_convergence, cup_hard, cup_mesh, cup_paper, esaform_cup, levy, nakajima, numisheet,
                                numisheet_cost, outlines, plastic, plate, rollup, shell)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,7 +36,7 @@ def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}.md" for s in (
-        "cup_convergence/cup_convergence", "cup_mesh/cup_mesh", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
+        "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
         "nakajima/nakajima", "numisheet93/numisheet", "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic",
         "plate/plate_convergence", "rollup/rollup", "shell/shell_convergence")}
 
@@ -193,7 +193,7 @@ def test_the_studies_tables_are_their_csvs():
     for study, table in ((plate, "plate/plate_convergence"), (shell, "shell/shell_convergence"),
                          (outlines, "outlines/outlines"), (levy, "levy/levy"), (rollup, "rollup/rollup"),
                          (plastic, "plastic/plastic"), (numisheet, "numisheet93/numisheet"),
-                         (cup_mesh, "cup_mesh/cup_mesh")):  # one CSV each
+                         (cup_mesh, "cup_mesh/cup_mesh"), (cup_hard, "cup_hard/hard_cases")):  # one CSV each
         assert study.markdown(_rows(RESULTS / f"{table}.csv")) == (RESULTS / f"{table}.md").read_text(), table
 
 

@@ -11,7 +11,7 @@ The paper's cup (demos/square_cup.toml) with one thing made hard at a time:
   driver must cut back on its own.
 Writes hard_cases.csv: stroke reached, the stop message (empty when it finished), increments,
 Newton iterations, cut-backs, wall time, the peak punch force and thinning of the last
-converged state.
+converged state; and hard_cases.md, its table in docs/contact.md.
 """
 
 from pathlib import Path
@@ -84,12 +84,28 @@ def run(out: Path, n: int = 16, only=None) -> list[dict]:
             continue
         say(f"cup-hard: {name}")
         rows.append(draw(name, s, out))
-        write_csv(out / "hard_cases.csv", rows, COLUMNS)
+        _write(out, rows)
     return rows
+
+
+def _write(out: Path, rows: list[dict]) -> None:
+    """hard_cases.csv and its table hard_cases.md (the CSV's digits, as docs/contact.md includes it)."""
+    write_csv(Path(out) / "hard_cases.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (Path(out) / "hard_cases.md").write_text(markdown(as_written))
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table docs/contact.md includes (hard_cases.md): a row per case."""
+    return ("| case | stroke | increments, iterations, cut-backs | wall | peak punch force | peak thinning |\n"
+            + "|---" * 6 + "|\n"
+            + "".join(f"| {r['case']} | {float(r['stroke_mm']):g} mm | {r['increments']}, {r['newton_iterations']}, "
+                      f"{r['cutbacks']} | {r['wall_s']:.0f} s | {r['peak_punch_force_kN']:.1f} kN | "
+                      f"{r['min_thickness_strain']:.3f} |\n" for r in rows))
 
 
 def tabulate(out: Path, n: int = 16) -> list[dict]:
     """hard_cases.csv again from the runs on disk (no computation)."""
     rows = [row(name, s, out) for name, s in cases(n).items() if (folder(out, name) / "summary.json").exists()]
-    write_csv(Path(out) / "hard_cases.csv", rows, COLUMNS)
+    _write(out, rows)
     return rows
