@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from shellform.studies import (cup_convergence, cup_hard, cup_mesh, cup_paper, esaform_cup, levy, nakajima, numisheet,
-                               numisheet_cost, outlines, plastic, plate, rollup, shell)
+from shellform.studies import (cup_convergence, cup_hard, cup_mesh, cup_paper, cup_strain, esaform_cup, levy, nakajima,
+                               numisheet, numisheet_cost, outlines, plastic, plate, rollup, shell, strip)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
@@ -36,9 +36,10 @@ def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}.md" for s in (
-        "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper", "esaform_cup/esaform_cup", "levy/levy",
-        "nakajima/nakajima", "numisheet93/numisheet", "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic",
-        "plate/plate_convergence", "rollup/rollup", "shell/shell_convergence")}
+        "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper",
+        "cup_strain/cup_strain", "esaform_cup/esaform_cup", "levy/levy", "nakajima/nakajima", "numisheet93/numisheet",
+        "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic", "plate/plate_convergence",
+        "rollup/rollup", "shell/shell_convergence", "strip/strip")}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):
@@ -193,7 +194,8 @@ def test_the_studies_tables_are_their_csvs():
     for study, table in ((plate, "plate/plate_convergence"), (shell, "shell/shell_convergence"),
                          (outlines, "outlines/outlines"), (levy, "levy/levy"), (rollup, "rollup/rollup"),
                          (plastic, "plastic/plastic"), (numisheet, "numisheet93/numisheet"),
-                         (cup_mesh, "cup_mesh/cup_mesh"), (cup_hard, "cup_hard/hard_cases")):  # one CSV each
+                         (cup_mesh, "cup_mesh/cup_mesh"), (cup_hard, "cup_hard/hard_cases"),
+                         (cup_strain, "cup_strain/cup_strain"), (strip, "strip/strip")):  # one CSV each
         assert study.markdown(_rows(RESULTS / f"{table}.csv")) == (RESULTS / f"{table}.md").read_text(), table
 
 

@@ -47,8 +47,40 @@ def table(out: Path, n: int = 16) -> list[dict]:
                          "increments": summary["increments"], "newton_iterations": summary["newton_iterations"],
                          "wall_s": summary["wall_time_s"]["total"], "stopped": summary["stopped"] or ""})
     write_csv(out / "cup_strain.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (out / "cup_strain.md").write_text(markdown(as_written))  # the CSV's digits, as docs/material.md includes it
     _plot(out, [name for name, _ in runs(n)])
     return rows
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table docs/material.md includes (cup_strain.md): a column per case (the first the
+    demo's finite strains, the second the small strains before), a row per answer at the two
+    reports."""
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    at = {(r["case"], float(r["stroke_mm"])): r for r in rows}
+    first, last = sorted({float(r["stroke_mm"]) for r in rows})
+
+    def thinning(r):  # the committed runs' CSV carries the key's name before its rename
+        return r["min_thickness_strain"] if "min_thickness_strain" in r else r["max_thickness_strain"]
+
+    def line(label, cell):
+        return f"| {label} | " + " | ".join(cell(c) for c in cases) + " |\n"
+
+    names = {"finite strain": "finite strain (now the demo)", "small strain": "small strain (before)"}
+    return ("| | " + " | ".join(names.get(c, c) for c in cases) + " |\n" + "|---" * (len(cases) + 1) + "|\n"
+            + line(f"punch force at {first:g} / {last:g} mm",
+                   lambda c: f"{at[c, first]['punch_force_kN']:.1f} / {at[c, last]['punch_force_kN']:.1f} kN")
+            + "".join(line(f"draw-in DX, DD at {s:g} mm", lambda c, s=s: f"{at[c, s]['DX']:.2f}, {at[c, s]['DD']:.2f} mm")
+                      for s in (first, last))
+            + line(f"peak thinning at {last:g} mm (at the punch corner, initially (28.1, 28.1) mm)",
+                   lambda c: f"{thinning(at[c, last]):.3f}")
+            + line(f"peak thickening at {last:g} mm (the flange edge at the middle of a side)",
+                   lambda c: f"{at[c, last]['max_thickening_strain']:+.3f}")
+            + line(f"the sheet's volume change (V - V0)/V0 at {first:g} / {last:g} mm",
+                   lambda c: f"{100 * at[c, first]['volume_change']:+.2g} % / {100 * at[c, last]['volume_change']:+.2g} %")
+            + line("increments, Newton iterations, wall (one after the other, nothing else on the machine)",
+                   lambda c: f"{at[c, last]['increments']}, {at[c, last]['newton_iterations']}, {at[c, last]['wall_s']:.0f} s"))
 
 
 def _plot(out: Path, names) -> None:

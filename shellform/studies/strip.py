@@ -164,8 +164,25 @@ def run(outdir: Path, stretch=1.5, steps=20) -> list[dict]:
         necked = f", neck from ln(stretch) {np.log(watch.onset['stretch']):.4f}" if watch.onset else ""
         say(f"strip: {name}: {path[-1]['nominal_stress']:.1f} MPa at stretch {stretch}{necked} ({seconds:.1f} s)")
     write_csv(outdir / "strip.csv", rows, COLUMNS)
+    as_written = [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rows]
+    (outdir / "strip.md").write_text(markdown(as_written))  # the CSV's digits, as docs/material.md includes it
     _plot(outdir / "strip.png", rows, mat)
     return rows
+
+
+def markdown(rows: list[dict], stretches=(1.1, 1.3, 1.5)) -> str:
+    """The table docs/material.md includes (strip.md): the homogeneous strip's nominal stress and
+    thickness strain at three stretches, finite against small strains and the closed form."""
+    at = {(r["model"], round(float(r["stretch"]), 6)): r for r in rows}
+    finite, small = "finite strain, homogeneous", "small strain (issue 3), homogeneous"
+    out = ("| stretch | closed form tau/lambda | finite strain | small strain (before) "
+           "| thickness strain: -(ln lambda)/2, finite, small |\n" + "|---" * 5 + "|\n")
+    for x in (x for x in stretches if (finite, x) in at and (small, x) in at):  # the stretches the runs reached
+        f, s = at[finite, x], at[small, x]
+        out += (f"| {x:g} | {f['closed_form']:.1f} MPa | {f['nominal_stress']:.1f} MPa | "
+                f"{s['nominal_stress']:.1f} MPa ({100 * s['rel_error']:+.0f} %) | "
+                f"{f['thickness_closed_form']:.3f}, {f['thickness_strain']:.3f}, {s['thickness_strain']:.3f} |\n")
+    return out
 
 
 def _plot(path, rows, mat):
