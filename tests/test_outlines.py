@@ -337,4 +337,5 @@ def test_outlines_study_writes_its_table(tmp_path):
     disc = [r for r in rows if r["case"] != "triangle"]
     assert all(r["rate"] > 1.9 for r in disc if not math.isnan(r["rate"])), disc
     assert (tmp_path / "outlines.csv").is_file() and (tmp_path / "outlines_error_time.png").is_file()
+    assert (tmp_path / "outlines.md").read_text().startswith("| case | cells | w_center |")  # docs/outlines.md's table
     assert (tmp_path / "outlines_nonlinear.csv").read_text().count("\n") == 3  # P = 1.488, 4.904 on n = 8
