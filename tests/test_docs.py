@@ -25,7 +25,8 @@ spec.loader.exec_module(docs_include)
 def test_the_pages_tables_are_their_studies_files():
     assert docs_include.check() == []
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
-    assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "esaform_cup", "nakajima", "numisheet_cost")}
+    assert included == {f"results/{s}/{s}.md" for s in ("cup_convergence", "esaform_cup", "nakajima", "numisheet_cost",
+                                                        "sensitivity")}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):

@@ -194,7 +194,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
             if s.output.png:
                 fields.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
             if sens is not None:
-                sensitivity.write(outdir, reports, sens.parameters, s.output.scatter, s.title)
+                sensitivity.write(outdir, reports, sens.parameters, s.output.scatter, s.title, picture=s.output.png)
         except DiskFull as err:
             stop_for_full_disk(err, f"writing the tables and fields at load factor {d.lam:.6g}")
     uncertain = {}  # the answers' standard deviations at the last report, from the scatter
@@ -209,6 +209,9 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
         "neck": necks.onset if necks is not None else None,
         **uncertain,
+        **({"sensitivity_checks": {  # where the derivatives are one-sided means, and the free rows' check
+            "increments_with_switching_layers": [i + 1 for i, k in enumerate(sens.switches) if k],
+            "largest_free_residual": max(sens.free_residual, default=0.0)}} if sens is not None else {}),
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
     }, outdir)
     summary.write(comm)

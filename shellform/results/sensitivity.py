@@ -21,7 +21,7 @@ Written into the output folder:
     sensitivities.csv   per report, answer and parameter: the parameter's value, da/dp, the
                         stated change (the scatter's s_p, else a tenth of the value) and
                         da/dp times it
-    tornado.png         at the last report: each answer's change for each parameter's stated
+    tornado.png         ([output] png) at the last report: each answer's change for each parameter's stated
                         change, largest first (an answer whose changes are all at round-off
                         beside the largest of its units, a zero displacement's, is left out)
 summary.json: "sensitivities" in each report, {parameter: {answer: da/dp}}; "uncertainty" (with
@@ -93,8 +93,9 @@ def uncertainty(derivatives: dict, scatter: dict) -> dict:
     return out
 
 
-def write(outdir: Path, reports: list[dict], parameters, scatter, title: str) -> None:
-    """sensitivities.csv and tornado.png from the reports' "sensitivities" (rank 0 writes)."""
+def write(outdir: Path, reports: list[dict], parameters, scatter, title: str, picture: bool = True) -> None:
+    """sensitivities.csv and (with `picture`) tornado.png from the reports' "sensitivities"
+    (rank 0 writes)."""
     stated = changes(parameters, scatter)
     values = {par.name: par.value for par in parameters}
     rows = [{"load_factor": r["load_factor"], "answer": answer, "parameter": name, "value": values[name],
@@ -102,7 +103,7 @@ def write(outdir: Path, reports: list[dict], parameters, scatter, title: str) ->
             for r in reports if "sensitivities" in r
             for name, ds in r["sensitivities"].items() for answer, d in ds.items()]
     write_csv(Path(outdir) / "sensitivities.csv", rows, COLUMNS)
-    if MPI.COMM_WORLD.rank == 0 and rows:
+    if picture and MPI.COMM_WORLD.rank == 0 and rows:
         _tornado(Path(outdir) / "tornado.png", reports[-1], stated, title)
 
 
