@@ -39,7 +39,7 @@ def test_the_pages_tables_are_their_studies_files():
         "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper",
         "cup_strain/cup_strain", "esaform_cup/esaform_cup", "levy/levy", "nakajima/nakajima", "numisheet93/numisheet",
         "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic", "plate/plate_convergence",
-        "rollup/rollup", "shell/shell_convergence", "strip/strip")}
+        "rollup/rollup", "sensitivity/sensitivity", "shell/shell_convergence", "strip/strip")}
 
 
 def test_a_table_that_differs_from_its_file_fails_the_check(tmp_path):

@@ -124,7 +124,11 @@ class Driver(Newton):
                 f"|dlambda|/|dq| fell to {k[-1] / k[0]:.2g} times the first increment's")
 
     def _commit(self, lam) -> None:
-        """Accept the increment's state (the sheet's and every part's)."""
+        """Accept the increment's state (the sheet's and every part's); a record with a
+        `converged(driver, lam)` sees the converged state first, before it is committed."""
+        for record in self.records:
+            if hasattr(record, "converged"):
+                record.converged(self, lam)
         self.model.commit()
         for part in self.parts:
             part.commit(lam)

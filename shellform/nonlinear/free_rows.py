@@ -15,7 +15,9 @@ whose rows and columns can be picked one by one, then the submatrix). The driver
 known rows may be taken out (the contact driver: those that stay known); the others stay in
 K_ff as identity rows, which solve to their known values. The symbolic factorisation is kept
 until a row taken out turns free, and where the rows to take out are too few to pay for the
-copies (MIN_SHARE) the whole matrix is factorised instead.
+copies (MIN_SHARE) the whole matrix is factorised instead. The numeric factors are reused for
+every solve with the same assembled matrix (the open holder's lift after Newton's step, the
+sensitivities' right-hand sides: nonlinear/sensitivity.py).
 """
 
 import numpy as np
@@ -45,6 +47,7 @@ class FreeRowsLU:
     def __init__(self, comm, owned: int, first: int):
         self.comm, self.owned, self.first = comm, owned, first
         self._eliminated = None  # the owned known rows taken out of the factorised matrix
+        self._factored = None  # (id, state) of the matrix whose factors the solver holds: reused while it is unchanged
         self._free = np.zeros(0, dtype=np.int32)
         self._aij = self._sub = self._ksp = self._is = None
         self._b = self._x = None
@@ -96,13 +99,17 @@ class FreeRowsLU:
         stale = self._stale(known, eliminable)
         if self.comm.allreduce(stale, op=MPI.LOR):  # every rank takes the new rows
             self._rows(np.sort(eliminable))
-        self._aij = A.convert("aij", self._aij if self._aij is not None else PETSc.Mat())
-        self._sub = self._aij.createSubMatrix(self._is, self._is, self._sub)
-        if self._ksp is None:
-            self._ksp = lu_solver(self._sub)
-            self._x, self._b = self._sub.createVecs()
-        else:
-            self._ksp.setOperators(self._sub)
+            self._factored = None
+        same = self._factored == (id(A), A.stateGet())  # A unchanged since its factors were made
+        if not self.comm.allreduce(same, op=MPI.LAND):
+            self._aij = A.convert("aij", self._aij if self._aij is not None else PETSc.Mat())
+            self._sub = self._aij.createSubMatrix(self._is, self._is, self._sub)
+            if self._ksp is None:
+                self._ksp = lu_solver(self._sub)
+                self._x, self._b = self._sub.createVecs()
+            else:
+                self._ksp.setOperators(self._sub)
+            self._factored = (id(A), A.stateGet())
         rhs = b.getArray(readonly=True)
         self._b.getArray()[:] = rhs[self._free]
         self._ksp.solve(self._b, self._x)

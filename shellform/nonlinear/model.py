@@ -173,6 +173,41 @@ class SheetModel:
         t3 = time.perf_counter()
         return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard))
 
+    def history(self) -> dict:
+        """The committed material state an increment starts from, as copies: per cell, point
+        and layer the plastic strain "ep" (3) and the equivalent plastic strain "p", and per
+        point the thickness stretch "stretch" (which is also the next increment's lever arm)."""
+        return {"ep": self.ep_n.copy(), "p": self.p_n.copy(), "stretch": self.stretch_n.copy()}
+
+    def respond(self, q: np.ndarray, history: dict, material: np.ndarray | None = None,
+                thickness: float | None = None) -> tuple[np.ndarray, dict, bool]:
+        """The element forces and the updated material state at the carrier array q (with
+        ghosts) from the committed state `history` (as history() gives it, its stretch the
+        lever arm), with another material or thickness where given: the map
+        (q, h_n, material) -> (f_e, h_n+1) that one evaluation computes, on arrays of its own,
+        so that nothing of the model's state changes. Returns (element vectors (cells, NDOF),
+        the updated state in history()'s keys, whether the material update failed)."""
+        k = self.kernels
+        mat = self.material if material is None else np.asarray(material, dtype=np.float64)
+        t = self.thickness if thickness is None else float(thickness)
+        z, strain = np.zeros_like(self.z), np.zeros_like(self.strain)
+        k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q, self.P, self.consts, self.beta,
+                      self.tying, z, strain)
+        ep, p, stretch = np.zeros_like(self.ep), np.zeros_like(self.p), np.ones_like(self.stretch)
+        resultants, tangents = np.zeros_like(self.resultants), np.zeros_like(self.tangents)
+        _, nfail, nguard = section_update(strain, self.taper, mat, t, self.plastic, self.finite, self.zeta, self.wz,
+                                          history["ep"], history["p"], history["stretch"], ep, p, stretch,
+                                          resultants, tangents, False, self.threads)
+        ironed_d, ironed = np.zeros_like(self.ironed_d), self.ironed.copy()
+        if self.ironing:
+            _, failed = ironing.squeeze(strain, self.clearance, t, self.modulus33, 2.0 * k.element.weights,
+                                        resultants, tangents, np.zeros_like(self.face_pressure), ironed_d, ironed)
+            nguard += failed
+        vectors = np.zeros_like(self.forms.vectors)
+        k.tensor_loop(self.threads, self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, z,
+                      resultants, tangents, ironed_d, ironed, False, vectors, self.forms.matrices)
+        return vectors, {"ep": ep, "p": p, "stretch": stretch}, bool(nfail or nguard)
+
     def tensor_arrays(self, tangent: bool) -> None:
         """The element vectors (and tangents) from the last evaluation's strains, stresses and
         section tangents: with tangent=True after an evaluation without, its K alone."""

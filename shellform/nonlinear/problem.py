@@ -116,15 +116,19 @@ class SheetProblem:
                         verbose=verbose, frames=frames, parts=[make(model) for make in parts])
         return cls(rect, model, driver, pdofs)
 
-    def value(self, name: str, x: float, y: float) -> float:
-        return value_at(self.driver.q, self.model.components, name, x, y, 1e-9 * self.rect.size)
+    def value(self, name: str, x: float, y: float, of: fem.Function | None = None) -> float:
+        """The component `name` at the vertex (x, y) of the state (of `of`, a function on the
+        carrier's space where given: a sensitivity's dq/dp)."""
+        return value_at(self.driver.q if of is None else of, self.model.components, name, x, y, 1e-9 * self.rect.size)
 
-    def reaction(self, side: str, comp: str) -> float:
-        """Sum over the side of the internal force conjugate to a held component."""
+    def reaction(self, side: str, comp: str, residual: np.ndarray | None = None) -> float:
+        """Sum over the side of the internal force conjugate to a held component (of
+        `residual`, owned rows, where given: a sensitivity's dR/dp gives the reaction's)."""
         dofs = self.prescribed_dofs.get((side, comp))
         if dofs is None:
             sub = self.model.V.sub(self.model.components.index(comp))
             dofs = fem.locate_dofs_topological(sub, 1, self.rect.facets(side))
         owned = self.model.V.dofmap.index_map.size_local * self.model.V.dofmap.index_map_bs
-        local = float(np.sum(self.driver.residual_full[dofs[dofs < owned]]))
+        R = self.driver.residual_full if residual is None else residual
+        local = float(np.sum(R[dofs[dofs < owned]]))
         return self.model.mesh.comm.allreduce(local, op=MPI.SUM)

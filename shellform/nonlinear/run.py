@@ -42,8 +42,9 @@ from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
 from shellform.nonlinear.problem import SheetProblem
+from shellform.nonlinear.sensitivity import Sensitivity, scene_parameters
 from shellform.scene import Scene
-from shellform.results import fields, neck, run_folder
+from shellform.results import fields, neck, run_folder, sensitivity
 from shellform.results.disk import DiskFull
 from shellform.results.log import Progress
 from shellform.results.summary import SheetSummary
@@ -116,9 +117,15 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
     necks = neck.NeckWatch(comm, "load_factor", "initial_xy") if p.model.plastic else None
     centres = p.model.cell_centres()
     series = fields.SheetSeries(p.model.V, p.model.num_cells, outdir) if s.output.vtu else None
+    sens = None
+    if s.output.sensitivities:  # the answers' derivatives along the path (nonlinear/sensitivity.py)
+        sens = Sensitivity(p.driver, scene_parameters(s))
+        p.driver.records.append(sens)
 
     def record():
         reports.append(_record(p, s))
+        if sens is not None:
+            reports[-1]["sensitivities"] = sensitivity.answers(p, sens, reports[-1], s.output.probe)
         if series is not None:
             with p.driver.room.write("the report"):
                 series.write(p.driver.lam, p.driver.q, p.model.components, p.model.cell_fields())
@@ -186,8 +193,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
                     fields.write_vtx(outdir, d.q, p.model.components, cell_functions(p))
             if s.output.png:
                 fields.write_png(outdir / "deformed.png", d.q, p.model.components, title=s.title)
+            if sens is not None:
+                sensitivity.write(outdir, reports, sens.parameters, s.output.scatter, s.title, picture=s.output.png)
         except DiskFull as err:
             stop_for_full_disk(err, f"writing the tables and fields at load factor {d.lam:.6g}")
+    uncertain = {}  # the answers' standard deviations at the last report, from the scatter
+    if sens is not None and s.output.scatter and reports and "sensitivities" in reports[-1]:
+        uncertain["uncertainty"] = sensitivity.uncertainty(reports[-1]["sensitivities"],
+                                                           sensitivity.changes(sens.parameters, s.output.scatter))
     summary = SheetSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "cells": p.model.mesh.topology.index_map(2).size_global,
@@ -195,6 +208,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
         "neck": necks.onset if necks is not None else None,
+        **uncertain,
+        **({"sensitivity_checks": {  # where the derivatives are one-sided means, and the free rows' check
+            "increments_with_switching_layers": [i + 1 for i, k in enumerate(sens.switches) if k],
+            "largest_free_residual": max(sens.free_residual, default=0.0)}} if sens is not None else {}),
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
     }, outdir)
     summary.write(comm)

@@ -324,6 +324,23 @@ class System:
         Kv.destroy()
         return out
 
+    def assembled(self, vectors: np.ndarray) -> np.ndarray:
+        """Element vectors in x, y, z (cells, NDOF: SheetModel.respond's) turned into the solve's
+        frames and assembled: the owned rows (the model's own arrays as they were)."""
+        m = self.model
+        kept = m.forms.vectors.copy()
+        m.forms.vectors[:] = vectors
+        if self.edge_frames is not None:
+            self.edge_frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, False)
+        if self.parts:
+            rotate_cell_arrays(m.dofs, self.rotated, self.frames, m.forms.vectors, m.forms.matrices, False)
+        vec = fem_petsc.assemble_vector(m.forms.vector, constants=m.forms.constants, coeffs=m.forms.vector_coeffs)
+        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        out = vec.getArray(readonly=True).copy()
+        vec.destroy()
+        m.forms.vectors[:] = kept
+        return out
+
     def energy_slope(self, dq_xyz: np.ndarray) -> float:
         """dq . R over all ranks, R (free rows, nodal frames) turned back to x, y, z, with the
         parts' own unknowns' shares."""

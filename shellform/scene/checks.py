@@ -69,6 +69,7 @@ def validate(s) -> None:
     every = s.output.checkpoint_every
     require(math.isfinite(every) and every >= 0, "output.checkpoint_every", f"must be finite and >= 0, got {every}")
     _validate_probes(s)
+    _validate_sensitivities(s)
     validate_tools(s)
     machine.check_size(s)  # first: a count too large for memory is named with the memory it needs
     _plausible_values(s)
@@ -192,6 +193,37 @@ def _validate_material(s) -> None:
         from shellform.results import fld
 
         fld.curves(mat)  # reads a measured curve; without one, Keeler-Brazier needs a Swift or power-law n
+
+
+def _validate_sensitivities(s) -> None:
+    """[output] sensitivities: a nonlinear sheet scene's (the tools' parts have no derivatives
+    yet), each a number the sheet depends on; scatter: one standard deviation >= 0 each."""
+    names, scatter = s.output.sensitivities, s.output.scatter
+    if not names:
+        require(not scatter, "output.scatter", "needs output.sensitivities (a standard deviation per parameter)")
+        return
+    require(s.nonlinear and s.tools is None, "output.sensitivities",
+            "sensitivities are computed for a nonlinear sheet scene without tools (the contact's parts have no "
+            "derivatives yet)")
+    numbers = {f.name for f in fields(s.material) if f.type is float and f.name != "thickness"}
+    base = s.hill79().pack()
+    require(len(set(names)) == len(names), "output.sensitivities", "names a parameter twice")
+    for name in names:
+        field_ = f"output.sensitivities ({name})"
+        section, _, key = name.partition(".")
+        if name in ("material.thickness", "loads.pressure"):
+            require(name != "loads.pressure" or s.loads.pressure != 0, field_, "needs a pressure other than 0")
+            continue
+        require(section == "material" and key in numbers, field_,
+                "must be material.<a number of [material]>, material.thickness or loads.pressure")
+        value = getattr(s.material, key)
+        require(not np.array_equal(s.with_material(key, value * (1 + 1e-3) if value else 1e-3).hill79().pack(),
+                                   base), field_,
+                f"the sheet does not depend on material.{key} (its hardening and yield function do not use it)")
+    require(not scatter or len(scatter) == len(names), "output.scatter",
+            f"needs one standard deviation per parameter of output.sensitivities ({len(names)}), got {len(scatter)}")
+    for i, sd in enumerate(scatter):
+        require(math.isfinite(sd) and sd >= 0, f"output.scatter[{i}]", f"must be finite and >= 0, got {sd}")
 
 
 def _validate_probes(s) -> None:

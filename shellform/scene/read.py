@@ -9,7 +9,7 @@ Scene made here is a checked one.
 import copy
 import json
 import tomllib
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 
 from shellform import effects as registry
@@ -41,6 +41,11 @@ class Scene:
         read and checked as a scene file is: a bad value raises InputError naming its field.
         This scene is left as it is."""
         return changed(self, changes)
+
+    def with_material(self, key: str, value: float) -> "Scene":
+        """This scene with material.<key> = value, not checked again: a parameter moved by a
+        small step (the sensitivities' differences, nonlinear/sensitivity.py)."""
+        return replace(self, material=replace(self.material, **{key: value}))
 
     @property
     def kappa0(self) -> tuple[float, float]:

@@ -257,6 +257,11 @@ class Output:
     fld: bool = True  # tool scenes with plasticity: the forming-limit view (results/fld.py)
     checkpoint_every: float = 60.0  # tool scenes: seconds of wall time between checkpoints (0: at reports only)
     probe: list[Probe] = field(default_factory=list, metadata={"items": "tables"})  # [[output.probe]]
+    # nonlinear sheet scenes: the answers' derivatives in these parameters (nonlinear/sensitivity.py),
+    # e.g. ["material.K", "material.n", "loads.pressure"]; scatter: a standard deviation per parameter
+    # (the same order; empty: none) for the answers' first-order standard deviations
+    sensitivities: list[str] = field(default_factory=list, metadata={"items": "names"})
+    scatter: list[float] = field(default_factory=list, metadata={"items": "numbers"})
 
 
 def bounds(s) -> tuple[float, float, float, float]:

@@ -1,0 +1,216 @@
+"""Sensitivities from one run: direct differentiation through the increments.
+
+For a parameter p of the sheet (a material constant, the thickness, the pressure), each
+converged increment n -> n+1 satisfies, on the free rows of the carrier q,
+
+    R(q_n+1, h_n, p) = 0,        h_n+1 = H(q_n+1, h_n, p),
+
+R the residual (the element forces of the material update from the committed state h_n, less
+lambda f_ext), H the update of the material state h (plastic strains, equivalent plastic strain,
+thickness stretch, which is also the next increment's lever arm), the known rows (the
+supports) independent of p. Differentiating along the path (direct differentiation of a
+path-dependent problem: Kleiber, Antunez, Hien and Kowalczyk, Parameter Sensitivity in
+Nonlinear Mechanics, Wiley 1997, ch. 5 and 7):
+
+    K q'_n+1 = -(dR/dh h'_n + dR/dp)         free rows; q' = 0 on the known rows
+    h'_n+1   = dH/dq q'_n+1 + dH/dh h'_n + dH/dp
+
+with ' = d/dp and K the consistent tangent of the converged increment (the tangent of the
+return mapping from h_n), computed and factorised once per increment for all parameters. The
+two brackets are directional derivatives of the element loop's own map
+(q, h_n, p) -> (f_e, h_n+1) (SheetModel.respond), by central differences along (0, h'_n, 1)
+and along (q'_n+1, h'_n, 1) with a step eps = STEP |p|: the semi-analytic method (Barthelemy
+and Haftka, AIAA J. 28, 1990), exact but for O(eps^2) and the return mapping's tolerance over
+eps (1e-12 / 1e-5; docs/sensitivity.md measures both). The second difference also gives the
+total derivative of the residual on every row: on the known rows the reactions' sensitivities,
+on the free rows about zero (a check that the solve and the differences agree).
+
+Where the response is not differentiable, a layer turning from elastic to plastic (or back)
+between p - eps and p + eps, the central difference is the mean of the one-sided derivatives;
+such layers are counted per increment (`switches`), so that a jump in a sensitivity can be
+traced to the increments where the plastic zone moved across a quadrature point.
+
+The sensitivity is a record of the driver (driver.records): `converged` runs with each
+converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through
+a resume. It sees the sheet and its supports only; the tools' parts (contact, friction, the
+holder) have no derivatives of their own yet, and a driver with parts is refused.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+
+from shellform.assembly.sheet_element import BS
+from shellform.errors import InputError
+
+STEP = 1e-5  # the central differences' step, relative to the parameter
+KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
+
+
+@dataclass
+class Parameter:
+    """A number the sheet's equations depend on, by name (its scene key) and value. A kind
+    says how a value enters: `respond(value)` -> the keywords of SheetModel.respond at that
+    value (material, thickness), and `external(driver, lam)` -> dR/dp from the loads (owned
+    rows, solve coordinates; None where the loads do not depend on it)."""
+
+    name: str
+    value: float
+
+    def respond(self, value: float) -> dict:
+        return {}
+
+    def external(self, driver, lam: float):
+        return None
+
+
+@dataclass
+class MaterialParameter(Parameter):
+    """A constant of the material: pack(value) -> the packed material array at that value."""
+
+    pack: object = None
+
+    def respond(self, value: float) -> dict:
+        return {"material": self.pack(value)}
+
+
+@dataclass
+class ThicknessParameter(Parameter):
+    """The sheet's initial thickness."""
+
+    def respond(self, value: float) -> dict:
+        return {"thickness": value}
+
+
+@dataclass
+class PressureParameter(Parameter):
+    """The dead pressure at load factor 1 (its value the driver's): R = f_int - lambda p f,
+    so dR/dp = -lambda f_ext / p."""
+
+    def external(self, driver, lam: float):
+        if self.value == 0.0:
+            raise InputError(f"output.sensitivities ({self.name})", "needs a pressure other than 0")
+        return -lam * driver.f_ext.getArray(readonly=True) / self.value
+
+
+def scene_parameters(scene) -> list[Parameter]:
+    """The parameters a sheet scene names in `[output] sensitivities` (checked with the scene:
+    "material.<number>", "material.thickness", "loads.pressure")."""
+    out = []
+    for name in scene.output.sensitivities:
+        key = name.partition(".")[2]
+        if name == "material.thickness":
+            out.append(ThicknessParameter(name, float(scene.material.thickness)))
+        elif name == "loads.pressure":
+            out.append(PressureParameter(name, float(scene.loads.pressure)))
+        else:
+            out.append(MaterialParameter(name, float(getattr(scene.material, key)),
+                                         lambda value, key=key: scene.with_material(key, value).hill79().pack()))
+    return out
+
+
+class Sensitivity:
+    """d/dp of the carrier, the material state and the residual along the path, for each
+    parameter (module docstring). A record of `driver`: add it with driver.records.append."""
+
+    def __init__(self, driver, parameters):
+        if driver.parts:
+            raise InputError("output.sensitivities", "sensitivities are computed for a sheet and its supports "
+                                                     "only; a scene with tools has none yet")
+        self.driver, self.model = driver, driver.model
+        self.parameters = list(parameters)
+        zeros = lambda a: np.zeros_like(a)  # noqa: E731
+        start = self.model.history()
+        self.dq = {p.name: zeros(driver.q.x.array) for p in self.parameters}
+        self.dh = {p.name: {k: zeros(start[k]) for k in KEYS} for p in self.parameters}
+        self.dR = {p.name: zeros(driver.residual_full) for p in self.parameters}
+        self.switches = []  # per increment: layers that turned elastic/plastic within +-eps, all parameters
+        self.free_residual = []  # per increment: the largest |dR/dp| on the free rows over the pseudo-load's (a check)
+
+    # -- the record's protocol ------------------------------------------------------------------
+    def converged(self, driver, lam: float) -> None:
+        """The increment to lam converged and is not committed yet: q'_n+1, h'_n+1 and dR/dp."""
+        model, comm = self.model, model_comm(self.model)
+        h_n = model.history()
+        q = driver.q.x.array.copy()
+        driver.linearize(lam)  # the consistent tangent at the converged state, from h_n
+        switched, ratio = 0, 0.0
+        owned = driver.n_owned * BS
+        free = np.ones(owned, dtype=bool)
+        free[driver.bc_dofs[driver.bc_dofs < owned]] = False
+        for par in self.parameters:
+            eps = STEP * abs(par.value) if par.value else STEP
+            dh = self.dh[par.name]
+            f = [model.respond(q, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))[0] for s in (1, -1)]
+            rhs = driver.assembled(f[0] - f[1]) / (2 * eps)
+            load = par.external(driver, lam)
+            if load is not None:
+                rhs[: load.size] += load
+            rhs[~free] = 0.0
+            out = driver.dq  # the step's work array, free after convergence
+            if not driver.solve_lifted(np.zeros_like(q), out, extra=-rhs):
+                raise RuntimeError(f"the sensitivity solve for {par.name} failed at load factor {lam:.6g}")
+            dq = driver.to_xyz(out.x.array)
+            ends = [model.respond(q + s * eps * dq, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))
+                    for s in (1, -1)]
+            dR = driver.assembled(ends[0][0] - ends[1][0]) / (2 * eps)
+            if load is not None:
+                dR[: load.size] += load
+            self.dq[par.name] = dq
+            self.dh[par.name] = {k: (ends[0][1][k] - ends[1][1][k]) / (2 * eps) for k in KEYS}
+            self.dR[par.name] = dR[:owned]
+            yielded = [e[1]["p"] > h_n["p"] for e in ends]
+            switched += int(np.sum(yielded[0] != yielded[1]))
+            scale = comm.allreduce(float(np.abs(rhs[:owned][free]).max(initial=0.0)), op=MPI.MAX)  # the pseudo-load
+            worst = comm.allreduce(float(np.abs(dR[:owned][free]).max(initial=0.0)), op=MPI.MAX)
+            ratio = max(ratio, worst / scale if scale > 0 else 0.0)
+        self.switches.append(comm.allreduce(switched, op=MPI.SUM))
+        self.free_residual.append(ratio)
+
+    def checkpoint(self) -> dict:
+        nodes, cells = {}, {}
+        for i, par in enumerate(self.parameters):
+            nodes[f"sensitivity{i}_dq"] = self.dq[par.name][: self.driver.n_owned * BS].reshape(-1, BS).copy()
+            for k in KEYS:
+                cells[f"sensitivity{i}_{k}"] = self.dh[par.name][k]
+        return {"nodes": nodes, "cells": cells}
+
+    def restore(self, state: dict) -> None:
+        for i, par in enumerate(self.parameters):
+            key = f"sensitivity{i}_dq"
+            if key not in state["nodes"]:
+                raise InputError("resume", "the checkpoint carries no sensitivities for this scene's parameters")
+            self.dq[par.name][: self.driver.n_owned * BS] = state["nodes"][key].ravel()
+            for k in KEYS:
+                self.dh[par.name][k][...] = state["cells"][f"sensitivity{i}_{k}"]
+
+    # -- what a run reads -----------------------------------------------------------------------
+    def carrier(self, name: str) -> np.ndarray:
+        """dq/dp (x, y, z; the local array, ghosts included) at the last converged increment."""
+        return self.dq[name]
+
+    def residual(self, name: str) -> np.ndarray:
+        """dR/dp on the owned rows, reactions included: summed over a support's rows, the
+        sensitivity of its reaction (SheetProblem.reaction(..., residual=))."""
+        return self.dR[name]
+
+    def state(self, name: str) -> dict:
+        """d/dp of the material state (history()'s keys) at the last converged increment."""
+        return self.dh[name]
+
+    def thickness_strain(self, name: str) -> np.ndarray:
+        """d/dp of SheetModel.thickness_strain per owned cell (finite strains: the mean of
+        d ln lambda3 = lambda3' / lambda3 over the points)."""
+        if not self.model.finite:
+            raise InputError(f"output.sensitivities ({name})", "the thickness strain's sensitivity needs finite_strain")
+        return (self.dh[name]["stretch"] / self.model.history()["stretch"]).mean(axis=1)
+
+
+def model_comm(model):
+    return model.mesh.comm
+
+
+def _along(h: dict, dh: dict, step: float) -> dict:
+    """The material state h + step dh (new arrays)."""
+    return {k: h[k] + step * dh[k] for k in KEYS}

@@ -1,0 +1,168 @@
+"""Sensitivities from one run (shellform.nonlinear.sensitivity): direct differentiation through
+the increments against closed forms and against finite differences of whole runs
+(docs/sensitivity.md)."""
+
+import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from shellform.errors import InputError
+from shellform.nonlinear.problem import SheetProblem
+from shellform.nonlinear.sensitivity import Sensitivity
+from shellform.studies import strip
+from shellform.studies.sensitivity import material_parameters, plate, pulled_strip, swift_derivatives, value_of
+
+STEEL = strip.mild_steel()
+
+
+def test_the_homogeneous_strip_against_the_closed_form():
+    """The nominal stress tau / lambda at a stretch of 1.5, after ten plastic increments whose
+    history sensitivities carry each one's plastic strain on: d/dK, d/dn, d/dE to 1e-6 of the
+    implicit derivative of tau = sigma_f(ln lambda - tau / E)."""
+    p, s = pulled_strip(STEEL, True, ("K", "n", "E"))
+    tau, exact = swift_derivatives(STEEL, 1.5)
+    area = strip.WIDTH * strip.T0
+    assert p.reaction("right", "u") / area == pytest.approx(tau / 1.5, rel=1e-8)
+    for name, d in exact.items():
+        got = p.reaction("right", "u", residual=s.residual(name)) / area
+        assert got == pytest.approx(d / 1.5, rel=1e-6), name
+    assert s.switches == [0] * 10  # every layer plastic throughout, the path smooth
+    assert max(s.free_residual) < 1e-5
+
+
+def test_the_free_strip_against_finite_differences_of_two_runs():
+    """The strip's end pulled: the force and the width's contraction (v at the free corner), for
+    K, n and nu, against central differences of two runs at p(1 +- 1e-4) (their error about
+    1e-8 of the value); where a derivative is near zero (the force's in nu), against the force's
+    own scale F / p."""
+    p, s = pulled_strip(STEEL, False, ("K", "n", "nu"))
+    F = p.reaction("right", "u")
+    for name in ("K", "n", "nu"):
+        value = getattr(STEEL, name)
+        h = 1e-4 * value
+        plus, _ = pulled_strip(replace(STEEL, **{name: value + h}), False)
+        minus, _ = pulled_strip(replace(STEEL, **{name: value - h}), False)
+        fd_force = (plus.reaction("right", "u") - minus.reaction("right", "u")) / (2 * h)
+        fd_v = (plus.value("v", strip.LENGTH, strip.WIDTH) - minus.value("v", strip.LENGTH, strip.WIDTH)) / (2 * h)
+        force = p.reaction("right", "u", residual=s.residual(name))
+        v = value_of(p, s, name, "v", strip.LENGTH, strip.WIDTH)
+        assert abs(force - fd_force) <= 1e-6 * max(abs(fd_force), abs(F / value)), name
+        assert v == pytest.approx(fd_v, rel=1e-6), name
+
+
+def centre_sensitivity(p, s, name):
+    return value_of(p, s, name, "w", 0.0, 0.0)
+
+
+def test_the_plate_in_large_deflection_is_homogeneous_in_E_and_the_pressure():
+    """An elastic sheet's stresses scale with E, so w(E, P) = W(P / E) and
+    E dw/dE + P dw/dP = 0 exactly: both sensitivities from one run, to 1e-6 of w's own scale;
+    the deflection is large (w about 3 t, dw/dP far from w / P)."""
+    E, P = 70e3, 5.0
+    p, s = plate(E, P, ("bending", "membrane", "geometric_nonlinearity"), sensitivities=True)
+    w = p.value("w", 0.0, 0.0)
+    dE, dP = centre_sensitivity(p, s, "E"), centre_sensitivity(p, s, "pressure")
+    assert abs(w) > 1.0  # large deflection
+    assert abs(dP * P / w - 1) > 0.3  # far from linear
+    assert abs(E * dE + P * dP) <= 1e-6 * abs(w)
+
+
+def test_the_linear_plate_deflects_as_one_over_E():
+    """Without geometric nonlinearity w = c P / E: dw/dE = -w / E and dw/dP = w / P, to 1e-6."""
+    E, P = 70e3, 1e-4
+    p, s = plate(E, P, ("bending",), sensitivities=True)
+    w = p.value("w", 0.0, 0.0)
+    assert centre_sensitivity(p, s, "E") == pytest.approx(-w / E, rel=1e-6)
+    assert centre_sensitivity(p, s, "pressure") == pytest.approx(w / P, rel=1e-6)
+
+
+def test_the_sensitivities_do_not_change_the_run():
+    """The run with sensitivities takes the same increments to the same state, bit for bit."""
+    p, _ = pulled_strip(STEEL, False, ("K",))
+    q, _ = pulled_strip(STEEL, False)
+    assert np.array_equal(p.driver.q.x.array, q.driver.q.x.array)
+    assert np.array_equal(p.driver.residual_full, q.driver.residual_full)
+    assert [h.iterations for h in p.driver.history] == [h.iterations for h in q.driver.history]
+
+
+def test_a_driver_with_parts_is_refused():
+    from shellform.nonlinear.parts import Part
+
+    p = SheetProblem.on_rectangle(MPI.COMM_WORLD, 2.0, 2.0, 1, STEEL, 1.0, strip.effects(True),
+                                  supports={"left": "clamped"}, parts=[lambda model: Part()])
+    with pytest.raises(InputError, match="output.sensitivities"):
+        Sensitivity(p.driver, material_parameters(STEEL, ("K",)))
+
+
+def test_a_scene_reports_its_sensitivities_and_their_uncertainty(tmp_path):
+    """`[output] sensitivities` and `scatter` on a sheet scene: every report carries d/dp of its
+    answers (the cantilever's largest w against central differences of two runs, to 1e-6),
+    sensitivities.csv and tornado.png are written, and summary.json gives each answer's first-order
+    standard deviation sqrt(sum (da/dp s_p)^2) with the parameters' shares summing to 1."""
+    import json
+
+    from shellform.run import run
+    from shellform.studies.sensitivity import CANTILEVER, cantilever_scene
+
+    scatter = [0.05, 50.0, 1e-5, 0.001]
+    s = cantilever_scene(True).changed({"output.scatter": scatter, "output.png": True, "process.report": [0.5]})
+    summary = run(s, tmp_path / "one")
+    data = json.loads((tmp_path / "one" / "summary.json").read_text(),
+                      parse_constant=lambda c: pytest.fail(f"summary.json holds {c}"))
+    assert [r["load_factor"] for r in data["reports"]] == pytest.approx([0.5, 1.0], abs=1e-12)
+    last = data["reports"][-1]["sensitivities"]
+    assert list(last) == list(CANTILEVER)
+    key, value = "material.K", CANTILEVER["material.K"]
+    h = 1e-4 * value
+    plain = cantilever_scene(False)
+    ends = [run(plain.changed({key: value + d}), tmp_path / f"fd{i}")["reports"][-1]["extremes"]["w"]["value"]
+            for i, d in enumerate((h, -h))]
+    assert last[key]["extreme_w"] == pytest.approx((ends[0] - ends[1]) / (2 * h), rel=1e-6)
+    w = data["uncertainty"]["extreme_w"]
+    sd = np.sqrt(sum((last[k]["extreme_w"] * sd_k) ** 2 for k, sd_k in zip(CANTILEVER, scatter)))
+    assert w["sd"] == pytest.approx(sd, rel=1e-12)
+    assert sum(w["shares"].values()) == pytest.approx(1.0, rel=1e-12)
+    rows = (tmp_path / "one" / "sensitivities.csv").read_text().splitlines()
+    assert rows[0].split(",")[:3] == ["load_factor", "answer", "parameter"]
+    assert len(rows) == 1 + 2 * 4 * len(last[key])  # two reports, four parameters, every answer
+    assert (tmp_path / "one" / "tornado.png").stat().st_size > 10_000
+    assert summary["reports"][-1]["sensitivities"] == last
+
+
+@pytest.mark.parametrize("changes, field", [
+    ({"output.sensitivities": ["material.Q"]}, "output.sensitivities (material.Q)"),  # not used by Swift
+    ({"output.sensitivities": ["tools.friction"]}, "output.sensitivities (tools.friction)"),
+    ({"output.sensitivities": ["material.K", "material.K"]}, "output.sensitivities"),
+    ({"output.sensitivities": ["material.K"], "output.scatter": [0.1, 0.2]}, "output.scatter"),
+    ({"output.sensitivities": ["material.K"], "output.scatter": [-0.1]}, "output.scatter[0]"),
+    ({"output.sensitivities": [], "output.scatter": [0.1]}, "output.scatter"),
+])
+def test_bad_sensitivities_are_named(changes, field):
+    from shellform.studies.sensitivity import cantilever_scene
+
+    with pytest.raises(InputError) as err:
+        cantilever_scene(False).changed(changes)
+    assert err.value.field == field
+
+
+def test_the_sensitivities_go_through_a_checkpoint(tmp_path):
+    """A checkpoint holds dq/dp and the material state's d/dp; a driver that resumes from it
+    continues with them (the history sensitivities a path-dependent derivative needs)."""
+    from shellform.nonlinear import checkpoint
+
+    p, s = pulled_strip(STEEL, False, ("K", "n"))
+    p.driver.checkpoint_dir = tmp_path
+    p.driver.save_checkpoint()
+    q, _ = pulled_strip(STEEL, False)  # a driver at the same mesh, then given sensitivities and the checkpoint
+    r = Sensitivity(q.driver, s.parameters)
+    q.driver.records.append(r)
+    q.driver.resume(checkpoint.read(tmp_path))
+    for name in ("K", "n"):
+        owned = q.driver.n_owned * 9
+        assert np.array_equal(r.carrier(name)[:owned], s.carrier(name)[:owned])
+        for key, values in s.state(name).items():
+            assert np.array_equal(r.state(name)[key], values), key
