@@ -37,10 +37,12 @@ reports it (summary.json "neck", null without a neck).
 
 import numpy as np
 
+from shellform.results.listeners import EndOfStroke
+
 PLASTIC = 0.01  # of the first increment's least stability: below it, its fall is extrapolated to a neck
 
 
-class NeckReached(Exception):
+class NeckReached(EndOfStroke):
     """A run's stroke or load path ends: the sheet starts to neck ([process] stop_at_neck)."""
 
 
