@@ -56,8 +56,9 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              without a neck. With [process] stop_at_neck the stroke ends at that
                              increment; without, the run goes on and only reports it
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
-                             after the tools withdraw (contact/springback.py; the picture: after
-                             minus before); summary.json: wall angle, flange edge, re-yield,
+                             after the tools withdraw (contact/springback.py releases them,
+                             results/springback.py writes; the picture: after minus before);
+                             summary.json: wall angle, flange edge, re-yield,
                              residual resultants
     checkpoint.npz           the last converged state (at every report, every output.checkpoint_every
                              seconds, at the end, at a stop: no convergence, Ctrl-C, SIGTERM),
@@ -91,7 +92,6 @@ from shellform.results import run_folder
 from shellform.results import springback as sprung_back
 from shellform.results.disk import DiskFull
 from shellform.results.drawing import CupListeners
-from shellform.results.fld import FormingLimitReached  # noqa: F401 (a stroke's end: results/fld.py)
 from shellform.results.listeners import EndOfStroke, Run
 from shellform.results.log import Progress, say
 from shellform.results.summary import DrawingSummary
