@@ -51,15 +51,19 @@ def _shell(s: Scene, outdir: Path, comm, scene_path) -> Summary:
 
 
 def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool = False,
-        comm=MPI.COMM_WORLD) -> Summary:
+        comm=MPI.COMM_WORLD, listeners=()) -> Summary:
     """Solve the scene into outdir (a folder this run owns: run_folder.start); scene_path: its
     file, for run.json; trace: the tools log every contact pass, Newton step and iterate;
     resume: the tools continue from the last converged state in outdir (InputError("resume")
-    for the other routes)."""
+    for the other routes); listeners: the caller's (shellform.results.listeners.Listener), told
+    of a tool scene's start, increments, reports, checkpoints, stop and end after the run's own
+    (ValueError for the other routes)."""
     outdir = Path(outdir)
     way = route(s)
     if resume and way != "tools":
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
+    if listeners and way != "tools":
+        raise ValueError("listeners: only a tool scene's run (a [tools] section) tells listeners")
     if way != "shell" and not jit.compiled():
         from shellform.results.log import say
 
@@ -72,7 +76,7 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     if way == "tools":
         from shellform.contact import run as tools
 
-        return tools.run(s, outdir, comm, trace=trace, resume=resume, scene_path=scene_path)
+        return tools.run(s, outdir, comm, trace=trace, resume=resume, scene_path=scene_path, listeners=listeners)
     if way == "sheet":
         from shellform.nonlinear import run as sheet
 

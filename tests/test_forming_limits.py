@@ -99,10 +99,9 @@ def test_forming_limit_view_uses_the_measured_curve(tmp_path):
                                                         str(write(tmp_path / "flc.csv", FLC))}})
     major, minor = np.array([0.1, 0.3, 0.2]), np.array([-0.2, 0.0, 0.2])
     coords = np.arange(27, dtype=float).reshape(3, 9)
-    model = SimpleNamespace(cell_fields=lambda: {"major_strain": major, "minor_strain": minor},
-                            cell_centres=lambda: coords.reshape(-1, 3, 3).mean(axis=1)[:, :2],
-                            mesh=SimpleNamespace(comm=MPI.COMM_WORLD))
-    p = SimpleNamespace(scene=s, model=model, stroke=10.0)
+    p = SimpleNamespace(material=s.material, comm=MPI.COMM_WORLD, stroke=10.0,  # the drawn sheet's published names
+                        cell_fields=lambda: {"major_strain": major, "minor_strain": minor},
+                        cell_centres=lambda: coords.reshape(-1, 3, 3).mean(axis=1)[:, :2])
     out = cup.forming_limits(tmp_path, p, "test", png=False)
     curve = fld.measured(FLC)
     expected = curve(minor) - major

@@ -2,6 +2,7 @@
 both nonlinear routes, and the summary each route returns, which knows its closing line and
 exit status; the command line's --version."""
 
+import csv
 import json
 import logging
 import re
@@ -115,6 +116,51 @@ def test_tools_route_summary(tmp_path):
         f"largest thinning (thickness strain) {summary['min_thickness_strain']:.4f}, "
         f"{summary['wall_time_s']['total']:.1f} s; results in {tmp_path}")
     assert summary.exit_status() == 0
+
+
+def test_a_callers_listener_is_told_the_increments_and_reports(tmp_path):
+    """A listener passed to shellform.run.run (results/listeners.py) is told of the start, every
+    increment (the driver's history), every report (the drawn sheet's public measurements), the
+    checkpoints, the stop and the end, in that order, and what it records is what the run's own
+    tables hold."""
+    from shellform.results.listeners import Listener
+
+    class Record(Listener):
+        def __init__(self):
+            self.events, self.increments, self.reports = [], [], []
+
+        def on_start(self, r):
+            self.events.append("start")
+
+        def on_increment(self, r):
+            self.events.append("increment")
+            self.increments.append((r.driver.history[-1].number, r.sheet.stroke, r.sheet.punch_force() / 1e3))
+
+        def on_report(self, r):
+            self.events.append("report")
+            self.reports.append(r.sheet.stroke)
+
+        def on_checkpoint(self, r):
+            self.events.append("checkpoint")
+
+        def on_stop(self, r):
+            self.events.append("stop")
+
+        def on_end(self, r):
+            self.events.append("end")
+
+    listener = Record()
+    summary = run.run(small_cup(), tmp_path, listeners=[listener])
+    rows = list(csv.DictReader(open(tmp_path / "force_stroke.csv")))
+    assert [n for n, _, _ in listener.increments] == [int(r["increment"]) for r in rows] == [1, 2]
+    assert len(listener.increments) == summary["increments"]
+    assert [f for _, _, f in listener.increments] == pytest.approx([float(r["punch_force_kN"]) for r in rows],
+                                                                    rel=1e-5)  # the CSV's 6 digits
+    assert listener.reports == [r["stroke_mm"] for r in summary["reports"]] == pytest.approx([0.1, 0.2])
+    assert listener.events == ["start", "increment", "report", "checkpoint", "increment", "report", "checkpoint",
+                               "stop", "end"]
+    with pytest.raises(ValueError, match="listeners"):
+        run.run(small_levy(), tmp_path / "levy", listeners=[listener])
 
 
 def test_exit_status_of_a_stop_by_signal(tmp_path):

@@ -20,6 +20,7 @@ from shellform.contact.pinch_edge import edge_load
 from shellform.mesh import blank, outline
 from shellform.nonlinear.model import SheetModel
 from shellform.nonlinear.problem import scene_controls
+from shellform.results import fields
 from shellform.scene import Scene
 from shellform.tools import kinds as tool_kinds
 
@@ -34,6 +35,7 @@ class DrawingProblem:
     model: SheetModel
     driver: SemiInverseDriver
     symmetry: int  # 4 for a quarter blank, 1 for the whole blank
+    _input_order: tuple | None = dataclasses.field(default=None, repr=False)
 
     @classmethod
     def from_scene(cls, s: Scene, comm=MPI.COMM_WORLD, checkpoint_dir=None, verbose=True, trace=False):
@@ -226,6 +228,67 @@ class DrawingProblem:
             return 0
         loose = d.holder.under(d.positions()) & ~d.holder.pinched
         return d.model.mesh.comm.allreduce(int(loose.sum()), op=MPI.SUM)
+
+    # -- the drawn sheet as the results read it (shellform.results.cup, "the drawn sheet") -----
+    @property
+    def comm(self):
+        """The sheet's communicator: every measurement here is collective over it or local to a rank."""
+        return self.model.mesh.comm
+
+    @property
+    def mesh(self):
+        """The blank's mesh (the series' functions live on it)."""
+        return self.rect.mesh
+
+    @property
+    def tools_kind(self):
+        """The scene's kind of tools (shellform.tools.kinds: its LINES, RIM, picture_depth)."""
+        return tool_kinds.kind(self.scene.tools.shape)
+
+    @property
+    def material(self):
+        """The scene's [material] section (the forming-limit curve's data)."""
+        return self.scene.material
+
+    def picture_depth(self) -> float:
+        """How deep the tools' surfaces are drawn in a picture or a series (the kind's own)."""
+        return self.tools_kind.picture_depth(self.scene.tools)
+
+    @property
+    def num_cells(self) -> int:
+        """The owned cells."""
+        return self.model.num_cells
+
+    def cell_fields(self) -> dict:
+        """Per owned cell: equivalent plastic strain, major and minor surface strains (SheetModel)."""
+        return self.model.cell_fields()
+
+    def cell_centres(self) -> np.ndarray:
+        """(owned cells, 2) the cells' initial centres."""
+        return self.model.cell_centres()
+
+    def cell_thickness_strain(self) -> np.ndarray:
+        """Per owned cell its thickness strain."""
+        return self.model.thickness_strain()
+
+    def membrane_stability(self) -> np.ndarray:
+        """Per owned cell the least eigenvalue of its membrane's tangent (results/neck.py)."""
+        return self.model.membrane_stability()
+
+    def volume_change(self) -> float:
+        """(V - V0) / V0 of the whole sheet."""
+        return self.model.volume_change()
+
+    def resultants(self) -> np.ndarray:
+        """(owned cells, quadrature points, 6) the stress resultants N and M of the last evaluation."""
+        return self.model.resultants
+
+    def input_order(self):
+        """The owned nodes' and cells' indices in the mesh's input (results.fields.input_order),
+        made once: the same files on any number of ranks."""
+        if self._input_order is None:
+            self._input_order = fields.input_order(self.model.V, self.model.num_cells)
+        return self._input_order
 
     # -- what the results show -----------------------------------------------------------------
     CONTACT_STATES = ("free", "punch", "die", "holder", "pinched")  # contact_nodes()'s codes 0 to 4

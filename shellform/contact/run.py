@@ -1,5 +1,11 @@
 """A deep-drawing scene from its TOML to results on disk: scene -> problem -> driver -> files.
 
+The run only builds and drives: the problem (shellform.contact.problem), its listeners (the
+cup's own, shellform.results.drawing, then the caller's: shellform.results.listeners), the
+checkpoints, the stops and the springback. It tells the listeners of the start, every
+increment, every report, every checkpoint, the stop and the end; they measure the drawn sheet
+through its public measurements and write the files. summary.json gathers what they found.
+
 Writes into the output folder (forces and draw-in for the whole blank, pictures included):
     summary.json             the friction coefficients the tools carried ("friction": punch, die,
                              holder; 0 without the effect); stroke_mm, draw_in_mm (DX, DY, DD)
@@ -50,8 +56,9 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              without a neck. With [process] stop_at_neck the stroke ends at that
                              increment; without, the run goes on and only reports it
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
-                             after the tools withdraw (contact/springback.py; the picture: after
-                             minus before); summary.json: wall angle, flange edge, re-yield,
+                             after the tools withdraw (contact/springback.py releases them,
+                             results/springback.py writes; the picture: after minus before);
+                             summary.json: wall angle, flange edge, re-yield,
                              residual resultants
     checkpoint.npz           the last converged state (at every report, every output.checkpoint_every
                              seconds, at the end, at a stop: no convergence, Ctrl-C, SIGTERM),
@@ -69,7 +76,6 @@ summary.json, its "stopped" saying "disk full at S mm: what could not be written
 which checkpoint is kept.
 """
 
-import json
 import time
 from pathlib import Path
 
@@ -82,24 +88,18 @@ from shellform.mesh import budget
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
-from shellform.results import cup, fld, neck, run_folder
+from shellform.results import run_folder
+from shellform.results import springback as sprung_back
 from shellform.results.disk import DiskFull
+from shellform.results.drawing import CupListeners
+from shellform.results.listeners import EndOfStroke, Run
 from shellform.results.log import Progress, say
 from shellform.results.summary import DrawingSummary
-from shellform.results.tables import write_csv, write_json
 from shellform.scene import Scene
-from shellform.tools import kinds as tool_kinds
-
 
 # a resume that changes one of these starts its steps afresh (not as the checkpoint had them)
 STEPPING = {"process.initial_step_mm", "process.min_step_mm", "process.max_step_mm", "process.max_iterations",
             "process.rtol"}
-# worst values over all increments, in summary.json: the balances and the pinch
-CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
-
-
-class FormingLimitReached(Exception):
-    """The stroke ends: an element's margin to the forming-limit curve reached 0."""
 
 
 def _stroke_of(lam, travel) -> float:
@@ -107,11 +107,11 @@ def _stroke_of(lam, travel) -> float:
     return float(lam) * abs(float(travel[0]))
 
 
-def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list, dict]:
+def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> dict:
     """Restore the last complete checkpoint in outdir (checkpoint.read: the previous one where
     the last is damaged), refused where what defines the state differs (run_folder.fingerprint)
-    or where it lies past this scene's stroke; the force-stroke rows and reports up to it, and
-    what the summary records of the resume."""
+    or where it lies past this scene's stroke; returns what the summary records of the resume
+    (the listeners take over their rows up to it: results/drawing.py)."""
     cells = p.model.mesh.topology.index_map(2).size_global
     saved = checkpoint.read(outdir, comm, budget.state_bytes(cells, s.process.thickness_points))
     if not p.driver.fingerprint:
@@ -138,246 +138,143 @@ def _resume(p: DrawingProblem, s: Scene, outdir: Path, comm) -> tuple[list, list
         raise InputError("resume", f"the checkpoint {saved.path} is damaged ({type(err).__name__}: {err})") from None
     if set(changed) & STEPPING:  # other steps asked for: they start afresh
         p.driver.forget_steps()
-    curve, reports = _taken_over(outdir, p.stroke + 1e-9)
-    info = {"from_stroke_mm": p.stroke, "checkpoint": saved.path.name, "damaged": saved.damaged,
+    return {"from_stroke_mm": p.stroke, "checkpoint": saved.path.name, "damaged": saved.damaged,
             "increments_before": len(p.driver.history), "changed": changed}
-    return curve, reports, info
 
 
-def _taken_over(outdir: Path, upto: float) -> tuple[list, list]:
-    """The force-stroke rows and the reports (force_stroke.csv, reports.json) up to the stroke
-    `upto`, which a resume takes over; none where a file is missing. InputError("resume")
-    naming the file where it is damaged (not the table a run writes)."""
-    import csv
-
-    curve, reports, path = [], [], outdir / "force_stroke.csv"
-    try:
-        if path.exists():
-            with open(path, newline="") as f:
-                rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
-            curve = [r for r in rows if r["stroke_mm"] <= upto]
-        path = outdir / "reports.json"
-        if path.exists():
-            reports = [r for r in json.loads(path.read_text()) if float(r["stroke_mm"]) <= upto]
-            for r in reports:
-                float(r["punch_force_kN"]), dict(r["draw_in_mm"])
-    except (OSError, UnicodeDecodeError, csv.Error, KeyError, IndexError, TypeError, ValueError) as err:
-        raise InputError("resume", f"{path} is damaged ({type(err).__name__}: {err}): the rows before the "
-                                   "checkpoint cannot be taken over; run the scene afresh") from None
-    return curve, reports
-
-
-def _previous_neck(outdir: Path) -> dict | None:
-    """The neck that the resumed run's summary.json reports (None without one or without it)."""
-    try:
-        return json.loads((outdir / "summary.json").read_text()).get("neck")
-    except (OSError, ValueError, AttributeError):
-        return None
-
-
-def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None) -> DrawingSummary:
+def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, scene_path=None,
+        listeners=()) -> DrawingSummary:
     """Draw the scene's cup; trace: log every contact pass, Newton step and iterate; resume:
     continue from the last converged state in outdir (written at every report, at the end and
     at a stop), with this scene's stroke and steps (the summary's "resumed" records what
     changed; another holder force or friction is another run: run_folder.check_process);
     without resume the folder is this run's alone
-    (run_folder.start). scene_path: the scene's file, for run.json."""
+    (run_folder.start). scene_path: the scene's file, for run.json. listeners: the caller's
+    (shellform.results.listeners.Listener), told of the run's events after the cup's own."""
     outdir = Path(outdir)
     run_folder.start(outdir, s, scene_path, resume, comm)
     t0, c0 = time.perf_counter(), time.process_time()
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
-    p.driver.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
-    curve, reports, stopped, resumed, signum = [], [], None, None, 0
-    paths = watch = None  # what the run records along the stroke, in its checkpoints (driver.records)
-    if p.model.plastic and (s.output.fld or s.process.stop_at_forming_limit):
-        (curve_of_limits, _), _ = fld.curves(s.material)
-        paths = fld.StrainPaths(curve_of_limits, comm, s.tools.stroke / 200) if s.output.fld else None
-        watch = fld.FormingLimitWatch(curve_of_limits, comm) if s.process.stop_at_forming_limit else None
-    p.driver.records += [r for r in (paths, watch) if r is not None]
+    d = p.driver
+    d.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
+    cup = CupListeners.of(s, p.model.plastic, outdir, comm, listeners)
+    if cup.limits is not None:
+        d.records += cup.limits.records()  # what the run records along the stroke, in its checkpoints
+    told = cup.all()
+    r = Run(p, d, s, outdir, comm)
+    signum = 0
     if resume:
-        curve, reports, resumed = _resume(p, s, outdir, comm)
+        r.resumed = _resume(p, s, outdir, comm)
+    told.announce("on_start", r)  # a resume's rows taken over (a damaged file refuses it)
+    if resume:
         run_folder.resumed(outdir, s, scene_path, comm)
     setup_s = time.perf_counter() - t0
-    series = cup.CupSeries(p, outdir, vtx=s.output.vtx, vtu=s.output.vtu, fld_margin=s.output.fld and p.model.plastic) \
-        if s.output.vtx or s.output.vtu else None
-    p.driver.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
+    d.progress = Progress("stroke", 1.0, " mm", s.tools.stroke)
     saved_at = [time.monotonic()]  # when the last checkpoint was written
-    necks = neck.NeckWatch(comm) if p.model.plastic else None
-    if necks is not None and resumed:
-        necks.carry(_previous_neck(outdir), p.stroke)
-    centres = p.model.cell_centres()
 
-    def on_increment(d):
-        h = d.history[-1]
-        hx, hy = p.holder_largest_at()
-        held, edge, off_band = p.holder_held_down()
-        curve.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
-                      "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
-                      "holder_lift_mm": p.holder_lift(),
-                      "max_penetration_mm": p.max_penetration(), "force_balance": p.force_balance(),
-                      "holder_largest_share": p.holder_share(), "holder_largest_x_mm": hx, "holder_largest_y_mm": hy,
-                      "holder_held_down": held, "holder_edge_load": edge, "holder_off_band": off_band,
-                      "free_under_closed_holder": p.free_under_holder(),
-                      "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
-                      "contact_passes": h.contact["passes"], **{f"nodes_on_{k}": v for k, v in p.in_contact().items()}})
-        necked = limit = False
-        if necks is not None:
-            before = necks.onset
-            necked = necks.reached(p.stroke, p.model.membrane_stability(), p.model.thickness_strain(), centres)
-            if necked and before is None and not s.process.stop_at_neck:
-                p.driver.progress.note(f"shellform: the sheet starts to neck: {neck.words(necks.onset)}")
-            if s.process.stop_at_neck and d.next_step is not None:  # shorter steps ahead of the run's end
-                d.bound_next_step(necks.ahead(d.next_step * s.tools.stroke) / s.tools.stroke)  # mm per load factor
-        if paths is not None or watch is not None:
-            f = p.model.cell_fields()
-            if paths is not None:
-                paths.record(p.stroke, f["major_strain"], f["minor_strain"])
-            limit = watch is not None and watch.reached(p.stroke, f["major_strain"], f["minor_strain"])
+    def checkpoint_now():
+        """What a resume takes over up to the checkpoint, then the state it ends at."""
+        told.announce("on_checkpoint", r)
+        d.save_checkpoint()
+        saved_at[0] = time.monotonic()
+
+    def on_increment(_):
+        told.announce("on_increment", r)
         every = s.output.checkpoint_every  # the increment, recorded, on disk at least this often
         if every and comm.allreduce(time.monotonic() - saved_at[0] >= every, op=MPI.LOR):
             checkpoint_now()
-        if limit:
-            raise FormingLimitReached
-        if necked and s.process.stop_at_neck:
-            raise neck.NeckReached
-
-    def write_curve():
-        with p.driver.room.write("force_stroke.csv"):
-            write_csv(outdir / "force_stroke.csv", curve, list(curve[0]) if curve else ["increment"])
-
-    def checkpoint_now():
-        """The curve so far, then the state it ends at: a resume takes the curve's rows up to the
-        checkpoint's stroke."""
-        write_curve()
-        p.driver.save_checkpoint()
-        saved_at[0] = time.monotonic()
-
-    def state() -> dict:
-        return {"stroke_mm": p.stroke, "draw_in_mm": cup.draw_in(p), "punch_force_kN": p.punch_force() / 1e3,
-                **cup.peak_thinning(p), "volume_change": p.model.volume_change()}
+        if r.ending is not None:
+            raise r.ending
 
     def report():
-        reports.append(state())
-        if paths is not None:
-            f = p.model.cell_fields()
-            paths.record(p.stroke, f["major_strain"], f["minor_strain"], final=True)
-        with p.driver.room.write("the report"):  # rank 0's writes after the collective ones
-            if series is not None:
-                series.write(p.stroke)
-            write_json(outdir / "reports.json", reports)  # what a resumed run takes over
+        told.announce("on_report", r)
+        with d.room.write("the report"):  # rank 0's writes after the collective ones
+            told.announce("save_report", r)
 
     def stop_for_full_disk(err: DiskFull, when: str) -> None:
         """A full disk stops the run: `stopped` (after a stop before it) says in one sentence
         where, why, and which checkpoint is kept."""
-        nonlocal stopped
         found = comm.bcast(checkpoint.last_complete(outdir) if comm.rank == 0 else None, root=0)
         g = found[1] if found else {}
         at = f" at {_stroke_of(g['lam'], g['contact_travel']):.4g} mm" if "lam" in g and "contact_travel" in g else ""
         resume = ": --resume continues from it once there is room" if found else ""
-        stopped = (f"{stopped}; " if stopped else "") + \
+        r.stopped = (f"{r.stopped}; " if r.stopped else "") + \
             f"disk full {when}: {err.strerror}; {checkpoint.kept_words(found, at)}{resume}"
-        p.driver.progress.note(f"shellform: stopped: {stopped}")
+        d.progress.note(f"shellform: stopped: {r.stopped}")
 
     def after_the_stroke():
-        """The tables and pictures of the drawn cup, then the springback: (rim, limits, sprung);
-        an Interrupted springback sets stopped and signum."""
-        nonlocal stopped, signum
-        if p.driver.verbose:
+        """The drawn cup's tables and pictures (the listeners' on_end), then the springback:
+        what springback changed, or None; an Interrupted springback sets stopped."""
+        nonlocal signum
+        if d.verbose:
             say("shellform: writing the tables and pictures" + (", then the springback" if s.process.springback else ""))
-        lines = cup.thickness_lines(p)
-        for name, line in lines.items():
-            write_csv(outdir / f"thickness_{name}.csv", line, ["initial_position_mm", "thickness_strain"])
-        cup.plot_thickness(outdir / "thickness.png", lines, f"{s.title}: stroke {p.stroke:.1f} mm")
-        rim = cup.write_rim(outdir, p, s.title) if tool_kinds.kind(s.tools.shape).RIM else None
-        cup.plot_force(outdir / "force_stroke.png", curve, s.title, p.symmetry)
-        if s.output.png:
-            cup.picture(outdir / "cup.png", p, f"{s.title}: stroke {p.stroke:.1f} mm")
-        limits = cup.forming_limits(outdir, p, s.title, s.output.png) if s.output.fld and p.model.plastic else {}
-        if paths is not None:
-            path = paths.critical(centres)
-            if path:
-                rows = [dict(zip(("stroke_mm", "major", "minor", "margin"), r))
-                        for r in zip(path["stroke_mm"], path["major"], path["minor"], path["margin"])]
-                write_csv(outdir / "strain_path.csv", rows, ["stroke_mm", "major", "minor", "margin"])
-                limits["strain_path"] = {"initial_xy_mm": path["initial_xy_mm"], "points": len(rows),
-                                         "end": {k: path[k][-1] for k in ("stroke_mm", "major", "minor", "margin")}}
-        if watch is not None:
-            limits["forming_limit_reached"] = watch.limit
-        sprung = None
-        if s.process.springback and stopped is None:
-            before = cup.profiles(p.initial_positions(), p.driver.displacements(), comm)
-            if p.driver.verbose:
-                say("shellform: springback: the tools withdraw")
-            try:
-                released = springback.release(p.driver)
-            except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
-                sprung = {"stopped": str(err)}
-                if isinstance(err, Interrupted):
-                    stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
-            else:
-                sprung = cup.springback(outdir, p, s.title, before, released)
-        return rim, limits, sprung
+        told.announce("on_end", r)
+        if not s.process.springback or r.stopped is not None:
+            return None
+        before = sprung_back.profiles(p.initial_positions(), d.displacements(), comm)
+        if d.verbose:
+            say("shellform: springback: the tools withdraw")
+        try:
+            released = springback.release(d)
+        except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
+            if isinstance(err, Interrupted):
+                r.stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
+            return {"stopped": str(err)}
+        return sprung_back.write(outdir, p, s.title, before, released)
 
     full = None  # the DiskFull that stopped the run
     try:
         try:
             for target in sorted(set(s.process.report) | {1.0}):
-                if target <= p.driver.lam + 1e-12:
+                if target <= d.lam + 1e-12:
                     continue  # reached before the resumed state
-                p.driver.run(target, on_increment=on_increment)
+                d.run(target, on_increment=on_increment)
                 report()
                 checkpoint_now()
-        except FormingLimitReached:  # the stroke ends here, drawn as far as the sheet can go
-            p.driver.progress.note(f"shellform: the forming-limit curve is reached at {watch.limit['stroke_mm']:.4g} mm")
+        except EndOfStroke as err:  # a listener ended the stroke here (the forming limit, the neck)
+            d.progress.note(f"shellform: {err}")
             report()
             checkpoint_now()
-        except neck.NeckReached:  # the stroke ends where the sheet starts to neck
-            p.driver.progress.note(f"shellform: the stroke ends: {neck.words(necks.onset)}")
+        except ConvergenceFailure as err:  # the driver wrote the state
+            r.stopped = str(err)
+            d.progress.note(f"shellform: stopped: {err}")
             report()
-            checkpoint_now()
-        except ConvergenceFailure as err:
-            stopped = str(err)
-            p.driver.progress.note(f"shellform: stopped: {err}")
-            report()
-            write_curve()
-        except Interrupted as err:  # the driver wrote the state; the curve up to it, and no report
-            stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal
-            p.driver.progress.note(f"shellform: {stopped}")
-            write_curve()
-            reports.append(state())  # in the summary only: a resumed run reports where the scene says
+            told.announce("on_checkpoint", r)
+        except Interrupted as err:  # the driver wrote the state; the rows up to it, and no report
+            r.stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal
+            d.progress.note(f"shellform: {r.stopped}")
+            told.announce("on_checkpoint", r)
+            cup.reports.last(r)  # in the summary only: a resumed run reports where the scene says
     except DiskFull as err:  # after the increment under way; nothing more is written but the summary
         full = err
         stop_for_full_disk(err, f"at {p.stroke:.4g} mm")
-        if not reports or reports[-1]["stroke_mm"] != p.stroke:
-            reports.append(state())  # in the summary only, as at a signal
-    p.driver.progress.close()
-    if series is not None:
-        series.close()
-    d = p.driver
-    rim, limits, sprung = None, {}, None  # as far as a full disk lets them come
+        cup.reports.last(r, again=False)  # in the summary only, as at a signal
+    d.progress.close()
+    told.announce("on_stop", r)
+    drawn, sprung = False, None  # as far as a full disk lets them come
     if full is None:
         try:
             d.room.check("the tables and pictures")
-            rim, limits, sprung = after_the_stroke()
+            sprung = after_the_stroke()
+            drawn = True
         except DiskFull as err:
             stop_for_full_disk(err, f"writing the tables and pictures at {p.stroke:.4g} mm")
+    rim = cup.drawn.rim if drawn else None
     summary = DrawingSummary({
         "title": s.title, "effects": list(s.effects), "ranks": comm.size, "threads": p.model.threads,
         "friction": {k: v if "friction" in s.effects else 0.0 for k, v in s.tools.friction_per_tool().items()},
         "cells": p.model.mesh.topology.index_map(2).size_global, "stroke_mm": p.stroke,
-        "draw_in_mm": [{"stroke_mm": r["stroke_mm"], **r["draw_in_mm"]} for r in reports],
-        "punch_force_kN": [{"stroke_mm": r["stroke_mm"], "force": r["punch_force_kN"]} for r in reports],
-        **{k: v for k, v in reports[-1].items() if k not in ("stroke_mm", "draw_in_mm", "punch_force_kN")},
-        "reports": reports, **limits, "neck": necks.onset if necks is not None else None,
+        **cup.reports.summary(), **(cup.limits.found if drawn and cup.limits is not None else {}),
+        "neck": cup.necking.onset if cup.necking is not None else None,
         "springback": sprung, **({"rim": rim} if rim else {}),
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "contact_passes": sum(h.contact["passes"] for h in d.history),
         "element_evaluations": {"run": d.evaluations, "reused": d.reused, "tangents": d.tangents},
-        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": stopped, "signal": signum,
-        "resumed_from_stroke_mm": resumed["from_stroke_mm"] if resumed else None, "resumed": resumed,
+        "cutbacks": sum(h.cutbacks for h in d.history), "stopped": r.stopped, "signal": signum,
+        "resumed_from_stroke_mm": r.resumed["from_stroke_mm"] if r.resumed else None, "resumed": r.resumed,
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "cpu_time_s": comm.allreduce(time.process_time() - c0, op=MPI.SUM),
-        "over_the_stroke": {k: max((row[k] for row in curve), default=0.0) for k in CHECKS},
+        "over_the_stroke": cup.table.over_the_stroke(),
     }, outdir)
     summary.write(comm)
     return summary

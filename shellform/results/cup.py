@@ -1,5 +1,14 @@
 """The drawn cup's results: draw-in, thickness lines, peak thinning, the VTX and VTU series, the
-force-stroke plot and the picture of the cup (used by shellform.contact.run).
+force-stroke plot and the picture of the cup (results/drawing.py's listeners call them).
+
+The drawn sheet `p` is read through its public measurements only, the names that
+shellform.contact.problem.DrawingProblem publishes for the results: comm, mesh, stroke,
+symmetry, num_cells, tools_kind (its LINES and RIM), material; nodal_values(),
+displacements(), cell_fields(), cell_centres(), input_order(), contact_nodes(),
+tool_placements(), blank_bounds(), blank_size(), picture_depth(), rim() (and, for
+results/springback.py and results/drawing.py, initial_positions(), resultants(), the forces
+and checks of the force-stroke table, membrane_stability(), cell_thickness_strain() and
+volume_change()). Nothing here reaches into the sheet's model, driver or scene.
 
 DX = draw-in of the blank edge on the axis y = 0 (initial x minus current x), DY the same on
 x = 0, DD along the diagonal at the edge's node farthest along x + y (the square blank's corner;
@@ -23,8 +32,6 @@ from mpi4py import MPI
 from shellform.results import fields
 from shellform.results.fields import offscreen_backend
 from shellform.results.tables import write_figure, write_screenshot
-from shellform.tools import kinds as tool_kinds
-from shellform.tools import square
 from shellform.tools.protocol import surface_mesh
 
 
@@ -35,7 +42,7 @@ def _gather(comm, *arrays):
 def draw_in(p) -> dict:
     """DX, DY, DD (mm) at the blank's edge on the axes and the diagonal (x, y >= 0 quadrant)."""
     X, x, _ = p.nodal_values()
-    X, x = _gather(p.model.mesh.comm, X, x)
+    X, x = _gather(p.comm, X, x)
     _, hx, _, hy = p.blank_bounds()
 
     def at(px, py):
@@ -46,7 +53,7 @@ def draw_in(p) -> dict:
     corner = int(np.argmax(X[:, 0] + X[:, 1]))
     out = {"DX": float(X0[0] - x0[0]), "DY": float(X1[1] - x1[1]),
            "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
-    if tool_kinds.kind(p.scene.tools.shape).RIM:
+    if p.tools_kind.RIM:
         out.update(rim_draw_in(rim(p)))
     return out
 
@@ -63,7 +70,7 @@ def rim(p) -> np.ndarray:
     X, x = X[on], x[on]
     rows = np.column_stack([np.degrees(np.arctan2(X[:, 1], X[:, 0])),
                             np.hypot(X[:, 0], X[:, 1]) - np.hypot(x[:, 0], x[:, 1]), x[:, 2]])
-    rows, = _gather(p.model.mesh.comm, rows)
+    rows, = _gather(p.comm, rows)
     return rows[np.argsort(rows[:, 0], kind="stable")]
 
 
@@ -91,7 +98,7 @@ def write_rim(outdir: Path, p, title: str) -> dict:
     out = {"least_draw_in_mm": float(rows[lo, 1]), "least_at_deg": float(rows[lo, 0]),
            "most_draw_in_mm": float(rows[hi, 1]), "most_at_deg": float(rows[hi, 0]),
            "z_spread_mm": float(np.ptp(rows[:, 2]))}
-    if p.model.mesh.comm.rank == 0:
+    if p.comm.rank == 0:
         import matplotlib
 
         matplotlib.use("Agg")
@@ -122,10 +129,10 @@ def thickness_lines(p) -> dict[str, list[dict]]:
     """Thickness strain at the nodes along the cup's lines (its kind of tools' LINES:
     shellform.tools.kinds), by initial distance."""
     X, _, e33 = p.nodal_values()
-    X, e33 = _gather(p.model.mesh.comm, X, e33)
+    X, e33 = _gather(p.comm, X, e33)
     tol = 1e-6 * p.blank_size()
     lines = {}
-    for name, line in tool_kinds.kind(p.scene.tools.shape).LINES.items():
+    for name, line in p.tools_kind.LINES.items():
         on = line(X, tol)
         r = np.hypot(X[on, 0], X[on, 1])
         lines[name] = [{"initial_position_mm": float(r[i]), "thickness_strain": float(e33[on][i])}
@@ -161,7 +168,7 @@ def plot_thickness(path: Path, lines: dict[str, list[dict]], title: str) -> None
 
 def peak_thinning(p) -> dict:
     X, x, e33 = p.nodal_values()
-    X, x, e33 = _gather(p.model.mesh.comm, X, x, e33)
+    X, x, e33 = _gather(p.comm, X, x, e33)
     i = int(np.argmin(e33))
     return {"min_thickness_strain": float(e33[i]), "where_initial_xy_mm": X[i].tolist(),
             "where_current_xyz_mm": x[i].tolist(), "max_thickening_strain": float(e33.max())}
@@ -175,13 +182,13 @@ def forming_limits(outdir: Path, p, title: str, png: bool) -> dict:
     from shellform.results import fld
     from shellform.results.tables import write_csv
 
-    (curve, label), beside = fld.curves(p.scene.material)
-    f = p.model.cell_fields()
+    (curve, label), beside = fld.curves(p.material)
+    f = p.cell_fields()
     margin = fld.margins(f["major_strain"], f["minor_strain"], curve)
-    centre = p.model.cell_centres()
+    centre = p.cell_centres()
     rows = [{"x0_mm": c[0], "y0_mm": c[1], "major": a, "minor": b, "margin": m}
             for c, a, b, m in zip(centre, f["major_strain"], f["minor_strain"], margin)]
-    comm = p.model.mesh.comm
+    comm = p.comm
     rows = [r for part in comm.allgather(rows) for r in part]
     write_csv(outdir / "fld.csv", rows, ["x0_mm", "y0_mm", "major", "minor", "margin"])
     fld.plot(outdir / "fld.png", f["major_strain"], f["minor_strain"], curve,
@@ -216,13 +223,13 @@ class CupSeries:
     TOOL_GRID = 96  # plan points per side of a tool's surface
 
     def __init__(self, p, outdir: Path, vtx: bool = True, vtu: bool = True, fld_margin: bool = False):
-        mesh = p.model.mesh
+        mesh, comm = p.mesh, p.comm
         self.p, self.outdir, self.writers, self.series = p, Path(outdir), [], {}
         self.fld_curve = None
         if fld_margin:
             from shellform.results import fld
 
-            mat = p.scene.material
+            mat = p.material
             self.fld_curve = fld.keeler_brazier(mat.thickness, fld.hardening_exponent(mat))
         if vtx:
             self.disp = fem.Function(fem.functionspace(mesh, ("Lagrange", 1, (3,))), name="displacement")
@@ -234,21 +241,21 @@ class CupSeries:
         if vtu:
             from shellform.results.vtu import PVDSeries
 
-            self.order = fields.input_order(p.model.V, p.model.num_cells)
+            self.order = p.input_order()
             names = ("cup", *p.tool_placements())  # on every rank: the placements reduce over them
-            if mesh.comm.rank == 0:
+            if comm.rank == 0:
                 self.series = {name: PVDSeries(self.outdir, name) for name in names}
 
     def write(self, stroke):
         p = self.p
-        values = p.model.cell_fields()
+        values = p.cell_fields()
         if self.writers:
             e33 = p.nodal_values()[2]
             n = len(e33)  # the owned nodes
             self.disp.x.array.reshape(-1, 3)[:n] = p.displacements()[:n]
             self.e33.x.array[:n] = e33
             for f in self.cells:
-                f.x.array[: p.model.num_cells] = values[f.name]
+                f.x.array[: p.num_cells] = values[f.name]
             for f in (self.disp, self.e33, *self.cells):
                 f.x.scatter_forward()
             for w in self.writers:
@@ -258,7 +265,7 @@ class CupSeries:
 
     def _write_vtu(self, stroke, values):
         p = self.p
-        comm = p.model.mesh.comm
+        comm = p.comm
         _, x, e33 = p.nodal_values()
         state, pressure = p.contact_nodes()
         n = len(self.order[0])
@@ -275,8 +282,7 @@ class CupSeries:
             return
         self.series["cup"].write(stroke, *whole)
         x0, x1, y0, y1 = p.blank_bounds()
-        t = p.scene.tools
-        span = tool_kinds.kind(t.shape).picture_depth(t)  # the walls, as deep as the stroke
+        span = p.picture_depth()  # the walls, as deep as the stroke
         for name, (tool, dz, above) in placements.items():
             z = dz * tool.axis[2]  # the height it has moved by
             z_range = (z - span, z + span)
@@ -335,10 +341,9 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None, mark: st
     magnitude), so that white is an unchanged thickness, red thickening and blue thinning.
     mark: a label format ("least {:.3f}") put on the cell where cell_field is least. On several
     ranks rank 0 gathers the sheet (fields.gather_in_input_order) and draws it: collective."""
-    m = p.model
     _, x, e33 = p.nodal_values()
-    cells = {} if cell_field is None else {"field": np.asarray(cell_field[1])[: m.num_cells]}
-    whole = fields.gather_in_input_order(m.mesh.comm, fields.input_order(m.V, m.num_cells), x, {"e33": e33}, cells)
+    cells = {} if cell_field is None else {"field": np.asarray(cell_field[1])[: p.num_cells]}
+    whole = fields.gather_in_input_order(p.comm, p.input_order(), x, {"e33": e33}, cells)
     if whole is None:
         return
     points, triangles, point_values, cell_values = whole
@@ -371,88 +376,3 @@ def picture(path: Path, p, title: str, cell_field: tuple | None = None, mark: st
     pl.camera_position = [(1.1 * L, -1.5 * L, 0.9 * L), (0.0, 0.0, -0.15 * L), (0.0, 0.0, 1.0)]
     write_screenshot(path, pl)
     pl.close()
-
-
-def profile(X, u, comm, diagonal=False):
-    """(initial distance, x or r, z) of the owned nodes (initial positions X, displacements u)
-    on the line y = 0 (or x = y), by initial distance from the centre, gathered on every rank."""
-    n = len(u)
-    x = X[:n] + u
-    on = square.LINES["diagonal" if diagonal else "transverse"](X[:n], 1e-6 * max(np.abs(X[:, :2]).max(), 1.0))
-    r = np.hypot(x[on, 0], x[on, 1]) if diagonal else x[on, 0]
-    rows, = _gather(comm, np.column_stack([np.hypot(X[:n, 0], X[:n, 1])[on], r, x[on, 2]]))
-    return rows[np.argsort(rows[:, 0])]
-
-
-def wall_angle(rows, depth: float) -> float:
-    """The wall's angle from the horizontal (degrees, 90: vertical): a line x(z) fitted to the
-    profile's points between 30 % and 70 % of the depth."""
-    z = rows[:, 2]
-    wall = (z < -0.3 * depth) & (z > -0.7 * depth)
-    if wall.sum() < 2:
-        return float("nan")
-    dxdz = np.polyfit(rows[wall, 2], rows[wall, 1], 1)[0]
-    return float(90.0 - np.degrees(np.arctan(abs(dxdz))))
-
-
-SPRINGBACK_LINES = {"transverse": False, "diagonal": True}
-
-
-def profiles(X, u, comm) -> dict:
-    """The transverse and diagonal profiles of a state (before or after springback): X the
-    owned nodes' initial positions, u their displacements."""
-    return {k: profile(X, u, comm, diagonal=v) for k, v in SPRINGBACK_LINES.items()}
-
-
-def springback(outdir: Path, p, title: str, before: dict, released) -> dict:
-    """What springback changed (shellform.contact.springback released the tools' forces into
-    `released`): wall angle and flange edge along the transverse line, the diagonal's corner,
-    the unloading's plastic layers, the residual resultants; springback.csv (both profiles) and
-    springback.png (the change along each line: sprung back minus drawn, in z and in the distance
-    from the centre, against the node's initial distance from the centre, which runs along the
-    wall where the drawn distance folds back on itself)."""
-    from shellform.results.tables import write_csv
-
-    lines = SPRINGBACK_LINES
-    after = profiles(p.initial_positions(), released.displacements(), p.model.mesh.comm)
-    depth = float(-before["transverse"][:, 2].min())
-    rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
-             "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]
-    write_csv(outdir / "springback.csv", rows, list(rows[0]))
-    m = p.model
-    N, M = m.resultants[..., :3], m.resultants[..., 3:]
-    comm = m.mesh.comm
-    edge = {k: (before[k][-1], after[k][-1]) for k in lines}
-    out = {
-        "stopped": None,
-        "wall_angle_deg": {"before": wall_angle(before["transverse"], depth),
-                           "after": wall_angle(after["transverse"], depth)},
-        "flange_edge_dz_mm": {k: float(a[2] - b[2]) for k, (b, a) in edge.items()},
-        "flange_edge_dr_mm": {k: float(a[1] - b[1]) for k, (b, a) in edge.items()},
-        "unloading_increments": len(released.history),
-        "plastic_layers_on_unloading": int(sum(h.plastic_layers for h in released.history)),
-        "residual_max_N_per_mm": comm.allreduce(float(np.abs(N[..., :2]).max(initial=0.0)), op=MPI.MAX),
-        "residual_max_M_N": comm.allreduce(float(np.abs(M[..., :2]).max(initial=0.0)), op=MPI.MAX),
-    }
-    if comm.rank == 0:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
-        for ax, k in zip(axes, lines):  # the change: on the profiles' scale it does not show
-            s0, r = before[k][:, 0], before[k][:, 1]
-            ax.plot(s0, after[k][:, 2] - before[k][:, 2], "b-", label="z: vertical")
-            ax.plot(s0, after[k][:, 1] - r, "r--", label="r: away from the centre")
-            ax.axhline(0.0, color="k", lw=0.5)
-            ax.set_xlabel("initial distance from the centre (mm)")
-            ax.set_ylabel("sprung back minus drawn (mm)")
-            ax.set_title(f"{k} line", fontsize=9)
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=8)
-        fig.suptitle(f"{title}: springback", fontsize=10)
-        fig.tight_layout()
-        write_figure(outdir / "springback.png", fig, dpi=120)
-        plt.close(fig)
-    return out

@@ -26,6 +26,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.errors import InputError
+from shellform.results.listeners import EndOfStroke
 from shellform.results.tables import write_figure
 
 FIELD = "material.forming_limit_curve"
@@ -146,6 +147,11 @@ def plot(path, major, minor, curve, title: str, label: str, beside=None) -> None
     fig.tight_layout()
     write_figure(path, fig, dpi=120)
     plt.close(fig)
+
+
+class FormingLimitReached(EndOfStroke):
+    """The stroke ends: an element's margin to the forming-limit curve reached 0 ([process]
+    stop_at_forming_limit)."""
 
 
 LIMIT_KEYS = ("stroke_mm", "increment_stroke_mm", "margin")  # FormingLimitWatch.limit

@@ -24,8 +24,8 @@ to 8,000 in its first plastic one), which a straight line through two increments
 reach 0 within a step; near a neck it is a few hundred MPa or less (Considere's d sigma / d eps
 - sigma, against E).
 
-The watch is told the sheet's state after every converged increment (a run's on_increment;
-the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
+The watch is told the sheet's state after every converged increment (a tool scene's Necking
+listener, results/drawing.py; a sheet scene's on_increment; the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
 tool scene, the load factor of a sheet scene) interpolated linearly between the last increment
 whose least stability is positive and the first whose is not (the least over all cells of
 every rank at each: where the weakest cell changes between them, a lower bound of the onset),
@@ -37,10 +37,12 @@ reports it (summary.json "neck", null without a neck).
 
 import numpy as np
 
+from shellform.results.listeners import EndOfStroke
+
 PLASTIC = 0.01  # of the first increment's least stability: below it, its fall is extrapolated to a neck
 
 
-class NeckReached(Exception):
+class NeckReached(EndOfStroke):
     """A run's stroke or load path ends: the sheet starts to neck ([process] stop_at_neck)."""
 
 
