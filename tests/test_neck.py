@@ -110,6 +110,37 @@ def test_a_thickening_cell_does_not_neck():
     assert watch.onset["initial_xy"] == [1.5, 0.5] and watch.onset["stability"] == -5.0
 
 
+def test_a_cell_drawn_more_than_stretched_does_not_neck():
+    """Given the major strains, a thinned cell is watched only where its thinning is at least
+    0.9 / (1 + r) of its major strain (uniaxial tension's share 1 / (1 + r), r = 1.5: 0.36): the
+    square cup's drawn corner (major 0.32, thickness strain -0.026, share 0.08) passes its force
+    maximum unreported; a cell stretched nearly uniaxially (share 0.38) is reported; the same
+    drawn cell with an isotropic sheet's r = 1 (0.45) neither."""
+    centres = np.array([[35.9, 34.4], [34.4, 31.25]])
+    major = np.array([0.32, 0.21])
+    thickness = np.array([-0.026, -0.079])
+    watch = NeckWatch(MPI.COMM_SELF, r=1.5)
+    assert not watch.reached(15.8, np.array([-30.0, 40.0]), thickness, centres, major)
+    assert watch.onset is None
+    assert watch.reached(20.1, np.array([-30.0, -12.0]), thickness, centres, major)
+    assert watch.onset["initial_xy_mm"] == [34.4, 31.25] and watch.onset["stability"] == -12.0
+    isotropic = NeckWatch(MPI.COMM_SELF, r=1.0)
+    assert not isotropic.reached(20.1, np.array([-30.0, -12.0]), thickness, centres, major)
+    assert isotropic.reached(20.1, np.array([-30.0, -12.0]), thickness, centres)  # without major strains: every thinned cell
+
+
+@pytest.mark.parametrize("changes, r", [({}, 1.5), ({"material.yield_function": "hill48", "material.r0": 0.7,
+                                                        "material.r45": 0.6, "material.r90": 2.1}, 2.1)])
+def test_the_largest_r_of_a_scene(changes, r):
+    from shellform import demos
+    from shellform.scene import load
+
+    s = load(demos.path("square_cup.toml"))
+    if changes:
+        s = s.changed({"material.r": 1.0, **changes})
+    assert s.largest_r() == r
+
+
 def test_a_resumed_watch_keeps_an_earlier_onset():
     """A resumed run at 12 mm keeps the onset found at 10 mm (from the summary before), and
     ignores one past its state (a run resumed from before it finds it again)."""

@@ -114,7 +114,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
     reports, stopped, signum = [], None, 0
     p.driver.progress = Progress("load factor", max(abs(x) for x in s.process.path))
     targets = sorted(set(s.process.report))
-    necks = neck.NeckWatch(comm, "load_factor", "initial_xy") if p.model.plastic else None
+    necks = neck.NeckWatch(comm, "load_factor", "initial_xy", s.largest_r()) if p.model.plastic else None
     centres = p.model.cell_centres()
     series = fields.SheetSeries(p.model.V, p.model.num_cells, outdir) if s.output.vtu else None
     sens = None
@@ -144,7 +144,8 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None) -> SheetSu
         if necks is None:
             return
         before = necks.onset
-        if necks.reached(d.lam, p.model.membrane_stability(), p.model.thickness_strain(), centres):
+        f = p.model.cell_fields()
+        if necks.reached(d.lam, p.model.membrane_stability(), f["thickness_strain"], centres, f["major_strain"]):
             if s.process.stop_at_neck:
                 raise neck.NeckReached
             if before is None:

@@ -191,8 +191,8 @@ class Necking(Listener):
     the steps shorten ahead of it and the stroke ends there (neck.NeckReached), without it the
     onset is noted and the run goes on. A resumed run keeps the onset the run before it found."""
 
-    def __init__(self, comm, stop: bool, stroke_mm: float):
-        self.watch, self.stop, self.stroke_mm = neck.NeckWatch(comm), stop, stroke_mm
+    def __init__(self, comm, stop: bool, stroke_mm: float, r: float = 1.0):
+        self.watch, self.stop, self.stroke_mm = neck.NeckWatch(comm, r=r), stop, stroke_mm
         self.centres = None
 
     @property
@@ -207,7 +207,9 @@ class Necking(Listener):
     def on_increment(self, run: Run) -> None:
         p, d = run.sheet, run.driver
         before = self.watch.onset
-        necked = self.watch.reached(p.stroke, p.membrane_stability(), p.cell_thickness_strain(), self.centres)
+        f = p.cell_fields()
+        necked = self.watch.reached(p.stroke, p.membrane_stability(), f["thickness_strain"], self.centres,
+                                    f["major_strain"])
         if necked and before is None and not self.stop:
             d.progress.note(f"shellform: the sheet starts to neck: {neck.words(self.watch.onset)}")
         if self.stop and d.next_step is not None:  # shorter steps ahead of the run's end
@@ -273,7 +275,7 @@ class CupListeners:
         limits = FormingLimits(scene, comm, o.fld, pr.stop_at_forming_limit) \
             if plastic and (o.fld or pr.stop_at_forming_limit) else None
         series = Series(o.vtx, o.vtu, o.fld and plastic) if o.vtx or o.vtu else None
-        necking = Necking(comm, pr.stop_at_neck, scene.tools.stroke) if plastic else None
+        necking = Necking(comm, pr.stop_at_neck, scene.tools.stroke, scene.largest_r()) if plastic else None
         return cls(DrawnCup(o.png), ForceStroke(outdir), limits, necking, series, Reports(outdir), tuple(extra))
 
     def all(self) -> Listeners:

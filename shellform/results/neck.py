@@ -10,6 +10,17 @@ A neck thins the sheet: only the cells thinner than the blank (thickness strain 
 watched. Where the sheet thickens, compressed in the mean (a cup's flange and its drawn-in rim,
 a rim ironed between the tools), the membrane tangent may turn indefinite too, but that is the
 membrane's own wrinkling, which the shell's bending resists, or the faces' pressure, not a neck.
+Given the cells' major strains, a cell is watched only on the stretching side of the forming-limit
+diagram, from uniaxial tension to equibiaxial stretching: where its thinning is at least
+STRETCHED / (1 + r) of its major strain (r the sheet's largest Lankford coefficient), as uniaxial
+tension thins the sheet by 1 / (1 + r) of its major strain (a proportional path of minor to
+major strain beta: -e33 = (1 + beta) eps1, beta = -r / (1 + r)). Left of uniaxial tension, where
+the flange is drawn in hoop compression towards pure shear (beta -> -1: the flange drawn over
+the die's corner into the wall), a material point may pass its force maximum (Swift's diffuse
+instability on the drawing side) and the sheet still draws on stably, barely thinning: there a
+local neck needs eps1 = n / (1 + beta) (Hill's zero-extension criterion, Hill 1952), without
+bound as beta -> -1, and the forming-limit view ([output] fld) is the measure of a drawn part's
+failure (docs/plastic.md).
 
 Where the run stops at the neck ([process] stop_at_neck), the watch shortens the steps ahead
 of the onset (`ahead`), so that the run ends close to it: from the least stability at the
@@ -40,6 +51,7 @@ import numpy as np
 from shellform.results.listeners import EndOfStroke
 
 PLASTIC = 0.01  # of the first increment's least stability: below it, its fall is extrapolated to a neck
+STRETCHED = 0.9  # of uniaxial tension's thinning share 1 / (1 + r): the least a watched cell's path thins
 
 
 class NeckReached(EndOfStroke):
@@ -49,10 +61,11 @@ class NeckReached(EndOfStroke):
 class NeckWatch:
     """The onset of the neck along a run. at, place: the names of the load measure and of the
     place in `onset` ("stroke_mm", "initial_xy_mm" for tool scenes; "load_factor", "initial_xy"
-    for sheet scenes)."""
+    for sheet scenes); r: the sheet's largest Lankford coefficient (Scene.largest_r)."""
 
-    def __init__(self, comm, at: str = "stroke_mm", place: str = "initial_xy_mm"):
+    def __init__(self, comm, at: str = "stroke_mm", place: str = "initial_xy_mm", r: float = 1.0):
         self.comm, self.at, self.place = comm, at, place
+        self.thinning = STRETCHED / (1.0 + r)  # the least share of its major strain a watched cell has thinned
         self.last = None  # (load measure, least stability) of the last increment
         self.thickness = None  # the local cells' thickness strains at the last increment
         self.onset = None  # {at, "increment_" + at, place, "thickness_strain", "stability"}, or None
@@ -66,12 +79,16 @@ class NeckWatch:
         if onset and self.onset is None and onset.get(self.at) is not None and onset[self.at] <= at:
             self.onset = dict(onset)
 
-    def reached(self, at: float, stability, thickness_strain, centres) -> bool:
+    def reached(self, at: float, stability, thickness_strain, centres, major_strain=None) -> bool:
         """After an increment at the load measure `at`: the local cells' stability, thickness
-        strain and initial centres (cells, 2). Whether the neck has started (now or before); the
-        cells that have not thinned are not watched (module docstring)."""
+        strain and initial centres (cells, 2), and where given their major strains. Whether the
+        neck has started (now or before); the cells that have not thinned, and given the major
+        strains those drawn more than stretched, are not watched (module docstring)."""
         thickness_strain = np.asarray(thickness_strain, dtype=float)
-        stability = np.where(thickness_strain < 0.0, np.asarray(stability, dtype=float), np.inf)
+        watched = thickness_strain < 0.0
+        if major_strain is not None:
+            watched &= -thickness_strain >= self.thinning * np.asarray(major_strain, dtype=float)
+        stability = np.where(watched, np.asarray(stability, dtype=float), np.inf)
         local = float(np.nanmin(stability)) if np.any(np.isfinite(stability)) else np.inf
         least, owner = min(self.comm.allgather((local, self.comm.rank)))
         if least <= 0.0 and self.onset is None:

@@ -47,6 +47,13 @@ class Scene:
         small step (the sensitivities' differences, nonlinear/sensitivity.py)."""
         return replace(self, material=replace(self.material, **{key: value}))
 
+    def largest_r(self) -> float:
+        """The largest Lankford coefficient the material states (r of Hill 1979, r0, r45, r90,
+        the fitted ones; 1 for an isotropic sheet): how much uniaxial tension thins it."""
+        m = self.material
+        given = [m.r0, m.r45, m.r90, *m.fit_r] if self.material.yield_function != "hill79" else [m.r]
+        return max([v for v in given if v > 0] or [1.0])
+
     @property
     def kappa0(self) -> tuple[float, float]:
         return (1.0 / self.surface.R1, 1.0 / self.surface.R2)

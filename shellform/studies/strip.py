@@ -120,7 +120,7 @@ def strip(mat, stretch: float, homogeneous=True, finite=True, steps=10, n=1, com
                      "width_strain": float(np.log(1.0 + p.value("v", LENGTH, WIDTH) / WIDTH)),
                      "stability": comm.allreduce(float(stability.min(initial=np.inf)), op=MPI.MIN)})
         if watch is not None:
-            watch.reached(1.0 + d.lam * a, stability, f["thickness_strain"], p.model.cell_centres())
+            watch.reached(1.0 + d.lam * a, stability, f["thickness_strain"], p.model.cell_centres(), f["major_strain"])
 
     p.driver.run(1.0, on_increment=record)
     return p, rows
