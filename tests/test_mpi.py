@@ -251,3 +251,30 @@ def test_drawbeads_on_two_ranks_match_serial(tmp_path):
     assert parallel["increments"] == serial["increments"] and parallel["balance"] <= 1e-6
     assert parallel["force"] == pytest.approx(serial["reports"][-1]["punch_force_kN"], rel=1e-6)
     assert parallel["DX"] == pytest.approx(serial["reports"][-1]["draw_in_mm"]["DX"], rel=1e-6)
+
+
+SENSITIVITY = """
+import shellform, json
+from mpi4py import MPI
+from shellform.run import run
+from shellform.studies.sensitivity import cantilever_scene
+summary = run(cantilever_scene(True).changed({{"mesh.n": 16}}), {out!r})
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT " + json.dumps(summary["reports"][-1]["sensitivities"]))
+"""
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
+def test_sensitivities_on_two_ranks_match_serial(tmp_path):
+    """The cantilever's sensitivities (nonlinear/sensitivity.py) on 2 ranks equal one rank's to
+    1e-7 of each answer's largest derivative (the solver's tolerance)."""
+    from shellform.run import run
+    from shellform.studies.sensitivity import cantilever_scene
+
+    serial = run(cantilever_scene(True).changed({"mesh.n": 16}), tmp_path / "one")["reports"][-1]["sensitivities"]
+    two = on_two_ranks(tmp_path, SENSITIVITY.format(out=str(tmp_path / "two")))
+    for name, answers in serial.items():
+        scale = max(abs(v) for v in answers.values())
+        for answer, value in answers.items():
+            assert abs(two[name][answer] - value) <= 1e-7 * scale, (name, answer)

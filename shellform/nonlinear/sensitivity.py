@@ -131,7 +131,7 @@ class Sensitivity:
     # -- the record's protocol ------------------------------------------------------------------
     def converged(self, driver, lam: float) -> None:
         """The increment to lam converged and is not committed yet: q'_n+1, h'_n+1 and dR/dp."""
-        model, comm = self.model, model_comm(self.model)
+        model, comm = self.model, self.model.mesh.comm
         h_n = model.history()
         q = driver.q.x.array.copy()
         driver.linearize(lam)  # the consistent tangent at the converged state, from h_n
@@ -177,11 +177,15 @@ class Sensitivity:
         return {"nodes": nodes, "cells": cells}
 
     def restore(self, state: dict) -> None:
+        work = self.driver.dq.x  # to share the owned rows with the ghosts
         for i, par in enumerate(self.parameters):
             key = f"sensitivity{i}_dq"
             if key not in state["nodes"]:
                 raise InputError("resume", "the checkpoint carries no sensitivities for this scene's parameters")
-            self.dq[par.name][: self.driver.n_owned * BS] = state["nodes"][key].ravel()
+            work.array[:] = 0.0
+            work.array[: self.driver.n_owned * BS] = state["nodes"][key].ravel()
+            work.scatter_forward()
+            self.dq[par.name] = work.array.copy()
             for k in KEYS:
                 self.dh[par.name][k][...] = state["cells"][f"sensitivity{i}_{k}"]
 
@@ -205,10 +209,6 @@ class Sensitivity:
         if not self.model.finite:
             raise InputError(f"output.sensitivities ({name})", "the thickness strain's sensitivity needs finite_strain")
         return (self.dh[name]["stretch"] / self.model.history()["stretch"]).mean(axis=1)
-
-
-def model_comm(model):
-    return model.mesh.comm
 
 
 def _along(h: dict, dh: dict, step: float) -> dict:
