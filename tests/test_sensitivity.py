@@ -166,3 +166,45 @@ def test_the_sensitivities_go_through_a_checkpoint(tmp_path):
         assert np.array_equal(r.carrier(name)[:owned], s.carrier(name)[:owned])
         for key, values in s.state(name).items():
             assert np.array_equal(r.state(name)[key], values), key
+
+
+def test_a_curved_clamped_rim_keeps_the_homogeneity(tmp_path):
+    """demos/clamped_disc_large_deflection.toml, its rim held in its vertices' own frames
+    (edge_frames.py): the sensitivities pass through those frames, and E dw/dE + P dw/dP = 0 at
+    the centre to 1e-6 of w (w about 0.97 t, membrane-stiffened)."""
+    from shellform import demos
+    from shellform.run import run
+    from shellform.scene import load
+
+    s = load(demos.path("clamped_disc_large_deflection.toml")).changed(
+        {"output.sensitivities": ["material.E", "loads.pressure"], "output.vtx": False, "output.vtu": False,
+         "output.png": False})
+    report = run(s, tmp_path / "disc")["reports"][-1]
+    d = report["sensitivities"]
+    E, P = s.material.E, s.loads.pressure
+    assert abs(report["w"]) > 0.5 * s.material.thickness
+    assert abs(E * d["material.E"]["w"] + P * d["loads.pressure"]["w"]) <= 1e-6 * abs(report["w"])
+
+
+def test_an_increment_ending_at_the_yield_point_is_flagged():
+    """A perfectly plastic strip (yield stress K) stretched homogeneously in one increment to
+    exactly its yield strain ln(lambda) = K / E: at K + eps it is elastic (d tau / dK = 0), at
+    K - eps it flows (d tau / dK = 1). The central difference lies between the one-sided
+    derivatives, and the increment's layers are counted as switching."""
+    from shellform.material import Hill79Material
+    from shellform.nonlinear.driver import Controls
+
+    mat = Hill79Material(E=1000.0, nu=0.3, hardening="swift", K=10.0, eps0=1.0, n=0.0)
+    a = np.exp(mat.K / mat.E) - 1.0
+    held = {("all", "u"): lambda x, y: a * x, ("all", "u_x"): a, ("all", "u_y"): 0.0}
+    p = SheetProblem.on_rectangle(MPI.COMM_WORLD, 2 * strip.LENGTH, 2 * strip.WIDTH, 1, mat, strip.T0,
+                                  strip.effects(True), region="quarter",
+                                  supports={"left": "symmetry", "bottom": "symmetry"}, prescribed=held,
+                                  controls=Controls(initial_step=1.0, max_step=1.0, rtol=1e-12))
+    s = Sensitivity(p.driver, material_parameters(mat, ("K",)))
+    p.driver.records.append(s)
+    p.driver.run(1.0)
+    tau = (1 + a) / (strip.WIDTH * strip.T0)
+    assert p.reaction("right", "u") * tau == pytest.approx(mat.K, rel=1e-9)
+    assert 0.3 < p.reaction("right", "u", residual=s.residual("K")) * tau < 0.7
+    assert s.switches[0] > 0
