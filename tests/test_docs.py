@@ -37,7 +37,8 @@ def test_the_pages_tables_are_their_studies_files():
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}.md" for s in (
         "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper",
-        "cup_strain/cup_strain", "esaform_cup/esaform_cup", "levy/levy", "nakajima/nakajima", "numisheet93/numisheet",
+        "cup_strain/cup_strain", "esaform_cup/esaform_cup", "esaform_hypotheses/esaform_hypotheses", "levy/levy",
+        "nakajima/nakajima", "numisheet93/numisheet",
         "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic", "plate/plate_convergence",
         "rollup/rollup", "sensitivity/sensitivity", "shell/shell_convergence", "strip/strip")}
 
@@ -180,6 +181,7 @@ def test_the_studies_tables_are_their_csvs():
              for r in _rows(RESULTS / "cup_convergence" / "cup_convergence.csv", drop_empty=True)],
             _rows(RESULTS / "cup_convergence" / "cup_convergence_estimates.csv")),
         "esaform_cup": esaform_cup.markdown(_rows(RESULTS / "esaform_cup" / "esaform_cup.csv"), []),
+        "esaform_hypotheses": esaform_cup.markdown(_rows(RESULTS / "esaform_hypotheses" / "esaform_hypotheses.csv"), []),
         "numisheet_cost": numisheet_cost.markdown(
             _rows(RESULTS / "numisheet_cost" / "numisheet_cost.csv", drop_empty=True),
             {r["answer"]: (r["value"], r["uncertainty"], r["source"])

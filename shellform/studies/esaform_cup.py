@@ -90,7 +90,13 @@ MODELS = {  # name: (label, the scene's material changes)
         "material.yield_function": "hill48", "material.r0": 0.526, "material.r45": 0.253, "material.r90": 0.601,
         "material.fit_angles": [], "material.fit_r": [], "material.fit_sigma": [],
         "material.sigma_b": 0.0, "material.r_b": 0.0, "material.a": 0.0}),
+    # the two assumptions docs/cup.md suspects, one at a time on the demo's Yld2000-2d
+    "yld2000-wide-die": ("Yld2000-2d, die radius 31.6 mm (1.6 mm clearance: the rim not ironed)",
+                         {"tools.die_radius": 31.6}),
+    "yld2000-gap-holder": ("Yld2000-2d, the holder at the benchmark's 1.04 mm gap",
+                           {"tools.holder": "gap", "tools.holder_gap": 1.04}),
 }
+HYPOTHESES = ("yld2000-wide-die", "yld2000-gap-holder")  # run apart: `hypotheses`'s docstring
 # github.com/stefanSCS/PolyN, CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt:
 # (angle in degrees, measured cup height in mm)
 MEASURED = np.array([
@@ -305,7 +311,7 @@ def plot(path: Path, rows: list[dict], out: Path) -> None:
     plt.close(fig)
 
 
-def run(out: Path, levels=LEVELS, models=tuple(MODELS), stroke=None) -> list[dict]:
+def run(out: Path, levels=LEVELS, models=("yld2000", "hill48"), stroke=None) -> list[dict]:
     """Draw each yield function on each level into out (a finished run of the same scene there
     is reused), then the tables and the plot."""
     out = Path(out)
@@ -320,6 +326,15 @@ def run(out: Path, levels=LEVELS, models=tuple(MODELS), stroke=None) -> list[dic
             say(f"esaform-cup: {run_name(model, n)}")
             run_cup(s, d)
     return tables(out, {m: levels for m in models})
+
+
+def hypotheses(out: Path, n: int = 12) -> list[dict]:
+    """The demo's Yld2000-2d drawn through on n with each assumption of docs/cup.md changed in
+    turn (HYPOTHESES), into their own folder:
+
+        python -c "from shellform.studies import esaform_cup as e; e.hypotheses('docs/results/esaform_hypotheses')"
+    """
+    return run(out, levels=(n,), models=HYPOTHESES)
 
 
 def tables(out: Path, levels: dict) -> list[dict]:
