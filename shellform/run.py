@@ -56,14 +56,14 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     file, for run.json; trace: the tools log every contact pass, Newton step and iterate;
     resume: the tools continue from the last converged state in outdir (InputError("resume")
     for the other routes); listeners: the caller's (shellform.results.listeners.Listener), told
-    of a tool scene's start, increments, reports, checkpoints, stop and end after the run's own
-    (ValueError for the other routes)."""
+    of a tool or sheet scene's start, increments, reports, checkpoints (tools), stop and end
+    after the run's own (ValueError for the linear shell, which has no increments)."""
     outdir = Path(outdir)
     way = route(s)
     if resume and way != "tools":
         raise InputError("resume", "only tool scenes (a [tools] section) resume from a checkpoint")
-    if listeners and way != "tools":
-        raise ValueError("listeners: only a tool scene's run (a [tools] section) tells listeners")
+    if listeners and way == "shell":
+        raise ValueError("listeners: the linear shell's solve has no increments to tell them of")
     if way != "shell" and not jit.compiled():
         from shellform.results.log import say
 
@@ -80,5 +80,5 @@ def run(s: Scene, outdir, *, scene_path=None, trace: bool = False, resume: bool 
     if way == "sheet":
         from shellform.nonlinear import run as sheet
 
-        return sheet.run(s, outdir, comm, scene_path=scene_path)
+        return sheet.run(s, outdir, comm, scene_path=scene_path, listeners=listeners)
     return _shell(s, outdir, comm, scene_path)

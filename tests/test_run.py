@@ -160,7 +160,44 @@ def test_a_callers_listener_is_told_the_increments_and_reports(tmp_path):
     assert listener.events == ["start", "increment", "report", "checkpoint", "increment", "report", "checkpoint",
                                "stop", "end"]
     with pytest.raises(ValueError, match="listeners"):
-        run.run(small_levy(), tmp_path / "levy", listeners=[listener])
+        run.run(scene.load(DEMOS / "square_plate.toml"), tmp_path / "plate", listeners=[listener])
+
+
+def test_a_sheet_scenes_listener_is_told_its_increments_and_reports(tmp_path):
+    """A sheet scene (results/sheet.py) tells a caller's listener its start, every increment,
+    every report and its stop and end, in that order: the load factors it sees are summary.json's
+    reports and increments.csv's rows."""
+    from shellform.results.listeners import Listener
+
+    class Record(Listener):
+        def __init__(self):
+            self.events, self.lams, self.reports = [], [], []
+
+        def on_start(self, r):
+            self.events.append("start")
+
+        def on_increment(self, r):
+            self.events.append("increment")
+            self.lams.append(r.driver.history[-1].lam)
+
+        def on_report(self, r):
+            self.events.append("report")
+            self.reports.append(r.driver.lam)
+
+        def on_stop(self, r):
+            self.events.append("stop")
+
+        def on_end(self, r):
+            self.events.append("end")
+
+    listener = Record()
+    summary = run.run(small_levy(), tmp_path, listeners=[listener])
+    rows = list(csv.DictReader(open(tmp_path / "increments.csv")))
+    assert listener.lams == pytest.approx([float(r["load_factor"]) for r in rows]) and len(rows) == summary["increments"]
+    assert listener.reports == pytest.approx([r["load_factor"] for r in summary["reports"]])
+    assert listener.reports == pytest.approx([0.5, 1.0])
+    assert listener.events[0] == "start" and listener.events[-2:] == ["stop", "end"]
+    assert listener.events.count("report") == 2 and listener.events.count("increment") == len(rows)
 
 
 def test_exit_status_of_a_stop_by_signal(tmp_path):
