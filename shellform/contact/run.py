@@ -186,10 +186,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if r.ending is not None:
             raise r.ending
 
-    def report():
-        told.announce("on_report", r)
-        with d.room.write("the report"):  # rank 0's writes after the collective ones
-            told.announce("save_report", r)
 
     def stop_for_full_disk(err: DiskFull, when: str) -> None:
         """A full disk stops the run: `stopped` (after a stop before it) says in one sentence
@@ -229,16 +225,16 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
                 if target <= d.lam + 1e-12:
                     continue  # reached before the resumed state
                 d.run(target, on_increment=on_increment)
-                report()
+                told.report(r)
                 checkpoint_now()
         except EndOfStroke as err:  # a listener ended the stroke here (the forming limit, the neck)
             d.progress.note(f"shellform: {err}")
-            report()
+            told.report(r)
             checkpoint_now()
         except ConvergenceFailure as err:  # the driver wrote the state
             r.stopped = str(err)
             d.progress.note(f"shellform: stopped: {err}")
-            report()
+            told.report(r)
             told.announce("on_checkpoint", r)
         except Interrupted as err:  # the driver wrote the state; the rows up to it, and no report
             r.stopped, signum = f"{err} at {p.stroke:.4g} mm; --resume continues from there", err.signal

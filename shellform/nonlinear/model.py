@@ -154,24 +154,38 @@ class SheetModel:
     # -- the element loop -------------------------------------------------------------------
     def evaluate(self, q: fem.Function, tangent: bool = True, elastic_tangent: bool = False) -> Evaluation:
         """Element forces (and tangents) at the carrier state q, into the copy forms."""
+        out = {"z": self.z, "strain": self.strain, "ep": self.ep, "p": self.p, "stretch": self.stretch,
+               "resultants": self.resultants, "tangents": self.tangents, "face_pressure": self.face_pressure,
+               "ironed_d": self.ironed_d, "ironed": self.ironed, "vectors": self.forms.vectors}
+        ev, self.pressed = self._loops(q.x.array, self.ep_n, self.p_n, self.lever, self.material, self.thickness,
+                                       out, tangent, elastic_tangent)
+        return ev
+
+    def _loops(self, q, ep_n, p_n, lever, material, thickness, out, tangent=False, elastic_tangent=False):
+        """The element and material loops at the carrier array q from the state (ep_n, p_n, the
+        lever arm) with `material` and `thickness`, into the arrays of `out` (SheetModel's names;
+        the tangents into the copy forms' matrices with `tangent`): (Evaluation, points pressed)."""
         k = self.kernels
         t0 = time.perf_counter()
-        k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q.x.array, self.P, self.consts, self.beta,
-                      self.tying, self.z, self.strain)
+        k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q, self.P, self.consts, self.beta,
+                      self.tying, out["z"], out["strain"])
         t1 = time.perf_counter()
         nplastic, nfail, nguard = section_update(
-            self.strain, self.taper, self.material, self.thickness, self.plastic, self.finite, self.zeta, self.wz,
-            self.ep_n, self.p_n, self.lever, self.ep, self.p, self.stretch, self.resultants, self.tangents,
+            out["strain"], self.taper, material, thickness, self.plastic, self.finite, self.zeta, self.wz,
+            ep_n, p_n, lever, out["ep"], out["p"], out["stretch"], out["resultants"], out["tangents"],
             elastic_tangent, self.threads)
+        pressed = 0
         if self.ironing:
-            self.pressed, failed = ironing.squeeze(self.strain, self.clearance, self.thickness, self.modulus33,
-                                                   2.0 * self.kernels.element.weights, self.resultants, self.tangents,
-                                                   self.face_pressure, self.ironed_d, self.ironed)
+            pressed, failed = ironing.squeeze(out["strain"], self.clearance, thickness, self.modulus33,
+                                              2.0 * k.element.weights, out["resultants"], out["tangents"],
+                                              out["face_pressure"], out["ironed_d"], out["ironed"])
             nguard += failed  # a mid-surface turned inside out: past the strain guard
         t2 = time.perf_counter()
-        self.tensor_arrays(tangent)
+        k.tensor_loop(self.threads, self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, out["z"],
+                      out["resultants"], out["tangents"], out["ironed_d"], out["ironed"], tangent, out["vectors"],
+                      self.forms.matrices)
         t3 = time.perf_counter()
-        return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard))
+        return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard)), pressed
 
     def history(self) -> dict:
         """The committed material state an increment starts from, as copies: per cell, point
@@ -184,29 +198,19 @@ class SheetModel:
         """The element forces and the updated material state at the carrier array q (with
         ghosts) from the committed state `history` (as history() gives it, its stretch the
         lever arm), with another material or thickness where given: the map
-        (q, h_n, material) -> (f_e, h_n+1) that one evaluation computes, on arrays of its own,
-        so that nothing of the model's state changes. Returns (element vectors (cells, NDOF),
-        the updated state in history()'s keys, whether the material update failed)."""
-        k = self.kernels
+        (q, h_n, material) -> (f_e, h_n+1) that one evaluation computes (the same loops), on
+        arrays of its own, so that nothing of the model's state changes. Returns (element
+        vectors (cells, NDOF), the updated state in history()'s keys, whether the material
+        update failed)."""
         mat = self.material if material is None else np.asarray(material, dtype=np.float64)
         t = self.thickness if thickness is None else float(thickness)
-        z, strain = np.zeros_like(self.z), np.zeros_like(self.strain)
-        k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q, self.P, self.consts, self.beta,
-                      self.tying, z, strain)
-        ep, p, stretch = np.zeros_like(self.ep), np.zeros_like(self.p), np.ones_like(self.stretch)
-        resultants, tangents = np.zeros_like(self.resultants), np.zeros_like(self.tangents)
-        _, nfail, nguard = section_update(strain, self.taper, mat, t, self.plastic, self.finite, self.zeta, self.wz,
-                                          history["ep"], history["p"], history["stretch"], ep, p, stretch,
-                                          resultants, tangents, False, self.threads)
-        ironed_d, ironed = np.zeros_like(self.ironed_d), self.ironed.copy()
-        if self.ironing:
-            _, failed = ironing.squeeze(strain, self.clearance, t, self.modulus33, 2.0 * k.element.weights,
-                                        resultants, tangents, np.zeros_like(self.face_pressure), ironed_d, ironed)
-            nguard += failed
-        vectors = np.zeros_like(self.forms.vectors)
-        k.tensor_loop(self.threads, self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, z,
-                      resultants, tangents, ironed_d, ironed, False, vectors, self.forms.matrices)
-        return vectors, {"ep": ep, "p": p, "stretch": stretch}, bool(nfail or nguard)
+        out = {"z": np.zeros_like(self.z), "strain": np.zeros_like(self.strain), "ep": np.zeros_like(self.ep),
+               "p": np.zeros_like(self.p), "stretch": np.ones_like(self.stretch),
+               "resultants": np.zeros_like(self.resultants), "tangents": np.zeros_like(self.tangents),
+               "face_pressure": np.zeros_like(self.face_pressure), "ironed_d": np.zeros_like(self.ironed_d),
+               "ironed": self.ironed.copy(), "vectors": np.zeros_like(self.forms.vectors)}
+        ev, _ = self._loops(q, history["ep"], history["p"], history["stretch"], mat, t, out)
+        return out["vectors"], {"ep": out["ep"], "p": out["p"], "stretch": out["stretch"]}, ev.failed
 
     def tensor_arrays(self, tangent: bool) -> None:
         """The element vectors (and tangents) from the last evaluation's strains, stresses and

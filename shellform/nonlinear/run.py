@@ -83,10 +83,6 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None, listeners=
         if r.ending is not None:
             raise r.ending
 
-    def report():
-        told.announce("on_report", r)
-        with d.room.write("the report"):
-            told.announce("save_report", r)
 
     def stop_for_full_disk(err: DiskFull, when: str) -> None:
         """A full disk stops the run: `stopped` (after a stop before it) says in one sentence
@@ -106,17 +102,17 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None, listeners=
                 stops = [x for x in targets if lo < x < hi]
                 for x in (stops if target > d.lam else stops[::-1]) + [target]:
                     d.run(x, on_increment=on_increment)
-                    report()
+                    told.report(r)
         except EndOfStroke as err:  # a listener ended the load path here (the neck)
             d.progress.note(f"shellform: {err}")
-            report()
+            told.report(r)
         except (ConvergenceFailure, Interrupted) as err:
             r.stopped = str(err)
             if isinstance(err, Interrupted):
                 signum = err.signal
                 r.stopped = f"{err} at load factor {d.lam:.6g}"
             d.progress.note(f"shellform: stopped: {r.stopped}")
-            report()  # the last converged state, which the driver restored
+            told.report(r)  # the last converged state, which the driver restored
     except DiskFull as err:  # after the increment under way; nothing more is written but the summary
         full = err
         stop_for_full_disk(err, f"at load factor {d.lam:.6g}")

@@ -91,3 +91,10 @@ class Listeners(list):
         """Call `event` (a Listener method's name) of every listener with the run."""
         for listener in self:
             getattr(listener, event)(run)
+
+    def report(self, run: Run) -> None:
+        """A report: every listener records (on_report), then writes inside the room the driver
+        keeps for the report (save_report: rank 0's writes after the collective ones)."""
+        self.announce("on_report", run)
+        with run.driver.room.write("the report"):
+            self.announce("save_report", run)
