@@ -38,8 +38,9 @@ reach 0 within a step; near a neck it is a few hundred MPa or less (Considere's 
 The watch is told the sheet's state after every converged increment by the listener `Necking`,
 one for both routes (a tool scene's run, contact/run.py with results/drawing.py; a sheet scene's,
 nonlinear/run.py with results/sheet.py; the driver knows nothing of it), which reads the
-problem's public measurements (cell_fields, membrane_stability, cell_centres). It records the onset once: the load measure (the stroke of a
-tool scene, the load factor of a sheet scene) interpolated linearly between the last increment
+problem's public measurements (cell_fields, membrane_stability, cell_centres). It records the
+onset once: the load measure (the stroke of a tool scene, the load factor of a sheet scene,
+both the driver's load factor times a unit) interpolated linearly between the last increment
 whose least stability is positive and the first whose is not (the least over all cells of
 every rank at each: where the weakest cell changes between them, a lower bound of the onset),
 the initial x, y of the cell weakest at that first increment, and its thickness strain
