@@ -43,7 +43,7 @@ def test_least_squares_on_the_eight_classic_data_is_the_exact_fit():
     """Eight data for eight alphas: no misfit to share, so the least-squares alphas are those of
     yld2000.fit (which solves the eight equations) to 1e-8, and every error vanishes."""
     exact = yld2000.fit(AA2090_DATA, 8.0)
-    fit = yld2000_fit.fit(lists_of(AA2090_DATA), 8.0)
+    fit = yld2000.least_squares(lists_of(AA2090_DATA), 8.0)
     np.testing.assert_allclose(fit.alpha, exact, atol=1e-8)
     assert max(abs(r["error"]) for r in fit.rows) < 1e-8
 
@@ -53,11 +53,11 @@ def test_data_of_a_known_set_at_7_angles_are_fitted_back(with_r_b):
     """r and sigma/sigma0 of the AA2090-T3 alphas at 0, 15, ..., 90 degrees, sigma_b (and r_b):
     15 or 16 data the set meets exactly, fitted back to 1e-6. The fit normalises sigma_bar to
     the rolling direction's yield stress, so the set comes back scaled by its sigma0 (0.99996)."""
-    sigma, r, sigma_b, r_b = yld2000_fit.predicted(AA2090, 8.0, ANGLES)
+    sigma, r, sigma_b, r_b = yld2000.predicted(AA2090, 8.0, ANGLES)
     values = {"fit_angles": ANGLES, "fit_r": list(r), "fit_sigma": list(250.0 * sigma), "sigma_b": 250.0 * sigma_b}
     if with_r_b:
         values["r_b"] = r_b
-    fit = yld2000_fit.fit(values, 8.0)
+    fit = yld2000.least_squares(values, 8.0)
     np.testing.assert_allclose(fit.alpha, sigma[0] * np.array(AA2090), atol=1e-6)
     assert max(abs(row["error"]) for row in fit.rows) < 1e-8
     assert len(fit.rows) == 2 * 7 + 1 + with_r_b
@@ -93,7 +93,7 @@ def test_our_yld2000_gives_polyns_table_for_the_siegen_alphas():
     (CM_Data/AA6016_Parameters/AA6016T4_Yld2000_Siegen_deg8_Err_and_Coeff.txt, 4 digits): sigma
     and r at 0, 15, ..., 90 degrees, sigma_b, and PolyN's generalised biaxial r = -r_b/(1 + r_b)."""
     siegen = [0.9238, 0.9967, 0.9365, 1.0227, 1.0303, 1.0075, 0.8385, 1.3761]
-    sigma, r, sigma_b, r_b = yld2000_fit.predicted(siegen, 8.0, ANGLES)
+    sigma, r, sigma_b, r_b = yld2000.predicted(siegen, 8.0, ANGLES)
     np.testing.assert_allclose(sigma, [1.0000, 0.9800, 0.9336, 0.9080, 0.9264, 0.9662, 0.9831], atol=6e-5)
     np.testing.assert_allclose(r, [0.5261, 0.3643, 0.2521, 0.2530, 0.2791, 0.4215, 0.6013], atol=6e-5)
     assert sigma_b == pytest.approx(0.9910, abs=6e-5)

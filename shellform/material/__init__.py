@@ -142,10 +142,10 @@ class SheetMaterial:
         else:
             words.append(", ".join(f"{k} {v}" for k, v in self.yield_parameters.items()))
             if self.yield_function == "yld2000":
-                from shellform.material import yld2000_fit
+                from shellform.material import yld2000, yld2000_fit
 
                 if yld2000_fit.given(self.yield_parameters):
-                    words.append(yld2000_fit.fit(self.yield_parameters, self.yield_parameters["a"]).text)
+                    words.append(yld2000.least_squares(self.yield_parameters, self.yield_parameters["a"]).text)
             words.append(f"rolling direction {float(self.rolling_direction):g} deg from x")
         words.append(f"hardening {self.hardening}")
         if self.hardening == "table":

@@ -32,8 +32,9 @@ degree 1 and convexity kept, smooth where rho = 0). a >= 2 is required so that t
 stays finite where a u_i vanishes.
 
 The alphas are given, fitted exactly to eight data (``fit``), or fitted by least squares to r
-values and yield stresses at any angles (shellform.material.yld2000_fit, which states r(theta)
-and sigma(theta) of a plane-stress yield function).
+values and yield stresses at any angles (``least_squares``: shellform.material.yld2000_fit, which
+states r(theta) and sigma(theta) of a plane-stress yield function and is told this criterion's
+``predicted``; it imports nothing of this module, which imports it).
 
 Parameters (packed at PAR_): the rows of L' and L'' (2 x 2 normal block and the shear entry
 each) and a. ``parameters`` refuses (naming material.alpha) a set whose sigma_bar vanishes for
@@ -83,7 +84,7 @@ def directions(n=1000) -> np.ndarray:
 
 def parameters(values: dict) -> list[float]:
     """The packed L', L'' and a from alpha (8 numbers), or from the data FIT_DATA (``fit``), or
-    from the lists FIT_LISTS with sigma_b, r_b (``yld2000_fit.fit``, least squares), and a
+    from the lists FIT_LISTS with sigma_b, r_b (``least_squares``), and a
     (>= 2); InputError names the field."""
     require("a" in values, "material.a", "is required by yield_function = 'yld2000' (its exponent: 6 for bcc, "
                                          "8 for fcc metals)")
@@ -96,7 +97,7 @@ def parameters(values: dict) -> list[float]:
                 f"to fit them exactly, or {', '.join(FIT_LISTS)} with sigma_b (and r_b) to fit them by least "
                 "squares)")
         if yld2000_fit.given(values):
-            alpha = list(yld2000_fit.fit(values, a).alpha)
+            alpha = list(least_squares(values, a).alpha)
         else:
             alpha = fit(values, a)
     else:
@@ -213,6 +214,18 @@ def uniaxial_and_biaxial(alpha, a) -> dict:
     out["sigma_b"], out["r_b"] = 1.0 / sb, a1 / a0
     return out
 
+
+def predicted(alpha, a: float, angles) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """sigma(theta)/sigma_bar and r(theta) at the angles, sigma_b/sigma_bar and r_b, of the set."""
+    out = np.array([uniaxial(alpha, a, t) for t in angles]).reshape(-1, 2)
+    b = uniaxial_and_biaxial(alpha, a)
+    return out[:, 0], out[:, 1], b["sigma_b"], b["r_b"]
+
+
+def least_squares(values: dict, a: float) -> yld2000_fit.Fit:
+    """alpha1..alpha8 by least squares to the material's fit_angles, fit_r, fit_sigma, sigma_b
+    (and r_b), and the table of their errors: yld2000_fit.fit told this criterion's predictions."""
+    return yld2000_fit.fit(values, a, predicted)
 
 
 def fit(data: dict, a: float) -> list[float]:

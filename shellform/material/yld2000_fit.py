@@ -17,7 +17,8 @@ s^2 g0 + c^2 g1 - s c g2 and -(g0 + g1), so the Lankford value is
 
 **Balanced-biaxial tension** u = (1, 1, 0): sigma_b = sigma_bar / sigma_bar(1, 1, 0) and
 r_b = dep22/dep11 = g1/g0 (1 for an isotropic sheet). ``yld2000.uniaxial`` and
-``yld2000.uniaxial_and_biaxial`` evaluate these forms.
+``yld2000.uniaxial_and_biaxial`` evaluate these forms, ``yld2000.predicted`` at the data's
+angles.
 
 **The fit.** The data are r_i and sigma_i at the angles theta_i of ``fit_angles`` (0 among
 them), sigma_b and optionally r_b. The stresses count as ratios q_i = sigma_i/sigma(0),
@@ -39,6 +40,11 @@ angles 0, 45, 90 and r_b these are the eight of ``yld2000.fit`` and the fit is t
 
 ``data`` validates the keys (InputError naming the field), ``fit`` returns a ``Fit``: the alphas
 and the table of measured, fitted and error per datum (``Fit.rows``).
+
+**The design.** The fit lies below the criterion: it imports nothing of it, and is told the
+criterion's predictions (``fit(values, a, predicted)``). The criterion's parameters complete
+alpha from the lists with it (``yld2000.least_squares``), so the dependency runs one way,
+yld2000 -> yld2000_fit.
 """
 
 from dataclasses import dataclass
@@ -148,17 +154,9 @@ def data(values: dict) -> Data:
     return d
 
 
-def predicted(alpha, a: float, angles) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """sigma(theta)/sigma_bar and r(theta) at the angles, sigma_b/sigma_bar and r_b, of the set."""
-    from shellform.material import yld2000
-
-    out = np.array([yld2000.uniaxial(alpha, a, t) for t in angles]).reshape(-1, 2)
-    b = yld2000.uniaxial_and_biaxial(alpha, a)
-    return out[:, 0], out[:, 1], b["sigma_b"], b["r_b"]
-
-
-def residuals(alpha, a: float, d: Data) -> np.ndarray:
-    """e_0, the ratios' and r values' errors per angle, e_b and e_rb (module docstring)."""
+def residuals(alpha, a: float, d: Data, predicted) -> np.ndarray:
+    """e_0, the ratios' and r values' errors per angle, e_b and e_rb (module docstring), of the
+    criterion's predictions (``fit``)."""
     sigma, r, sigma_b, r_b = predicted(alpha, a, d.angles)
     s0 = sigma[d.angles.index(0.0)]
     e = [s0 - 1.0, *(sigma / s0 - d.q), *(r - d.r), sigma_b / s0 - d.q_b]
@@ -168,19 +166,21 @@ def residuals(alpha, a: float, d: Data) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=32)
-def _solve(d: Data, a: float) -> tuple[tuple[float, ...], int]:
+def _solve(d: Data, a: float, predicted) -> tuple[tuple[float, ...], int]:
     from scipy.optimize import least_squares
 
-    sol = least_squares(lambda x: residuals(x, a, d), np.ones(ALPHAS), xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    sol = least_squares(lambda x: residuals(x, a, d, predicted), np.ones(ALPHAS), xtol=1e-15, ftol=1e-15, gtol=1e-15)
     return tuple(float(x) for x in sol.x), int(sol.status)
 
 
-def fit(values: dict, a: float) -> Fit:
+def fit(values: dict, a: float, predicted) -> Fit:
     """alpha1..alpha8 of Yld2000-2d (exponent a) by least squares to the material's fit_angles,
     fit_r, fit_sigma, sigma_b (and r_b), with the table of their errors; InputError naming the
-    field where the data are malformed or the fit does not converge."""
+    field where the data are malformed or the fit does not converge. predicted(alpha, a, angles):
+    the criterion's sigma(theta)/sigma_bar and r(theta) at the angles, sigma_b/sigma_bar and r_b
+    (yld2000.predicted; yld2000.least_squares passes it)."""
     d = data(values)
-    alpha, status = _solve(d, float(a))
+    alpha, status = _solve(d, float(a), predicted)
     require(status > 0 and all(math.isfinite(x) for x in alpha), "material.fit_angles",
             f"the least-squares fit of Yld2000-2d (a = {a:g}) to these data did not converge (status {status})")
     sigma, r, sigma_b, r_b = predicted(alpha, a, d.angles)

@@ -31,6 +31,7 @@ from shellform.nonlinear import checkpoint
 from shellform.nonlinear.interrupt import Interrupted, StopRequests
 from shellform.nonlinear.newton import Controls, Newton  # noqa: F401 (the driver's controls)
 from shellform.results.disk import Room
+from shellform.results.listeners import Record
 from shellform.results.log import Progress
 from shellform.results.tables import write_json
 
@@ -81,9 +82,9 @@ class Driver(Newton):
         self.progress = Progress()  # a run sets its own (label, total, unit)
         self.stops = StopRequests(model.mesh.comm)  # Ctrl-C and SIGTERM while it steps (interrupt.py)
         self.fingerprint = {}  # what defines the run, written into its checkpoints (set by a run)
-        # what a run records along the way and a resume continues (a strain path, a watch): each
-        # owns its state, checkpoint() -> groups and restore(state), kept with the driver's
-        self.records = []
+        # what a run records along the way and a resume continues (a strain path, a watch, the
+        # sensitivities): each a Record (results/listeners.py), its state kept with the driver's
+        self.records: list[Record] = []
         self._numbering = None  # the checkpoints' global numbers of nodes and cells (numbering())
         self.q_n = self.q.x.array.copy()  # the carrier of the last converged increment
         self.lam = 0.0
@@ -124,11 +125,10 @@ class Driver(Newton):
                 f"|dlambda|/|dq| fell to {k[-1] / k[0]:.2g} times the first increment's")
 
     def _commit(self, lam) -> None:
-        """Accept the increment's state (the sheet's and every part's); a record with a
-        `converged(driver, lam)` sees the converged state first, before it is committed."""
+        """Accept the increment's state (the sheet's and every part's); every record sees the
+        converged state first (Record.converged), before it is committed."""
         for record in self.records:
-            if hasattr(record, "converged"):
-                record.converged(self, lam)
+            record.converged(self, lam)
         self.model.commit()
         for part in self.parts:
             part.commit(lam)

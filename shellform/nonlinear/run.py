@@ -131,7 +131,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, scene_path=None, listeners=
         "dofs": p.model.V.dofmap.index_map.size_global * 9, "reports": own.reports.rows,
         "increments": len(d.history), "newton_iterations": sum(h.iterations for h in d.history),
         "cutbacks": sum(h.cutbacks for h in d.history), "stopped": r.stopped, "signal": signum,
-        "neck": own.necking.watch.onset if own.necking is not None else None,
+        "neck": own.necking.onset if own.necking is not None else None,
         **(own.sensitivities.summary(r) if own.sensitivities is not None else {}),
         "wall_time_s": time.perf_counter() - t0, "setup_s": setup_s, **d.times,
     }, outdir)

@@ -30,7 +30,7 @@ between p - eps and p + eps, the central difference is the mean of the one-sided
 such layers are counted per increment (`switches`), so that a jump in a sensitivity can be
 traced to the increments where the plastic zone moved across a quadrature point.
 
-The sensitivity is a record of the driver (driver.records): `converged` runs with each
+The sensitivity is a Record of the driver (driver.records): `converged` runs with each
 converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through
 a resume. It sees the sheet and its supports only; the tools' parts (contact, friction, the
 holder) have no derivatives of their own yet, and a driver with parts is refused.
@@ -43,6 +43,7 @@ from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
 from shellform.errors import InputError
+from shellform.results.listeners import Record
 
 STEP = 1e-5  # the central differences' step, relative to the parameter
 KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
@@ -110,9 +111,10 @@ def scene_parameters(scene) -> list[Parameter]:
     return out
 
 
-class Sensitivity:
+class Sensitivity(Record):
     """d/dp of the carrier, the material state and the residual along the path, for each
-    parameter (module docstring). A record of `driver`: add it with driver.records.append."""
+    parameter (module docstring). A record of `driver` (results/listeners.py Record): add it
+    with driver.records.append."""
 
     def __init__(self, driver, parameters):
         if driver.parts:

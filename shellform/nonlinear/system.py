@@ -14,15 +14,14 @@ force on its node's normal row). A support's row on a turned node is the frame's
 F_k . d, which the frames keep on +-e_k (a symmetry plane keeps its meaning with the sign of
 the frame): its correction is F_kk (g_k - q_k).
 
-The element loops run once per iterate and their arrays are kept: an iterate at the same q
-and material state (a pass's first, after the set changed) turns the kept arrays from their
-frames into today's (T = F F0^T), and a trial leaves its tangent for later: the element
-tangents, K's assembly and the parts' stiffness are computed only when a solve needs them.
-The solve factorises the free rows alone where that pays (free_rows.py).
+The element loops run once per iterate and their arrays are kept (element_arrays.py: an
+iterate at the same q and material state, a pass's first after the set changed, turns the kept
+arrays from their frames into today's, T = F F0^T), and a trial leaves its tangent for later:
+the element tangents, K's assembly and the parts' stiffness are computed only when a solve
+needs them. The solve factorises the free rows alone where that pays (free_rows.py).
 """
 
 import time
-from dataclasses import replace
 
 import dolfinx.fem.petsc as fem_petsc
 import numpy as np
@@ -31,7 +30,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from shellform.assembly.sheet_element import BS
-from shellform.nonlinear.frames import from_frames, rotate_cell_arrays
+from shellform.nonlinear.element_arrays import ElementArrays
+from shellform.nonlinear.frames import from_frames
 from shellform.nonlinear.free_rows import FreeRowsLU, lu_solver
 from shellform.nonlinear.parts import Constraints
 
@@ -60,7 +60,7 @@ class System:
         self.rotated = np.zeros(self.n_local, dtype=bool)
         self._shared = [fem.Function(V) for _ in range(3)]  # frames (9 values = 3 x 3), known, flags
         self._known = np.zeros_like(self.g)
-        self._array_frames = (self.rotated.copy(), self.frames.copy())
+        self.arrays = ElementArrays(model, self.edge_frames, bool(self.parts), self.rotated, self.frames)
         self.times = {"element_s": 0.0, "constitutive_s": 0.0, "assembly_s": 0.0, "solve_s": 0.0, "parts_s": 0.0}
         self.f_ext = fem_petsc.create_vector(V)  # external load at lambda = 1: dead pressure
         self.f_ext.set(0.0)
@@ -76,10 +76,7 @@ class System:
                                   imap.local_range[0] * V.dofmap.index_map_bs)
         self._stable_rows = self._known_rows_of(self.support_dofs)  # the known rows that stay known
         self._floor = 0.0
-        self._memo = None  # the last evaluation (_evaluate)
         self._later = None  # (lam, elastic_tangent) of a trial whose tangent is not assembled yet (trial)
-        self.evaluations = self.reused = 0  # of the element loops: run, and reused (a pass's first)
-        self.tangents = 0  # element tangents computed (at most one per evaluation)
         self.solves = 0  # linear solves: Newton iterations, those of failed attempts included
         self.residual_full = np.zeros(self.n_owned * BS)
 
@@ -161,25 +158,15 @@ class System:
     def residual(self, lam, tangent: bool, elastic_tangent: bool = False):
         """Assemble R (into self.b, Dirichlet rows zero) and optionally K; return (|R_free| with
         the parts' own equations, scale, ev)."""
-        m = self.model
         self._later = None
         self.q.x.scatter_forward()
-        ev = self._evaluate(tangent, elastic_tangent)
+        ev = self.arrays.evaluate(self.q, tangent, elastic_tangent, self.rotated, self.frames)
         t0 = time.perf_counter()
-        with self.b.localForm() as bl:
-            bl.set(0.0)
-        fem_petsc.assemble_vector(self.b, m.forms.vector, constants=m.forms.constants, coeffs=m.forms.vector_coeffs)
-        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        # scale of the residual: the element forces before they cancel in the sum (round-off)
-        f_int = np.sqrt(m.mesh.comm.allreduce(float(np.sum(m.forms.vectors**2)), op=MPI.SUM))
+        f_int = self.arrays.assemble_vector(self.b)  # the residual's scale: the element forces' norm
         self.b.axpy(-lam, self.f_ext)
         R = self.b.getArray(readonly=False)
         if tangent:
-            self.A.zeroEntries()
-            fem_petsc.assemble_matrix(self.A, m.forms.matrix, bcs=self.bcs, constants=m.forms.constants,
-                                      coeffs=m.forms.matrix_coeffs)
-            self.A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
-            self.A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+            self.arrays.assemble_matrix(self.A, self.bcs)
         if self.nodal is not None:
             self.nodal.add(lam, self.q.x.array, R, self.A if tangent else None)
         for part in self.parts:
@@ -197,46 +184,14 @@ class System:
         self.times["element_s"] += ev.element_s
         self.times["constitutive_s"] += ev.constitutive_s
         self.times["assembly_s"] += time.perf_counter() - t0
-        if tangent:  # the residual's round-off floor: eps times stiffness times a cell size
-            kmax = float(np.abs(np.einsum("cii->ci", m.forms.matrices)).max()) if m.num_cells else 0.0
-            self._floor = 1e3 * np.finfo(float).eps * m.mesh.comm.allreduce(kmax, op=MPI.MAX) * m.cell_size
+        if tangent:
+            self._floor = self.arrays.round_off_floor()
         ext = max([abs(lam) * self.f_ext.norm()] + [abs(lam) * p.magnitude for p in self.parts]
                   + ([abs(lam) * self.nodal.magnitude] if self.nodal is not None else []))
         norm = self.b.norm()
         for part in self.parts:
             norm = float(np.hypot(norm, part.imbalance()))
         return norm, max(f_int, ext, self._floor / self.controls.rtol), ev
-
-    def _evaluate(self, tangent: bool, elastic_tangent: bool):
-        """The element loops at q, turned into the solve's frames; or the last evaluation's
-        arrays, turned from its frames into today's, where q, the committed material state and
-        the tangent asked for are those of the last evaluation (a pass starts where the one
-        before ended: only its set and frames changed). Returns the Evaluation."""
-        m, memo, q = self.model, self._memo, self.q.x.array
-        same = (memo is not None and memo["version"] == m.state_version and np.array_equal(memo["q"], q)
-                and (not tangent or memo["elastic"] == elastic_tangent))
-        if same and (memo["tangent"] or not tangent):
-            self._reframe_element_arrays(memo["tangent"])
-            self.reused += 1
-            return replace(memo["ev"], element_s=0.0, constitutive_s=0.0)
-        if same:  # the state's tangent, left for later (trial): the element tangents alone
-            t0 = time.perf_counter()
-            m.tensor_arrays(tangent=True)
-            seconds = time.perf_counter() - t0
-            self.tangents += 1
-            self._element_arrays(True)
-            memo["tangent"] = True
-            return replace(memo["ev"], element_s=seconds, constitutive_s=0.0)
-        ev = m.evaluate(self.q, tangent=tangent, elastic_tangent=elastic_tangent)
-        self.tangents += tangent
-        if m.mesh.comm.size > 1:  # every rank takes the same branch on a failed update: global counts
-            counts = m.mesh.comm.allreduce(np.array([ev.plastic_layers, ev.failures, ev.guard]), op=MPI.SUM)
-            ev = replace(ev, plastic_layers=int(counts[0]), failures=int(counts[1]), guard=int(counts[2]))
-        self.evaluations += 1
-        self._element_arrays(tangent)
-        self._memo = {"version": m.state_version, "tangent": tangent, "elastic": elastic_tangent, "q": q.copy(),
-                      "ev": ev}
-        return ev
 
     def trial(self, lam, elastic_tangent: bool = False):
         """residual(lam, tangent=True) for Newton's iterates and line-search trials, the tangent
@@ -254,7 +209,12 @@ class System:
 
     def forget_evaluation(self) -> None:
         """The next residual runs the element loops afresh (no kept arrays)."""
-        self._memo = None
+        self.arrays.forget()
+
+    # the element loops run, their arrays reused (a pass's first), the element tangents computed
+    evaluations = property(lambda self: self.arrays.evaluations)
+    reused = property(lambda self: self.arrays.reused)
+    tangents = property(lambda self: self.arrays.tangents)
 
     def linearize(self, lam, tangent: bool = True) -> float:
         """R (and K) at the current q as Newton's iterates after a pass's first see them: the
@@ -271,29 +231,6 @@ class System:
             lam, elastic = self._later
             self._later = None
             self.residual(lam, tangent=True, elastic_tangent=elastic)
-
-    def _element_arrays(self, tangent: bool) -> None:
-        """Between the element loop and assembly: the arrays into the edge frames and the nodal
-        frames."""
-        m = self.model
-        if self.edge_frames is not None:
-            self.edge_frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, tangent)
-        if self.parts:
-            rotate_cell_arrays(m.dofs, self.rotated, self.frames, m.forms.vectors, m.forms.matrices, tangent)
-            self._array_frames = (self.rotated.copy(), self.frames.copy())
-
-    def _reframe_element_arrays(self, tangent: bool) -> None:
-        """The kept arrays from the frames F0 they were turned into to the current F: T = F F0^T
-        on every block turned in either (F0 = I on a block that was not turned; orthogonal, so
-        exact to round-off). The edge frames never change."""
-        if not self.parts:
-            return
-        m = self.model
-        rotated0, F0 = self._array_frames
-        turn = rotated0 | self.rotated
-        G = np.einsum("nij,nkj->nik", self.frames, F0)
-        rotate_cell_arrays(m.dofs, turn, G, m.forms.vectors, m.forms.matrices, tangent)
-        self._array_frames = (self.rotated.copy(), self.frames.copy())
 
     def free_tangent(self, lam: float):
         """The tangent at the current q on its free rows, K_ff (scipy CSR), and those rows (the
@@ -315,31 +252,12 @@ class System:
         """K v on the owned rows with the element tangents as they are (no Dirichlet rows; v a
         local array with ghosts): the change of the residual, reactions included, along v."""
         self.assemble_tangent()
-        m = self.model
-        self._memo = None  # the element vectors are overwritten here
-        m.forms.vectors[:] = np.einsum("cij,cj->ci", m.forms.matrices, v[m.unrolled_dofs])
-        Kv = fem_petsc.assemble_vector(m.forms.vector, constants=m.forms.constants, coeffs=m.forms.vector_coeffs)
-        Kv.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        out = Kv.getArray(readonly=True).copy()
-        Kv.destroy()
-        return out
+        return self.arrays.apply(v)
 
     def assembled(self, vectors: np.ndarray) -> np.ndarray:
         """Element vectors in x, y, z (cells, NDOF: SheetModel.respond's) turned into the solve's
         frames and assembled: the owned rows (the model's own arrays as they were)."""
-        m = self.model
-        kept = m.forms.vectors.copy()
-        m.forms.vectors[:] = vectors
-        if self.edge_frames is not None:
-            self.edge_frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, False)
-        if self.parts:
-            rotate_cell_arrays(m.dofs, self.rotated, self.frames, m.forms.vectors, m.forms.matrices, False)
-        vec = fem_petsc.assemble_vector(m.forms.vector, constants=m.forms.constants, coeffs=m.forms.vector_coeffs)
-        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        out = vec.getArray(readonly=True).copy()
-        vec.destroy()
-        m.forms.vectors[:] = kept
-        return out
+        return self.arrays.assembled(vectors, self.rotated, self.frames)
 
     def energy_slope(self, dq_xyz: np.ndarray) -> float:
         """dq . R over all ranks, R (free rows, nodal frames) turned back to x, y, z, with the

@@ -7,7 +7,7 @@ Each owns its state and its file, and is told of the run's events by shellform.c
 | `DrawnCup` | | | | thickness_*.csv, thickness.png, rim.csv/.png (a kind with a rim), cup.png | "rim" |
 | `ForceStroke` | a row: forces, the holder, the checks, iterations, contacts | | force_stroke.csv | force_stroke.png | "over_the_stroke" |
 | `FormingLimits` | the strain path's record; the watch (may end the stroke) | the path's record | | fld.csv, fld.png, cup_margin.png, strain_path.csv | forming_limit, min_margin..., strain_path, forming_limit_reached |
-| `Necking` | the watch (may bound the next step, end the stroke) | | | | "neck" |
+| `neck.Necking` | the watch (may bound the next step, end the stroke; results/neck.py, the sheet route's too) | | | | "neck" |
 | `Series` | | cup.bp, cup_cells.bp, cup.pvd and the tools' | | (closed at the stop) | |
 | `Reports` | | the state: stroke, draw-in, punch force, thinning, volume change; reports.json | | | draw_in_mm, punch_force_kN, the last report's values, "reports" |
 
@@ -178,46 +178,6 @@ class FormingLimits(Listener):
         self.found = found
 
 
-def previous_neck(outdir: Path) -> dict | None:
-    """The neck that the resumed run's summary.json reports (None without one or without it)."""
-    try:
-        return json.loads((outdir / "summary.json").read_text()).get("neck")
-    except (OSError, ValueError, AttributeError):
-        return None
-
-
-class Necking(Listener):
-    """Where the sheet starts to neck (results/neck.py); with `stop` ([process] stop_at_neck)
-    the steps shorten ahead of it and the stroke ends there (neck.NeckReached), without it the
-    onset is noted and the run goes on. A resumed run keeps the onset the run before it found."""
-
-    def __init__(self, comm, stop: bool, stroke_mm: float, r: float = 1.0):
-        self.watch, self.stop, self.stroke_mm = neck.NeckWatch(comm, r=r), stop, stroke_mm
-        self.centres = None
-
-    @property
-    def onset(self) -> dict | None:
-        return self.watch.onset
-
-    def on_start(self, run: Run) -> None:
-        self.centres = run.sheet.cell_centres()
-        if run.resumed is not None:
-            self.watch.carry(previous_neck(run.outdir), run.sheet.stroke)
-
-    def on_increment(self, run: Run) -> None:
-        p, d = run.sheet, run.driver
-        before = self.watch.onset
-        f = p.cell_fields()
-        necked = self.watch.reached(p.stroke, p.membrane_stability(), f["thickness_strain"], self.centres,
-                                    f["major_strain"])
-        if necked and before is None and not self.stop:
-            d.progress.note(f"shellform: the sheet starts to neck: {neck.words(self.watch.onset)}")
-        if self.stop and d.next_step is not None:  # shorter steps ahead of the run's end
-            d.bound_next_step(self.watch.ahead(d.next_step * self.stroke_mm) / self.stroke_mm)  # mm per load factor
-        if necked and self.stop:
-            run.end_with(neck.NeckReached(f"the stroke ends: {neck.words(self.watch.onset)}"))
-
-
 class Series(Listener):
     """The cup's series at the reports (cup.CupSeries: VTX and VTU), opened at the start,
     closed where the stepping stops."""
@@ -261,7 +221,7 @@ class CupListeners:
     drawn: DrawnCup
     table: ForceStroke
     limits: FormingLimits | None
-    necking: Necking | None
+    necking: neck.Necking | None
     series: Series | None
     reports: Reports
     extra: tuple = ()
@@ -275,7 +235,7 @@ class CupListeners:
         limits = FormingLimits(scene, comm, o.fld, pr.stop_at_forming_limit) \
             if plastic and (o.fld or pr.stop_at_forming_limit) else None
         series = Series(o.vtx, o.vtu, o.fld and plastic) if o.vtx or o.vtu else None
-        necking = Necking(comm, pr.stop_at_neck, scene.tools.stroke, scene.largest_r()) if plastic else None
+        necking = neck.Necking.stroke(comm, pr.stop_at_neck, scene.tools.stroke, scene.largest_r()) if plastic else None
         return cls(DrawnCup(o.png), ForceStroke(outdir), limits, necking, series, Reports(outdir), tuple(extra))
 
     def all(self) -> Listeners:

@@ -26,7 +26,7 @@ import numpy as np
 from mpi4py import MPI
 
 from shellform.errors import InputError
-from shellform.results.listeners import EndOfStroke
+from shellform.results.listeners import EndOfStroke, Record
 from shellform.results.tables import write_figure
 
 FIELD = "material.forming_limit_curve"
@@ -157,12 +157,13 @@ class FormingLimitReached(EndOfStroke):
 LIMIT_KEYS = ("stroke_mm", "increment_stroke_mm", "margin")  # FormingLimitWatch.limit
 
 
-class FormingLimitWatch:
+class FormingLimitWatch(Record):
     """Where a stroke reaches the forming-limit curve: after each increment the smallest margin
     over the elements (every rank's); `reached` once it is <= 0. The stroke at which it is 0 is
     interpolated linearly in the stroke between the last increment with a positive margin and
     the first without (the margin of the element that is worst at each: a lower bound of the
-    limit's stroke where the worst element changes between them)."""
+    limit's stroke where the worst element changes between them). A record of the driver
+    (listeners.Record): its checkpoints carry the watch."""
 
     def __init__(self, curve, comm):
         self.curve, self.comm = curve, comm
@@ -197,12 +198,13 @@ class FormingLimitWatch:
         self.limit = dict(zip(LIMIT_KEYS, map(float, limit))) if limit is not None and limit.size == 3 else None
 
 
-class StrainPaths:
+class StrainPaths(Record):
     """The elements' major and minor true strains along the stroke (each rank its own elements),
     recorded where the stroke has moved by at least `spacing` since the last record and at the
     end (`final`): a bounded record, about stroke / spacing copies of two strains per element.
     `critical` gives the path of the element whose margin to the curve is smallest at the last
-    record: the strain path that ends nearest the forming limit (or past it)."""
+    record: the strain path that ends nearest the forming limit (or past it). A record of the
+    driver (listeners.Record): its checkpoints carry the path."""
 
     def __init__(self, curve, comm, spacing: float):
         self.curve, self.comm, self.spacing = curve, comm, spacing

@@ -20,6 +20,11 @@ measurements (shellform.results.cup, "the drawn sheet"), never the problem's ins
 increments through the driver's public history. What it adds to summary.json the run asks of
 it by name. A caller passes its own listeners (shellform.run.run(..., listeners=[...])): they
 are told after the run's own, in the same order of events.
+
+What a run records along the way and a resume continues (the strain path, the forming-limit
+watch, the sensitivities) is a `Record` of the driver instead: the driver tells it of each
+converged increment before committing it and keeps its state in its checkpoints, so that a
+resume restores it with the sheet's.
 """
 
 from dataclasses import dataclass, field
@@ -82,6 +87,25 @@ class Listener:
 
     def on_end(self, run: Run) -> None:
         """The drawn cup, where the disk has room: its tables and pictures."""
+
+
+class Record:
+    """What a run records along the way and a resume continues (a strain path, a watch, the
+    sensitivities): kept with the driver's state (driver.records), in its checkpoints. The
+    driver tells each record, in list order, of a converged increment before committing it
+    (`converged`: the converged state, the committed one still at hand), writes its state into
+    every checkpoint (`checkpoint`) and reads it back on a resume (`restore`). Every method
+    defaults to doing nothing, as a Part's does (shellform.nonlinear.parts)."""
+
+    def converged(self, driver, lam: float) -> None:
+        """The increment to lam converged and is not committed yet (driver: its public state)."""
+
+    def checkpoint(self) -> dict:
+        """{"nodes": {...}, "cells": {...}, "global": {...}}: what a resume continues from."""
+        return {}
+
+    def restore(self, state: dict) -> None:
+        """Read back checkpoint() (this rank's groups)."""
 
 
 class Listeners(list):

@@ -35,9 +35,12 @@ to 8,000 in its first plastic one), which a straight line through two increments
 reach 0 within a step; near a neck it is a few hundred MPa or less (Considere's d sigma / d eps
 - sigma, against E).
 
-The watch is told the sheet's state after every converged increment (a tool scene's Necking
-listener, results/drawing.py; a sheet scene's on_increment; the driver knows nothing of it). It records the onset once: the load measure (the stroke of a
-tool scene, the load factor of a sheet scene) interpolated linearly between the last increment
+The watch is told the sheet's state after every converged increment by the listener `Necking`,
+one for both routes (a tool scene's run, contact/run.py with results/drawing.py; a sheet scene's,
+nonlinear/run.py with results/sheet.py; the driver knows nothing of it), which reads the
+problem's public measurements (cell_fields, membrane_stability, cell_centres). It records the
+onset once: the load measure (the stroke of a tool scene, the load factor of a sheet scene,
+both the driver's load factor times a unit) interpolated linearly between the last increment
 whose least stability is positive and the first whose is not (the least over all cells of
 every rank at each: where the weakest cell changes between them, a lower bound of the onset),
 the initial x, y of the cell weakest at that first increment, and its thickness strain
@@ -46,9 +49,12 @@ interpolated to the onset the same way. `reached` stays True from then on; a run
 reports it (summary.json "neck", null without a neck).
 """
 
+import json
+from pathlib import Path
+
 import numpy as np
 
-from shellform.results.listeners import EndOfStroke
+from shellform.results.listeners import EndOfStroke, Listener, Run
 
 PLASTIC = 0.01  # of the first increment's least stability: below it, its fall is extrapolated to a neck
 STRETCHED = 0.9  # of uniaxial tension's thinning share 1 / (1 + r): the least a watched cell's path thins
@@ -141,3 +147,63 @@ def words(onset: dict, at: str = "stroke_mm", place: str = "initial_xy_mm") -> s
     x, y = onset[place]
     where = f"stroke {onset[at]:.4g} mm" if at == "stroke_mm" else f"{at.replace('_', ' ')} {onset[at]:.4g}"
     return f"diffuse neck from {where} at initial ({x:.4g}, {y:.4g}), thickness strain {onset['thickness_strain']:.4f}"
+
+
+def previous_neck(outdir: Path) -> dict | None:
+    """The neck that the resumed run's summary.json reports (None without one or without it)."""
+    try:
+        return json.loads((outdir / "summary.json").read_text()).get("neck")
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
+class Necking(Listener):
+    """Where the sheet starts to neck (NeckWatch), a listener of either route's run; with `stop`
+    ([process] stop_at_neck) the steps shorten ahead of the onset and the run ends there
+    (NeckReached), without it the onset is noted and the run goes on. A resumed run keeps the
+    onset the run before it found (summary.json "neck").
+
+    The load measure is the driver's load factor times `unit`: a tool scene's stroke in mm
+    (`stroke`: unit the scene's stroke), a sheet scene's load factor (`load_factor`: unit 1);
+    the watch's steps are bounded in it, the driver's in load factor (the bound divided by
+    unit). The sheet is read through the problem's public measurements (cell_fields,
+    membrane_stability, cell_centres), which DrawingProblem and SheetProblem both publish."""
+
+    def __init__(self, watch: NeckWatch, stop: bool, unit: float, path: str):
+        self.watch, self.stop, self.unit, self.path = watch, stop, unit, path
+        self.centres = None
+
+    @classmethod
+    def stroke(cls, comm, stop: bool, stroke_mm: float, r: float = 1.0) -> "Necking":
+        """A tool scene's: the onset at the stroke (mm), where the stroke ends."""
+        return cls(NeckWatch(comm, "stroke_mm", "initial_xy_mm", r), stop, stroke_mm, "stroke")
+
+    @classmethod
+    def load_factor(cls, comm, stop: bool, r: float = 1.0) -> "Necking":
+        """A sheet scene's: the onset at the load factor, where the load path ends."""
+        return cls(NeckWatch(comm, "load_factor", "initial_xy", r), stop, 1.0, "load path")
+
+    @property
+    def onset(self) -> dict | None:
+        return self.watch.onset
+
+    def words(self) -> str:
+        return words(self.watch.onset, self.watch.at, self.watch.place)
+
+    def on_start(self, run: Run) -> None:
+        self.centres = run.sheet.cell_centres()
+        if run.resumed is not None:
+            self.watch.carry(previous_neck(run.outdir), run.driver.lam * self.unit)
+
+    def on_increment(self, run: Run) -> None:
+        p, d = run.sheet, run.driver
+        before = self.watch.onset
+        f = p.cell_fields()
+        necked = self.watch.reached(d.lam * self.unit, p.membrane_stability(), f["thickness_strain"], self.centres,
+                                    f["major_strain"])
+        if necked and before is None and not self.stop:
+            d.progress.note(f"shellform: the sheet starts to neck: {self.words()}")
+        if self.stop and d.next_step is not None:  # shorter steps ahead of the run's end
+            d.bound_next_step(self.watch.ahead(d.next_step * self.unit) / self.unit)  # a measure per load factor
+        if necked and self.stop:
+            run.end_with(NeckReached(f"the {self.path} ends: {self.words()}"))

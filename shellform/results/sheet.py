@@ -5,7 +5,7 @@ records and writes, each part owning its state and its files.
 |---|---|---|---|---|---|
 | `SheetReports` | the probes checked | | the report: the load factor, u, v, w at the origin and the probes, the extremes, the peak strains | increments.csv, nodal.bp, cells.bp, deformed.png | reports |
 | `SheetSeries` | | | the state in sheet.pvd (`[output] vtu`) | | |
-| `SheetNecking` | | the neck watch (results/neck.py); at the neck with `stop_at_neck` the load path ends (run.end_with) and the steps shorten ahead of it | | | neck |
+| `neck.Necking` | the cells' centres | the neck watch (results/neck.py, the cup's too); at the neck with `stop_at_neck` the load path ends (run.end_with) and the steps shorten ahead of it | | | neck |
 | `SheetSensitivities` | the sensitivities, a record of the driver (nonlinear/sensitivity.py) | | each report's derivatives (results/sensitivity.py) | sensitivities.csv, tornado.png | uncertainty, sensitivity_checks |
 
 The run (shellform.nonlinear.run) tells them in that order, then a caller's own; `run.sheet` is
@@ -110,32 +110,6 @@ class SheetSeries(Listener):
         self.series.write(run.driver.lam, run.driver.q, p.model.components, p.model.cell_fields())
 
 
-class SheetNecking(Listener):
-    """Where the sheet starts to neck (results/neck.py); with `stop` ([process] stop_at_neck) the
-    steps shorten ahead of it and the load path ends there."""
-
-    def __init__(self, comm, stop: bool, r: float):
-        self.watch, self.stop, self.centres = neck.NeckWatch(comm, "load_factor", "initial_xy", r), stop, None
-
-    def on_start(self, run: Run) -> None:
-        self.centres = run.sheet.model.cell_centres()
-
-    def on_increment(self, run: Run) -> None:
-        p, d = run.sheet, run.driver
-        before = self.watch.onset
-        f = p.model.cell_fields()
-        if self.watch.reached(d.lam, p.model.membrane_stability(), f["thickness_strain"], self.centres,
-                              f["major_strain"]):
-            if self.stop:
-                run.end_with(neck.NeckReached(
-                    f"the load path ends: {neck.words(self.watch.onset, 'load_factor', 'initial_xy')}"))
-            elif before is None:
-                d.progress.note(f"shellform: the sheet starts to neck: "
-                                f"{neck.words(self.watch.onset, 'load_factor', 'initial_xy')}")
-        if self.stop and d.next_step is not None:  # shorter steps ahead of the run's end
-            d.bound_next_step(self.watch.ahead(d.next_step))
-
-
 class SheetSensitivities(Listener):
     """The answers' derivatives in `[output] sensitivities` (nonlinear/sensitivity.py), added to
     each report of `reports`."""
@@ -175,7 +149,7 @@ class SheetListeners:
     def __init__(self, s, sheet, outdir, comm, sensitivity_of=None, extra=()):
         self.reports = SheetReports()
         self.series = SheetSeries(sheet, outdir) if s.output.vtu else None
-        self.necking = SheetNecking(comm, s.process.stop_at_neck, s.largest_r()) if sheet.model.plastic else None
+        self.necking = neck.Necking.load_factor(comm, s.process.stop_at_neck, s.largest_r()) if sheet.model.plastic else None
         self.sensitivities = SheetSensitivities(sensitivity_of, self.reports) if sensitivity_of else None
         self.extra = list(extra)
 

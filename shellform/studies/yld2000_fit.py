@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from shellform import demos, scene
-from shellform.material import yld2000_fit
+from shellform.material import yld2000, yld2000_fit
 from shellform.results.log import say
 from shellform.results.tables import write_csv
 
@@ -25,7 +25,7 @@ SCENE = demos.path("esaform2021_cup.toml")
 def fit_of(path=SCENE) -> yld2000_fit.Fit:
     """The least-squares fit of a scene's [material] (its yield_parameters as the run takes them)."""
     values = scene.load(path).hill79().yield_parameters
-    return yld2000_fit.fit(values, values["a"])
+    return yld2000.least_squares(values, values["a"])
 
 
 def run(outdir, path=SCENE) -> list[dict]:
@@ -52,7 +52,7 @@ def plot(path: Path, fit: yld2000_fit.Fit) -> None:
     import matplotlib.pyplot as plt
 
     theta = np.linspace(0.0, 90.0, 91)
-    sigma, r, _, _ = yld2000_fit.predicted(fit.alpha, fit.a, theta)
+    sigma, r, _, _ = yld2000.predicted(fit.alpha, fit.a, theta)
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.6))
     for ax, quantity, curve, label in ((axes[0], "r", r, "r value"),
                                        (axes[1], "sigma/sigma0", sigma / sigma[0], "sigma / sigma0")):
