@@ -19,7 +19,7 @@ from shellform.contact.semi_inverse import ContactControls, SemiInverseDriver
 from shellform.contact.pinch_edge import edge_load
 from shellform.mesh import blank, outline
 from shellform.nonlinear.model import SheetModel
-from shellform.nonlinear.problem import scene_controls
+from shellform.nonlinear.problem import SheetFields, scene_controls
 from shellform.results import fields
 from shellform.scene import Scene
 from shellform.tools import kinds as tool_kinds
@@ -29,7 +29,7 @@ GAP_HOLDER = 2  # a holder at a gap is the third rigid tool
 
 
 @dataclass
-class DrawingProblem:
+class DrawingProblem(SheetFields):
     scene: Scene
     rect: object
     model: SheetModel
@@ -259,21 +259,9 @@ class DrawingProblem:
         """The owned cells."""
         return self.model.num_cells
 
-    def cell_fields(self) -> dict:
-        """Per owned cell: equivalent plastic strain, major and minor surface strains (SheetModel)."""
-        return self.model.cell_fields()
-
-    def cell_centres(self) -> np.ndarray:
-        """(owned cells, 2) the cells' initial centres."""
-        return self.model.cell_centres()
-
     def cell_thickness_strain(self) -> np.ndarray:
         """Per owned cell its thickness strain."""
         return self.model.thickness_strain()
-
-    def membrane_stability(self) -> np.ndarray:
-        """Per owned cell the least eigenvalue of its membrane's tangent (results/neck.py)."""
-        return self.model.membrane_stability()
 
     def volume_change(self) -> float:
         """(V - V0) / V0 of the whole sheet."""

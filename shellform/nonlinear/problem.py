@@ -46,8 +46,27 @@ def scene_controls(s) -> Controls:
                     max_iterations=pr.max_iterations, rtol=pr.rtol)
 
 
+class SheetFields:
+    """What a problem shows of its sheet per owned cell, read through to its SheetModel (`model`):
+    the measurements the listeners of either route take (results/neck.py, results/fld.py)."""
+
+    model: SheetModel
+
+    def cell_fields(self) -> dict:
+        """Per owned cell: equivalent plastic strain, thickness, major and minor strains (SheetModel)."""
+        return self.model.cell_fields()
+
+    def cell_centres(self) -> np.ndarray:
+        """(owned cells, 2) the cells' initial centres."""
+        return self.model.cell_centres()
+
+    def membrane_stability(self) -> np.ndarray:
+        """Per owned cell the least eigenvalue of its membrane's tangent (results/neck.py)."""
+        return self.model.membrane_stability()
+
+
 @dataclass
-class SheetProblem:
+class SheetProblem(SheetFields):
     rect: object
     model: SheetModel
     driver: Driver
@@ -120,18 +139,6 @@ class SheetProblem:
         """The component `name` at the vertex (x, y) of the state (of `of`, a function on the
         carrier's space where given: a sensitivity's dq/dp)."""
         return value_at(self.driver.q if of is None else of, self.model.components, name, x, y, 1e-9 * self.rect.size)
-
-    def cell_fields(self) -> dict:
-        """Per owned cell: equivalent plastic strain, thickness, major and minor strains (SheetModel)."""
-        return self.model.cell_fields()
-
-    def cell_centres(self) -> np.ndarray:
-        """(owned cells, 2) the cells' initial centres."""
-        return self.model.cell_centres()
-
-    def membrane_stability(self) -> np.ndarray:
-        """Per owned cell the least eigenvalue of its membrane's tangent (results/neck.py)."""
-        return self.model.membrane_stability()
 
     def reaction(self, side: str, comp: str, residual: np.ndarray | None = None) -> float:
         """Sum over the side of the internal force conjugate to a held component (of
