@@ -82,14 +82,20 @@ class ElementArrays:
         self.memo = None
 
     def _turn(self, tangent: bool, rotated: np.ndarray, frames: np.ndarray) -> None:
-        """Between the element loop and assembly: the arrays into the edge frames and the nodal
-        frames."""
+        """Between the element loop and assembly: the arrays into the solve's frames, which
+        the kept arrays are in from now on."""
+        self._into_frames(tangent, rotated, frames)
+        if self.nodal:
+            self.turned = (rotated.copy(), frames.copy())
+
+    def _into_frames(self, tangent: bool, rotated: np.ndarray, frames: np.ndarray) -> None:
+        """The model's element vectors (and matrices, with `tangent`) from x, y, z into the edge
+        frames and the nodal frames."""
         m = self.model
         if self.edge_frames is not None:
             self.edge_frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, tangent)
         if self.nodal:
             rotate_cell_arrays(m.dofs, rotated, frames, m.forms.vectors, m.forms.matrices, tangent)
-            self.turned = (rotated.copy(), frames.copy())
 
     def _reframe(self, tangent: bool, rotated: np.ndarray, frames: np.ndarray) -> None:
         """The kept arrays from the frames F0 they were turned into to the current F: T = F F0^T
@@ -146,10 +152,7 @@ class ElementArrays:
         m = self.model
         kept = m.forms.vectors.copy()
         m.forms.vectors[:] = vectors
-        if self.edge_frames is not None:
-            self.edge_frames.turn_cell_arrays(m.dofs, m.forms.vectors, m.forms.matrices, False)
-        if self.nodal:
-            rotate_cell_arrays(m.dofs, rotated, frames, m.forms.vectors, m.forms.matrices, False)
+        self._into_frames(False, rotated, frames)
         out = self._assemble_vectors()
         m.forms.vectors[:] = kept
         return out
