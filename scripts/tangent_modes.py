@@ -1,6 +1,6 @@
 """The tangent's softest modes at a tool run's last converged state.
 
-    python scripts/tangent_modes.py SCENE OUT [--set key=value ...] [-k K]
+    python scripts/tangent_modes.py SCENE OUT [--set key=value ...] [-k K] [--shift S] [--unsymmetric]
 
 OUT: a `shellform run` folder with its checkpoint (the scene and the --set values it was run
 with). The tangent on the free rows (System.free_tangent, their count in each row) at the
@@ -12,6 +12,13 @@ mode's values there, largest first, beside the nodes' initial and current places
 mode of an element alternates in sign from node to node; a physical one (a wrinkle, a drum
 mode of a stretched bottom) keeps its sign over many nodes. One rank. docs/performance.md
 ("The soft modes of the fine cups") has what it found.
+
+--shift S: the shift-invert's shift in N/mm (default -1e-6 of the median diagonal): the K
+eigenvalues nearest it are found. --unsymmetric: first a line with K's own K eigenvalues
+nearest the shift (scipy's eigs; K is unsymmetric where friction slips), its symmetric part's
+and the asymmetry |K - K^T| / |K| (sums of magnitudes): a symmetric part that is indefinite
+while K is not says the energy slope of a Newton step may lose its sign without the
+equilibrium being unstable.
 """
 
 import argparse
@@ -27,17 +34,24 @@ from shellform.contact.problem import DrawingProblem
 from shellform.nonlinear import checkpoint
 
 
-def modes(s, out, k: int) -> list[dict]:
+def modes(s, out, k: int, shift: float | None = None, unsymmetric: bool = False) -> list[dict]:
     p = DrawingProblem.from_scene(s, MPI.COMM_SELF)
     d = p.driver
     d.resume(checkpoint.read(out, MPI.COMM_SELF))
     K, free = d.free_tangent(d.lam)
     S = ((K + K.T) / 2).tocsc()
     scale = float(np.median(np.abs(S.diagonal())))
-    values, vectors = sla.eigsh(S, k=k, sigma=-1e-6 * scale, which="LM")
+    sigma = -1e-6 * scale if shift is None else shift
+    values, vectors = sla.eigsh(S, k=k, sigma=sigma, which="LM")
+    rows = []
+    if unsymmetric:
+        own = sla.eigs(K.tocsc(), k=k, sigma=sigma, which="LM", return_eigenvectors=False)
+        rows.append({"stroke_mm": p.stroke, "free_rows": len(free),
+                     "asymmetry": float(abs(K - K.T).sum() / abs(K).sum()),
+                     "K_eigenvalues": [[float(z.real), float(z.imag)] for z in np.sort_complex(own)],
+                     "symmetric_part_eigenvalues": sorted(float(v) for v in values)})
     x0 = p.initial_positions()
     x = x0 + p.displacements()[: len(x0)]
-    rows = []
     for i in np.argsort(values):
         v = np.zeros(d.q.x.array.size)
         v[free] = vectors[:, i]
@@ -60,11 +74,13 @@ def main():
     parser.add_argument("out")
     parser.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("-k", type=int, default=8)
+    parser.add_argument("--shift", type=float, default=None)
+    parser.add_argument("--unsymmetric", action="store_true")
     args = parser.parse_args()
     s = scene.load(args.scene)
     if args.settings:
         s = s.changed(scene.settings(args.settings))
-    for row in modes(s, args.out, args.k):
+    for row in modes(s, args.out, args.k, args.shift, args.unsymmetric):
         print(json.dumps(row))
 
 
