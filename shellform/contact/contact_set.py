@@ -51,7 +51,7 @@ class ContactControls:
     max_toggles: int = 2  # switches of one node (or of the holder) per increment before it is frozen
     friction_rtol: float = 1e-4  # passes end when |mu dp| <= friction_rtol |mu p| (2-norms)
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
-    holder_spread: str = "area"  # "area" or "rigid" (holder.py)
+    holder_spread: str = "area"  # a spread rule of holder_split.py
     trace: bool = False  # log every pass, step and iterate (the largest residuals) and each node that switches
 
 

@@ -1,18 +1,9 @@
 """The blank holder under force control: it pinches the flange onto the die's flat top.
 
 Between the rigid die and the rigid holder, a flange node is *pinched*: its normal position is
-known (it lies on the die) whatever the sign of its net normal force R0 (die minus holder).
-The shell carries no through-thickness strain, so the two faces' forces are known only through
-their difference R0 and the holder's total F; their split is a modelling choice. The holder
-presses each pinched node with what holds it down plus a *squeeze* s_i >= 0:
-
-    off the edge's band   h_i = s_i + max(-R0_i, 0),   d_i = s_i + max(R0_i, 0)
-    on the edge's band    h_i = s_i + f e_i,           d_i = h_i D / H,  D = max(H + sum R0_j, 0)
-                          sum_i h_i = F,  friction pressure d_i + h_i
-
-(H = sum h_j and the sums over the band): on the band the die presses with the band's
-equilibrium total, shared as the holder presses, not node by node with the positive lobes of
-the discrete couple the pinch carries there (their sum grows as 1/h, and friction saw it).
+known (it lies on the die) whatever the sign of its net normal force R0 (die minus holder). How
+F is shared between the pinched nodes' two faces, the holding-down, the edge's band and the
+squeeze a spread rule spreads, is the split (holder_split.py).
 
 The band is the pinched nodes that carry the couple turning the sheet from the flange onto the
 die's shoulder (within two cells of the holder's inner edge, or drawn past it in this
@@ -20,15 +11,10 @@ increment): e_i is their share of the edge load V_e per unit length of the holde
 edge (pinch_edge.py: the couple over the sheet's own through-thickness compliance, the same total
 on every mesh), which replaces the discrete force the rigid pinch puts there (it grows as 1/h).
 With E_in the holding-down off the band and E_e = sum e_i, the holder carries the edge in full
-(f = 1) while E_in + E_e <= F; beyond, it *rides* on its edge: f = (F - E_in) / E_e and no squeeze
-is left. A holder riding on its edge is lifted by micrometres (the couple's arm grows to take
-less force: EdgeLoad.riding_lift), so the flange stays pinched while that lift is below the
-contact's tolerance (1 % of t); where it is not (a light holder), the holder opens. The squeeze
-left to spread is S = F - E_in - f E_e >= 0. ``spread`` says how:
-- "area" (default): s_i = S A_i / sum A (tributary areas), the uniform flange pressure of a
-  holder whose own compliance and the sheet's absorb the flange's thickness differences.
-- "rigid": the rigid holder on the thickest rim: s_i = k_i max(top_i - Z, 0) with the
-  through-thickness stiffness k_i = E A_i / t and Z fixed by sum s_i = S.
+while E_in + E_e <= F; beyond, it *rides* on its edge. A holder riding on its edge is lifted by
+micrometres (the couple's arm grows to take less force: EdgeLoad.riding_lift), so the flange
+stays pinched while that lift is below the contact's tolerance (1 % of t); where it is not (a
+light holder), the holder opens.
 
 The holder *opens* when the flange off the band pushes it up harder than F holds it down
 (E_in > F), or when riding on its edge would lift it by more than the tolerance: criteria on
@@ -51,41 +37,26 @@ contact set's update (contact_set.py), whose tools its open face joins.
 import numpy as np
 from mpi4py import MPI
 
+from shellform.contact.holder_split import HolderSplit
 from shellform.contact.lifted_face import LiftedFace
 from shellform.contact.nodes import W_SLOPES
 from shellform.contact.pinch_edge import edge_weights
 from shellform.nonlinear.parts import Part
 from shellform.results.log import say
-from shellform.scene import SPREADS
-
-
-def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:
-    """Z with sum k_i max(tops_i - Z, 0) = force (the highest top when force is 0)."""
-    order = np.argsort(-tops)
-    t, kk = tops[order], k[order]
-    K = np.cumsum(kk)
-    S = np.cumsum(kk * t)
-    # with the first j + 1 tops touching: force = S_j - K_j Z  ->  Z_j = (S_j - force) / K_j
-    Z = (S - force) / K
-    below = np.append(t[1:], -np.inf)  # Z_j is the answer where it lies in [t_{j+1}, t_j]
-    j = int(np.argmax(Z >= below))
-    return float(Z[j])
 
 
 class PinchingHolder(Part):
     """The holder (tool: a BlankHolder) with force F on the owned nodes under it (plan position
-    over the die's flat top): a part. area: tributary areas of the owned nodes; stiffness: their
-    E A / t (the "rigid" spread); nodes: the SheetNodes; friction: the CoulombFriction whose
+    over the die's flat top): a part. nodes: the SheetNodes (their tributary areas); stiffness:
+    their E A / t; spread: the split's rule (holder_split.py); friction: the CoulombFriction whose
     slip forces depend on the lifted nodes' normal forces; edge: the pinch's EdgeLoad
     (pinch_edge.py; None: no band, the rigid pinch's discrete couple)."""
 
     def __init__(self, tool, force: float, nodes, stiffness: np.ndarray, comm, spread: str = "area",
                  thickness: float = 0.0, max_toggles: int = 2, trace: bool = False, edge=None):
-        if spread not in SPREADS:
-            raise ValueError(f"holder spread must be one of {SPREADS}, got {spread!r}")
-        self.tool, self.force, self.comm, self.spread = tool, float(force), comm, spread
+        self.split = HolderSplit(force, nodes.area, stiffness, comm, spread)
+        self.tool, self.force, self.comm = tool, float(force), comm
         self.nodes, self.thickness, self.max_toggles, self.trace = nodes, thickness, max_toggles, trace
-        self.area, self.k = np.asarray(nodes.area, dtype=float), np.asarray(stiffness, dtype=float)
         n = nodes.n_owned
         self.closed, self.toggles = False, 0
         self.lifted_face = LiftedFace(tool, force, thickness, spread, comm)
@@ -96,7 +67,6 @@ class PinchingHolder(Part):
         self.edge_law = edge
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
-        self.band_ratio, self.band_force = 0.0, 0.0  # the die's force on the band over the holder's, the holder's
         self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
         self.contact = self.friction = None
         self.committed = None
@@ -151,18 +121,6 @@ class PinchingHolder(Part):
         band = pinched & (s < 2.0 * rows)
         return np.where(pinched, self.edge_load * self.nodes.current_area() * j * edge_weights(s, rows), 0.0), band
 
-    def demands(self, pinched: np.ndarray, net: np.ndarray, edge: np.ndarray, band: np.ndarray) -> tuple[float, float]:
-        """(E_in, E_e), all ranks: the holding-down the pinched nodes off the edge's band need
-        (sum max(-R0, 0)) and the edge load on the band (sum e_i)."""
-        inner = pinched & ~band
-        both = self.comm.allreduce(np.array([np.maximum(-net[inner], 0.0).sum(), edge.sum()]), op=MPI.SUM)
-        return float(both[0]), float(both[1])
-
-    def edge_share(self, inner: float, total_edge: float) -> float:
-        """f: the share of its edge load E_e the holder gives after the holding-down E_in."""
-        left = max(self.force - inner, 0.0)
-        return 1.0 if total_edge <= left else left / total_edge
-
     def rides(self, share: float, tolerance: float) -> bool:
         """Whether giving its edge `share` of the edge load lifts the holder by at most
         `tolerance` (EdgeLoad.riding_lift; always without an edge load)."""
@@ -171,57 +129,23 @@ class PinchingHolder(Part):
     def lifted(self, net: np.ndarray, edge: np.ndarray, band: np.ndarray, tolerance: float) -> bool:
         """The closed holder cannot hold the flange: its holding-down off the edge's band passes
         F, or riding on its edge would lift it by more than `tolerance` (all ranks agree)."""
-        inner, total_edge = self.demands(self.pinched, net, edge, band)
-        return inner > self.force or not self.rides(self.edge_share(inner, total_edge), tolerance)
+        inner, total_edge = self.split.demands(self.pinched, net, edge, band)
+        return inner > self.force or not self.rides(self.split.edge_share(inner, total_edge), tolerance)
 
     def may_ride(self, x: np.ndarray, under: np.ndarray, contact) -> bool:
         """Whether the open holder, closed on the flange on the die under it, could carry at
         least the share of its edge load that keeps riding within the contact's tolerance."""
         total = self._sum(self.edge_shares(x, under & contact.on(contact.die))[0])
-        return self.rides(self.edge_share(0.0, total), contact.controls.penetration)
+        return self.rides(self.split.edge_share(0.0, total), contact.controls.penetration)
 
     def held_down(self, net: np.ndarray) -> tuple[float, float, float]:
-        """(E_in + f E_e, E_e, E_in) / F of the closed holder at its last split: the part of F that
-        holds the flange down against its own lift, the edge load's demand (> 1: the holder rides
-        on its edge) and the holding-down off the edge's band."""
-        inner, edge = self.demands(self.pinched, net, self.edge, self.band)
-        return (inner + self.edge_share(inner, edge) * edge) / self.force, edge / self.force, inner / self.force
-
-    def split(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray, band: np.ndarray):
-        """(die face d, holder face h) forces on the pinched nodes (zero elsewhere) of a closed
-        holder, from their net normal forces R0, their tops z + t/2 (the "rigid" spread) and the
-        edge load's shares e_i on its band (module docstring)."""
-        inner, total_edge = self.demands(pinched, net, edge, band)
-        f = self.edge_share(inner, total_edge)
-        S = max(self.force - inner, 0.0) - f * total_edge
-        s = np.zeros(net.size)
-        if self.spread == "area":
-            total = self._sum(self.area[pinched])
-            if total > 0:
-                s[pinched] = S * self.area[pinched] / total
-        else:
-            all_tops = np.concatenate(self.comm.allgather(tops[pinched]))
-            all_k = np.concatenate(self.comm.allgather(self.k[pinched]))
-            if all_tops.size:
-                Z = holder_height(all_tops, all_k, S)
-                s[pinched] = self.k[pinched] * np.maximum(tops[pinched] - Z, 0.0)
-        h = np.where(pinched, s + np.where(band, f * edge, np.maximum(-net, 0.0)), 0.0)
-        on_band = pinched & band
-        H, R = self._sum(h[on_band]), self._sum(net[on_band])
-        self.band_ratio = max(H + R, 0.0) / H if H > 0 else 0.0  # the die's force on the band over the holder's
-        self.band_force = H
-        d = np.where(pinched, np.where(band, self.band_ratio * h, s + np.maximum(net, 0.0)), 0.0)
-        return d, h
+        """(E_in + f E_e, E_e, E_in) / F of the closed holder at its last split (HolderSplit.held_down)."""
+        return self.split.held_down(self.pinched, net, self.edge, self.band)
 
     def face_slopes(self, net: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(dd_i/dR0_i, dh_i/dR0_i) of the pinched nodes at the last split (F's spread held
-        fixed), whose sum is d(d_i + h_i)/dR0_i: off the edge's band the die's 1 where R0 > 0 and
-        the holder's -1 where R0 < 0 (sign(R0) together); on it the die's h_i / H (d_i = h_i D / H,
-        D the band's equilibrium total) while the die presses the band, 0 where it is clear, and
-        the holder's 0 (h_i = s_i + f e_i)."""
-        own = self.face / self.band_force if self.band_force > 0 and self.band_ratio > 0 else np.zeros_like(self.face)
-        return (np.where(self.band, own, (net > 0).astype(float)),
-                np.where(self.band, 0.0, -(net < 0).astype(float)))
+        """(dd_i/dR0_i, dh_i/dR0_i) of the pinched nodes at the last split (HolderSplit.face_slopes),
+        whose sum is d(d_i + h_i)/dR0_i."""
+        return self.split.face_slopes(net, self.face, self.band)
 
     def face_gap(self, x: np.ndarray, half: np.ndarray):
         """Gap and normal of the open holder's face to the nodes at x with half thicknesses
@@ -268,7 +192,7 @@ class PinchingHolder(Part):
         split; the open holder's face takes the force of the nodes on it."""
         if self.closed:
             self.edge, self.band = self.edge_shares(x, self.pinched)
-            d, self.face = self.split(self.pinched, net, self._tops(x), self.edge, self.band)
+            d, self.face = self.split.forces(self.pinched, net, self._tops(x), self.edge, self.band)
             contact.press(self.pinched, d[self.pinched])
         else:
             self.edge, self.band = np.zeros(net.size), np.zeros(net.size, dtype=bool)

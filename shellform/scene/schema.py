@@ -30,7 +30,7 @@ __all__ = ["LOAD_STEP_KEYS", "STROKE_STEP_KEYS", "TOOL_SHAPES", "SPREADS", "HOLD
 LOAD_STEP_KEYS = ("initial_step", "min_step", "max_step")
 STROKE_STEP_KEYS = ("initial_step_mm", "min_step_mm", "max_step_mm")
 TOOL_SHAPES = tool_kinds.SHAPES  # tools.shape: the registered kinds of tools (shellform.tools.kinds)
-SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder.py)
+SPREADS = ("area", "rigid")  # the blank holder's spread of its force (shellform/contact/holder_split.py SPREAD_RULES)
 HOLDERS = ("force", "gap")  # the blank holder presses with a force, or is held at a gap over the die
 
 SUPPORTS = ("simply_supported", "clamped", "symmetry", "free", "clamped_sliding")
