@@ -1,6 +1,6 @@
 """The ESAFORM 2021 cup drawn through: its height profile against the benchmark's measured one.
 
-    shellform study esaform-cup --out docs/results/esaform_cup [--levels 12 16 20]
+    shellform study esaform-cup --out docs/results/esaform_cup [--levels 12 16 20 24]
 
 The scene demos/esaform2021_cup.toml (AA6016-T4, 1 mm; the benchmark's tools, blank, Voce curve
 and friction; a force-controlled holder of 10 kN) with the effect ``ironing`` added and the
@@ -79,7 +79,7 @@ from shellform.studies.cup_hard import folder, variant
 
 SCENE = "esaform2021_cup.toml"
 STROKE = 45.0
-LEVELS = (12, 16, 20)
+LEVELS = (12, 16, 20, 24)
 QUICK_LEVELS = (6,)
 QUICK_STROKE = 4.0
 ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
