@@ -233,3 +233,27 @@ def test_the_pinched_flange_s_taper_carries_no_moment():
     assert np.abs(m.strain[tapered][..., 3:] - m.taper[tapered]).max() < 0.1 * taper
     assert np.abs(m.resultants[tapered][..., 3:]).max() < 0.01 * D * taper
     assert np.abs(m.resultants[~tapered][..., 3:]).max() > 10 * D * taper  # the wall and the shoulder bend
+
+
+def test_the_holder_s_pressure_is_its_face_force_over_the_node_s_area_against_the_flow_stress():
+    """DrawingProblem.holder_pressure: the largest h_i / a_i (a_i a third of the current plan area
+    of the cells around node i), and the largest ratio to the flow stress at the node, which lies
+    between the pressure over the largest flow stress in the sheet and over the initial yield
+    stress (the flow curve rises); on the paper's cup at 4 mm the flange is pressed at a few
+    times F over its area (the holding-down and the edge's band on the spread), far below yielding
+    it through its thickness."""
+    from shellform.material import hardening
+
+    s = square_cup()
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(4.0 / s.tools.stroke)
+    pressure, ratio = p.holder_pressure()
+    h, area = d.holder, d.nodes.current_area()
+    assert pressure == pytest.approx(float(np.max(h.face / area)), rel=1e-14)
+    mean = h.force / float(area[h.pinched].sum())
+    assert mean < pressure < 20 * mean
+    m = d.model
+    highest = hardening.flow_stress(float(m.cell_fields()["equivalent_plastic_strain"].max()), m.material)[0]
+    assert pressure / highest <= ratio <= pressure / hardening.flow_stress(0.0, m.material)[0]
+    assert 0.0 < ratio < 0.1

@@ -28,7 +28,8 @@ from shellform.results.listeners import Listener, Listeners, Run
 from shellform.results.tables import write_csv, write_json
 
 # worst values over all increments, in summary.json: the balances and the pinch
-CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "free_under_closed_holder")
+CHECKS = ("max_penetration_mm", "force_balance", "holder_largest_share", "holder_pressure_over_flow_stress",
+          "free_under_closed_holder")
 
 
 def _damaged(path: Path, err: Exception) -> InputError:
@@ -67,12 +68,14 @@ class ForceStroke(Listener):
         p, h = run.sheet, run.driver.history[-1]
         hx, hy = p.holder_largest_at()
         held, edge, off_band = p.holder_held_down()
+        pressure, over_flow = p.holder_pressure()
         self.rows.append({"increment": h.number, "stroke_mm": p.stroke, "punch_force_kN": p.punch_force() / 1e3,
                           "holder_force_kN": p.holder_force() / 1e3, "holder_height_mm": p.holder_height(),
                           "holder_lift_mm": p.holder_lift(),
                           "max_penetration_mm": p.max_penetration(), "force_balance": p.force_balance(),
                           "holder_largest_share": p.holder_share(), "holder_largest_x_mm": hx,
-                          "holder_largest_y_mm": hy, "holder_held_down": held, "holder_edge_load": edge,
+                          "holder_largest_y_mm": hy, "holder_largest_pressure_MPa": pressure,
+                          "holder_pressure_over_flow_stress": over_flow, "holder_held_down": held, "holder_edge_load": edge,
                           "holder_off_band": off_band, "free_under_closed_holder": p.free_under_holder(),
                           "iterations": h.iterations, "min_line_search": h.contact["min_line_search"],
                           "contact_passes": h.contact["passes"],
