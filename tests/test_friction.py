@@ -132,6 +132,53 @@ def test_slip_tangent_carries_the_normal_force_change():
     assert error <= 1e-6, error
 
 
+def test_slip_tangent_on_the_known_columns_reaches_the_solve_through_the_lift():
+    """The slipping force's normal-force term on a *known* column (the normal row of a node on
+    the punch, its own or a neighbour's), which the assembled tangent cannot hold, enters the
+    solve through the lift of the known corrections (Friction.lift_known): the element tangents'
+    column and that term together match central differences of the residual on the slipping
+    nodes' tangential rows along that node's normal, to 1e-6 of the largest entry (without the
+    term the error is 3 % of it here; a node ironed between two faces keeps such a correction in every iterate,
+    and Newton converged only linearly there, docs/cup.md)."""
+    d, lam = drawn_cup(2.0)
+    m = d.model
+    slip = np.flatnonzero(d.friction.slipping & d.contact.on(0) & ~d.holder.pinched)
+    assert slip.size > 0
+    near = np.unique(m.dofs[np.isin(m.dofs, slip[:4]).any(axis=1)])
+    on_punch = [b for b in near if b < d.n_owned and d.contact.tool[b] == 0][:4]
+    d.linearize(lam)
+    d.assemble_tangent()
+    rows = np.setdiff1d((BS * slip[:, None] + np.arange(2)).ravel(), d.bc_dofs)  # not those of a symmetry line
+    R0 = d.b.getArray()[rows].copy()
+    frames, h = d.frames.copy(), 1e-6
+    worst = size = without = 0.0
+    for b in on_punch:
+        j = BS * b + 2
+        e = np.zeros(d.q.x.array.size)
+        e[j] = 1.0
+        element = d.apply_tangent(e)[rows]
+        lifted = np.zeros(d.n_owned * BS)
+        d.friction.lift_known(e, lifted)
+        column = element - lifted[rows]
+        q0 = d.q.x.array.copy()
+        v = np.zeros_like(q0)
+        v[BS * b: BS * b + 3] = frames[b, 2]  # the node's normal, the known row's direction
+        sides = []
+        for sign in (1.0, -1.0):
+            d.q.x.array[:] = q0 + sign * h * v
+            d.linearize(lam, tangent=False)
+            sides.append(d.b.getArray()[rows].copy())
+        d.q.x.array[:] = q0
+        fd = (sides[0] - sides[1]) / (2 * h)
+        worst = max(worst, np.abs(fd - column).max())
+        without = max(without, np.abs(fd - element).max())
+        size = max(size, np.abs(column).max())
+    d.linearize(lam)
+    assert np.isfinite(R0).all() and size > 0
+    assert worst <= 1e-6 * size, worst / size
+    assert without >= 1e-2 * size, without / size
+
+
 def test_strip_between_a_die_and_a_holder_of_other_frictions_carries_each_face_with_its_own():
     """Friction per tool on a pinched node: the strip between a die of mu 0.05 and a holder of mu
     0.25 (F = 1 kN), pulled 2 mm. Both faces slip together, each with its own coefficient: once

@@ -20,7 +20,10 @@ reactions), the slipping force's dependence on it enters the tangent too:
     d(-f_i)/dq = -m_i (d(mu_i p_i)/dR0_i) K_(i,n),   dp/dR0 = 1 on a tool, sign(R0) on a pinched node
 
 (K_(i,n) the node's normal row of the sheet's tangent, R0 its net normal force; non-symmetric),
-on the free tangent rows of every slipping node, in the free columns.
+on the free tangent rows of every slipping node: in K on the free columns, and on the known
+columns through the solve's lift of the known corrections (lift_known), which K cannot carry. Those
+corrections do not all vanish after a pass's first iterate: a node ironed between two faces
+lies at half the clearance through it, which moves with the node.
 
 The normal force p (both faces of a pinched node) is the part's too. Within a Newton pass it is
 taken from the reactions of every iterate after the first (the contact set's faces), so that
@@ -100,6 +103,7 @@ class CoulombFriction(Part):
         self.rate = np.zeros((n, 2, 2))  # -df/ds in the nodes' tangent slots
         self.slipping = np.zeros(n, dtype=bool)
         self.slip_rows = None  # (dp/dR0, g = f/p in the tangent slots) of the last normal-force tangent
+        self.known_columns = None  # that tangent's terms on the known columns (lift_known)
 
     @property
     def active(self) -> bool:
@@ -222,7 +226,7 @@ class CoulombFriction(Part):
 
     def add_tangent(self, K, R: np.ndarray, fixed: np.ndarray) -> None:
         """K += -df/ds; on the iterates after a pass's first, the slip force's dp/dq too."""
-        self.slip_rows = None
+        self.slip_rows = self.known_columns = None
         if not self.active:
             return
         add_tangent_slot_stiffness(K, self.rate)
@@ -330,8 +334,21 @@ class CoulombFriction(Part):
         rows = BS * b[:, None] + np.arange(2)  # (pairs, 2): the node's tangent slots in this cell
         g = np.where(fixed[rows], 0.0, g[b])  # none on a row held by symmetry
         row = model.forms.matrices[cells, BS * local + 2]  # (pairs, cell dofs): the normal row
-        # not on the known columns, whose corrections vanish after a pass's first iterate
-        row = np.where(fixed[model.unrolled_dofs[cells]], 0.0, row)
-        values = -c[b][:, None, None] * g[:, :, None] * row[:, None, :]
-        K.setValuesLocalRCV(rows.astype(np.int32), model.unrolled_dofs[cells].astype(np.int32),
+        columns = model.unrolled_dofs[cells]
+        known = fixed[columns]
+        # on the free columns into K; on the known ones (a node on a tool whose face moves with
+        # it, ironed between two faces, keeps a known correction after a pass's first iterate)
+        # into the lift (lift_known)
+        self.known_columns = (rows, -c[b][:, None] * g, np.where(known, row, 0.0), columns)
+        values = -c[b][:, None, None] * g[:, :, None] * np.where(known, 0.0, row)[:, None, :]
+        K.setValuesLocalRCV(rows.astype(np.int32), columns.astype(np.int32),
                             values.reshape(len(b), -1), addv=True)
+
+    def lift_known(self, delta: np.ndarray, b: np.ndarray) -> None:
+        """b -= the slipping force's normal-force tangent on the known columns times their
+        corrections (Part.lift_known): a known correction of a node's neighbours (or of its own normal
+        row) changes its normal force, and with it the slip force mu p."""
+        if self.known_columns is None:
+            return
+        rows, scale, row, columns = self.known_columns
+        np.subtract.at(b, rows, scale * np.einsum("pj,pj->p", row, delta[columns])[:, None])

@@ -93,6 +93,11 @@ class Part:
         """K += the part's stiffness (R: the residual with every part's forces; fixed: the
         known rows, local dofs)."""
 
+    def lift_known(self, delta: np.ndarray, b: np.ndarray) -> None:
+        """b -= the part's stiffness on the known columns times their corrections `delta` (local
+        dofs, the solve's frames; b: owned rows): what the assembled tangent, whose known columns
+        hold nothing, cannot carry into the free rows (system.py, the lift)."""
+
     def imbalance(self) -> float:
         """The residual of the part's own equation (0 without an unknown)."""
         return 0.0

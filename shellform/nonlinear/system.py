@@ -271,9 +271,12 @@ class System:
 
     # -- solves ------------------------------------------------------------------------------
     def _lift(self, delta: np.ndarray) -> None:
-        """b -= K_fD delta on the free rows, b = delta on the Dirichlet rows (the known jump)."""
+        """b -= K_fD delta on the free rows, b = delta on the Dirichlet rows (the known jump):
+        the element tangents' known columns and the parts' (Part.lift_known)."""
         arr = self.b.getArray(readonly=False)
         arr -= self.apply_tangent(delta)
+        for part in self.parts:
+            part.lift_known(delta, arr)
         owned = self.bc_dofs[self.bc_dofs < arr.size]
         arr[owned] = delta[owned]
         del arr
