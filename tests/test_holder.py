@@ -67,8 +67,10 @@ def test_the_open_holders_lift_step_is_exact_newton():
     """The lift is solved with the sheet (a bordered system). From the open state at 1.25 mm
     (400 N holder, its nodes slipping) with F raised by 1 %, central differences of the
     residual along the Newton direction (dq, dz_H) equal -R on the slipping holder nodes'
-    tangential rows and on the holder's equation: to 2e-3 of |R| (measured; h = 1e-4 to 1e-6
-    give the same), against 6e-2 without the slip forces' dp/dq on the lifted columns."""
+    tangential rows and on the holder's equation, to 1.2e-4 of |R| (h = 1e-4), against 0.18
+    without the slip forces' dp/dq on the known columns (Part.lift_known: the lifted columns and
+    their neighbours'; until 2026-11-29 the holder added that term on its lifted columns alone:
+    2e-3)."""
     s = square_cup(blank_holder_force=400.0)
     p = DrawingProblem.from_scene(s, verbose=False)
     d = p.driver
@@ -77,7 +79,7 @@ def test_the_open_holders_lift_step_is_exact_newton():
     assert not d.holder.closed and slip.size > 0
     rows = (BS * slip[:, None] + np.arange(2)).ravel()
     d.holder.force *= 1.01
-    q0, lift0, solve = d.q.x.array.copy(), d.holder.lift, d.solve_lifted
+    q0, lift0, lifted = d.q.x.array.copy(), d.holder.lift, d.friction.lift_known
 
     def residual(h=0.0, dq=0.0, dz=0.0):
         d.q.x.array[:] = q0 + h * dq
@@ -87,7 +89,7 @@ def test_the_open_holders_lift_step_is_exact_newton():
 
     errors = {}
     for exact in (True, False):
-        d.solve_lifted = solve if exact else (lambda delta, out, extra=None: solve(delta, out))
+        d.friction.lift_known = lifted if exact else (lambda delta, b: None)
         R = residual()
         assert d.solve(0.0)
         dz = d.holder.border(d)
@@ -96,7 +98,7 @@ def test_the_open_holders_lift_step_is_exact_newton():
         h = 1e-4
         change = (residual(h, dq, dz) - residual(-h, dq, dz)) / (2 * h)
         errors[exact] = np.abs(change + R).max() / np.abs(R).max()
-    assert errors[True] <= 5e-3 and errors[False] >= 3e-2, errors
+    assert errors[True] <= 1e-3 and errors[False] >= 0.1, errors
 
 
 def test_the_pinch_holds_the_slopes_of_a_mid_surface_on_the_die():

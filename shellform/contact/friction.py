@@ -102,7 +102,6 @@ class CoulombFriction(Part):
         self.force = np.zeros((n, 3))  # of the current iterate (x, y, z)
         self.rate = np.zeros((n, 2, 2))  # -df/ds in the nodes' tangent slots
         self.slipping = np.zeros(n, dtype=bool)
-        self.slip_rows = None  # (dp/dR0, g = f/p in the tangent slots) of the last normal-force tangent
         self.known_columns = None  # that tangent's terms on the known columns (lift_known)
 
     @property
@@ -226,7 +225,7 @@ class CoulombFriction(Part):
 
     def add_tangent(self, K, R: np.ndarray, fixed: np.ndarray) -> None:
         """K += -df/ds; on the iterates after a pass's first, the slip force's dp/dq too."""
-        self.slip_rows = self.known_columns = None
+        self.known_columns = None
         if not self.active:
             return
         add_tangent_slot_stiffness(K, self.rate)
@@ -319,12 +318,11 @@ class CoulombFriction(Part):
         """K += the slipping force's dependence on its normal force (module docstring): coef,
         per owned node, dp/dR0 where the node slips on a tool with p > 0 and 0 elsewhere; frames
         (local nodes) and normal (owned) as update() had them; fixed: the known rows (local
-        dofs), whose rows and columns get nothing. Keeps (coef, g) for the holder's lift."""
+        dofs), whose rows get nothing; on their columns the term goes to the lift (lift_known)."""
         n = len(coef)
         on = coef != 0
         g = np.zeros((n_local, 2))
         g[:n][on] = np.einsum("nij,nj->ni", frames[:n][on][:, :2], self.force[on]) / normal[on, None]
-        self.slip_rows = (coef.copy(), np.where(self.held, 0.0, g[:n]))
         c = np.zeros(n_local)
         c[:n] = coef
         cells, local = np.nonzero(c[model.dofs] != 0)

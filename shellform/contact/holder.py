@@ -48,8 +48,7 @@ from shellform.results.log import say
 class PinchingHolder(Part):
     """The holder (tool: a BlankHolder) with force F on the owned nodes under it (plan position
     over the die's flat top): a part. nodes: the SheetNodes (their tributary areas); stiffness:
-    their E A / t; spread: the split's rule (holder_split.py); friction: the CoulombFriction whose
-    slip forces depend on the lifted nodes' normal forces; edge: the pinch's EdgeLoad
+    their E A / t; spread: the split's rule (holder_split.py); edge: the pinch's EdgeLoad
     (pinch_edge.py; None: no band, the rigid pinch's discrete couple)."""
 
     def __init__(self, tool, force: float, nodes, stiffness: np.ndarray, comm, spread: str = "area",
@@ -68,7 +67,7 @@ class PinchingHolder(Part):
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
         self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
-        self.contact = self.friction = None
+        self.contact = None
         self.committed = None
 
     def bind(self, driver) -> None:
@@ -83,10 +82,9 @@ class PinchingHolder(Part):
     def lift(self, value: float) -> None:
         self.lifted_face.lift = float(value)
 
-    def compose(self, contact, friction) -> None:
-        """The contact set whose die the holder pinches onto and whose tools its open face joins,
-        and the friction on its nodes."""
-        self.contact, self.friction = contact, friction
+    def compose(self, contact) -> None:
+        """The contact set whose die the holder pinches onto and whose tools its open face joins."""
+        self.contact = contact
 
     @property
     def edge_load(self) -> float:
@@ -310,7 +308,7 @@ class PinchingHolder(Part):
         if count == 0:
             self.lifted_face.hold()
             return 0.0
-        return self.lifted_face.border(driver, on, self.imbalance(), self.friction)
+        return self.lifted_face.border(driver, on, self.imbalance())
 
     def slope(self) -> float:
         return self.lifted_face.slope(self.imbalance())

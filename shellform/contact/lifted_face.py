@@ -11,7 +11,7 @@ factors:
 F - sum p_i is the derivative of the energy with respect to the lift: it enters the residual's
 norm and the line search's energy slope (dz_H (F - sum p)). Where friction slips on the face's
 nodes, their slip forces depend on those nodes' normal forces, so the lifted columns carry
-friction's dp/dq too. The face is flat at z_face + z_H ("rigid" spread) or conforms to the
+friction's dp/dq too (the solve's lift of known columns, Part.lift_known). The face is flat at z_face + z_H ("rigid" spread) or conforms to the
 flange's thickness ("area": over each node z_face + z_H + (2 h - t0), z_H above the node's top
 when the node rests on the die), as the closed holder's pressure does.
 """
@@ -52,24 +52,17 @@ class LiftedFace:
         """No lift in this Newton iteration (the face is closed or touches nothing)."""
         self._lift0, self._dlift = self.lift, 0.0
 
-    def border(self, driver, on: np.ndarray, imbalance: float, friction=None) -> float:
+    def border(self, driver, on: np.ndarray, imbalance: float) -> float:
         """dz_H in this Newton iteration for the owned nodes `on` the face and its imbalance
         F - sum p_i (module docstring): dq (frame coordinates, from the solve) becomes
         dq_a + dz_H dq_b. NaN where the lifted solve fails."""
         self.hold()
-        n = on.size
         rows = BS * np.flatnonzero(on) + 2  # their normal rows (the frame's normal points down)
         unit = self._unit.x.array
         unit[:] = 0.0
         unit[rows] = -1.0  # the face up by 1: each node 1 up, -1 along its normal
         self._unit.x.scatter_forward()
-        extra = None
-        if friction is not None and friction.slip_rows is not None:  # dp/dq on these known columns
-            coef, g = friction.slip_rows
-            Ku = driver.apply_tangent(unit)[: n * BS].reshape(-1, BS)[:, 2]
-            extra = np.zeros(n * BS)
-            extra.reshape(-1, BS)[:, :2] = (coef * Ku)[:, None] * g
-        if not driver.solve_lifted(unit, self._response, extra):
+        if not driver.solve_lifted(unit, self._response):
             return np.nan
         dqa, dqb = driver.dq.x.array, self._response.x.array
         change = self.comm.allreduce(np.array([driver.apply_tangent(dqa)[rows].sum(),
