@@ -350,7 +350,8 @@ def tables(out: Path, levels: dict) -> list[dict]:
     write_csv(out / "esaform_cup.csv", rows, list(dict.fromkeys(k for r in rows for k in r)))
     if ests:
         write_csv(out / "esaform_cup_estimates.csv", ests, ["model", "answer", "values", "p", "estimate", "uncertainty"])
-    (out / "esaform_cup.md").write_text(markdown(rows, ests))
+    six = lambda rs: [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rs]  # noqa: E731
+    (out / "esaform_cup.md").write_text(markdown(six(rows), six(ests)))  # the table of the CSVs' six digits
     plot(out / "esaform_cup.png", rows, out)
     return rows
 
