@@ -265,10 +265,10 @@ def test_the_round_cup_with_ironing_is_drawn_through(tmp_path):
     shoulder (without 'ironing' the run stops at 36 mm): the run does not stop, the punch force
     falls from its peak (36.7 kN) below a tenth of it once the rim is through (1.6 kN seen), the
     rim lies below the shoulder's foot, 10.5 mm under the die's top (12.5 seen), and the tools'
-    z-forces balance to 3e-6 of the peak punch force over the whole stroke (the Newton tolerance,
-    rtol 1e-6 of the forces; seen 6e-7, 0.02 N, until friction's known columns entered the lift
-    on 2026-11-29, and 2.3e-6, 0.083 N, since: not yet explained, docs/contact.md; relative to the
-    punch force of the moment, 1.4e-5 where the rim slides in the clearance at 1.6 kN)."""
+    z-forces balance to 3e-6 of the peak punch force over the whole stroke: the z-sum of the
+    residual Newton leaves at rtol 1e-6 (2.3e-6, 0.083 N, seen; 31 times less at rtol 1e-7:
+    docs/contact.md, "The z-balance is the residual Newton leaves"; relative to the punch force
+    of the moment, 1.4e-5 where the rim slides in the clearance at 1.6 kN)."""
     s = scene.changed(scene.load(ROUND), {"effects": IRONING, "tools.stroke": 45.0, "output.png": False,
                                           "output.vtx": False, "output.fld": False, "process.springback": False})
     contact_run.run(s, tmp_path)

@@ -120,18 +120,19 @@ class DrawingProblem(SheetFields):
         return d.model.mesh.comm.allreduce(float(d.holder.face.max(initial=0.0)), op=MPI.MAX) / d.holder.force
 
     def holder_pressure(self) -> tuple[float, float]:
-        """The closed holder's largest pressure on a node, h_i / a_i (MPa: its face force over a
+        """The holder's largest pressure on a node, h_i / a_i (MPa: its face force over a
         third of the current plan area of the cells around it), and the largest ratio of that
         pressure to the sheet's flow stress at the node, sigma_bar(p_i) with p_i the area-weighted
         mean of the cells' equivalent plastic strain around it (the reference flow curve), all
-        ranks; zeros without a holder force. The mesh-independent form of "how much of F one node
+        ranks; zeros without a holder force. The face force is the closed holder's split of F or the
+        open holder's contact force. The mesh-independent form of "how much of F one node
         takes": a face pressing harder than the flow stress would iron the flange through its
         thickness (docs/contact.md, "The holder's pressure")."""
         d = self.driver
         if d.holder is None or d.holder.force <= 0:
             return 0.0, 0.0
         m = d.model
-        sums = d.nodes.cell_sums(m.cell_area * m.cell_fields()["equivalent_plastic_strain"], m.cell_area)
+        sums = d.nodes.cell_sums(m.cell_area * m.plastic_strain(), m.cell_area)
         pressure = np.divide(d.holder.face, d.nodes.current_area())
         pressed = np.flatnonzero(pressure > 0)
         flow = np.array([hardening.flow_stress(float(p), m.material)[0] for p in sums[pressed, 0] / sums[pressed, 1]])

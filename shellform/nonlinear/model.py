@@ -331,10 +331,14 @@ class SheetModel:
         equivalent plastic strain (max over the layers), thickness strain of the section (mean
         over the layers; ln(t/t0) with finite strains, the small-strain e33 without) and the
         major and minor logarithmic strains of the mid-surface."""
-        peq = self.p_n.max(axis=2).mean(axis=1)
         major, minor = _surface_strains(self.strain)
-        return {"equivalent_plastic_strain": peq, "thickness_strain": self.thickness_strain(),
+        return {"equivalent_plastic_strain": self.plastic_strain(), "thickness_strain": self.thickness_strain(),
                 "major_strain": major, "minor_strain": minor}
+
+    def plastic_strain(self) -> np.ndarray:
+        """Per owned cell: the equivalent plastic strain, the largest over the layers, averaged
+        over the quadrature points."""
+        return self.p_n.max(axis=2).mean(axis=1)
 
     def thickness_strain(self) -> np.ndarray:
         """Per owned cell: ln(t/t0) = mean ln lambda3 with finite strains, else the small-strain

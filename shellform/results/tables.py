@@ -71,14 +71,26 @@ def write_screenshot(path: Path, plotter) -> None:
     write_atomically(path, lambda f: image.imsave(f, picture, format="png"), binary=True)
 
 
+def _cell(v):
+    """A CSV cell: a float to six significant digits, anything else as it is."""
+    return f"{v:.6g}" if isinstance(v, float) else v
+
+
+def as_written(rows: list[dict]) -> list[dict]:
+    """The rows as `write_csv` writes them, read back: every float to its six digits, so that a
+    table printed beside the CSV (a study's markdown) rounds the same numbers the same way."""
+    return [{k: (float(_cell(v)) if isinstance(v, float) else v) for k, v in row.items()} for row in rows]
+
+
 def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
+    """rows to path with the given columns, floats to six significant digits."""
     if MPI.COMM_WORLD.rank != 0:
         return
     text = io.StringIO(newline="")
     writer = csv.DictWriter(text, fieldnames=columns, extrasaction="ignore")
     writer.writeheader()
     for row in rows:
-        writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+        writer.writerow({k: _cell(v) for k, v in row.items()})
     write_atomically(path, lambda f: f.write(text.getvalue()))
 
 

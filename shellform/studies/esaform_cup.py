@@ -72,7 +72,7 @@ import numpy as np
 from shellform.contact.run import run as run_cup
 from shellform.results import run_folder
 from shellform.results.log import say
-from shellform.results.tables import write_csv
+from shellform.results.tables import as_written, write_csv
 from shellform.results.vtu import last_step, read_vtu
 from shellform.studies.cup_convergence import richardson
 from shellform.studies.cup_hard import folder, variant
@@ -350,8 +350,7 @@ def tables(out: Path, levels: dict) -> list[dict]:
     write_csv(out / "esaform_cup.csv", rows, list(dict.fromkeys(k for r in rows for k in r)))
     if ests:
         write_csv(out / "esaform_cup_estimates.csv", ests, ["model", "answer", "values", "p", "estimate", "uncertainty"])
-    six = lambda rs: [{k: float(f"{v:.6g}") if isinstance(v, float) else v for k, v in r.items()} for r in rs]  # noqa: E731
-    (out / "esaform_cup.md").write_text(markdown(six(rows), six(ests)))  # the table of the CSVs' six digits
+    (out / "esaform_cup.md").write_text(markdown(as_written(rows), as_written(ests)))  # the CSVs' own digits
     plot(out / "esaform_cup.png", rows, out)
     return rows
 
