@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from shellform.nonlinear.frames import from_frames
-from shellform.contact.problem import HOLDER, DrawingProblem
+from shellform.contact.contact_set import FREE
+from shellform.contact.problem import DIE, HOLDER, DrawingProblem
 from shellform.assembly.sheet_element import BS
 
 from contact_cases import square_cup
@@ -99,6 +100,50 @@ def test_the_open_holders_lift_step_is_exact_newton():
         change = (residual(h, dq, dz) - residual(-h, dq, dz)) / (2 * h)
         errors[exact] = np.abs(change + R).max() / np.abs(R).max()
     assert errors[True] <= 1e-3 and errors[False] >= 0.1, errors
+
+
+def _open_at_one_mm():
+    s = square_cup(blank_holder_force=400.0)
+    p = DrawingProblem.from_scene(s, verbose=False)
+    p.driver.run(1.0 / s.tools.stroke)
+    d = p.driver
+    assert not d.holder.closed and d.contact.on(HOLDER).sum() > 0
+    d.holder.edge_law = None  # it rides on any edge: closing is the lift's decision alone
+    return d
+
+
+def test_the_holder_decides_and_the_set_moves_its_nodes_when_it_closes():
+    """The holder reads the set through its view and returns its decisions; the set applies
+    them (holder.py, contact_set.py). From the open state at 1 mm (400 N), a lift below its
+    closed position closes it at the set's update: its face's nodes go back onto the die, pinched,
+    with the die-minus-holder sign of their net normal forces (the set turns it)."""
+    d = _open_at_one_mm()
+    h, c = d.holder, d.contact
+    face = c.on(HOLDER).copy()
+    net = c.net_normal_forces()[face]
+    h.lift = -0.1
+    change = c.update(d.lam, 0)
+    assert h.closed and change.changes >= 1
+    assert c.on(DIE)[face].all() and h.pinched[face].all() and not c.on(HOLDER).any()
+    # the split of the turned R0 (die minus holder = -net): its faces h - d = net on each node
+    assert np.allclose(h.face[face] - c.pressure[face], net, rtol=0.0, atol=1e-9 * np.abs(net).max())
+
+
+def test_an_open_holder_that_touches_nothing_comes_down_onto_the_nearest_node():
+    """From the open state at 1 mm (400 N) with its face's nodes let go and the face 0.5 mm
+    higher, the set's update lowers it by the gap to the nearest node under it, which joins its
+    face; it stays open."""
+    d = _open_at_one_mm()
+    h, c = d.holder, d.contact
+    c.assign(c.on(HOLDER), FREE)
+    h.lift = h.lift + 0.5
+    x = d.nodes.positions()
+    gap = h.face_gap(x, d.nodes.half_thickness)[0][h.under(x)]
+    lift = h.lift
+    c.update(d.lam, 0)
+    assert not h.closed
+    assert h.lift == pytest.approx(lift - gap.min(), abs=1e-12)
+    assert c.on(HOLDER).sum() >= 1
 
 
 def test_the_pinch_holds_the_slopes_of_a_mid_surface_on_the_die():
@@ -204,10 +249,12 @@ def test_the_die_presses_the_edge_s_band_with_its_equilibrium_not_the_pinch_s_co
     d.run(12.0 / s.tools.stroke)
     h = d.holder
     net = d.net_normal_forces()
-    h.faces(d.nodes.positions(), net, d.contact)
+    pressed, values = h.faces(d.nodes.positions(), net)  # the die's face forces under it
+    die = np.zeros(net.size)
+    die[pressed] = values
     band = h.band & h.pinched
     assert band.sum() > 4 and h.face[band].min() > 0.0
-    die = d.contact.pressure[band]
+    die = die[band]
     total = float((h.face[band] + net[band]).sum())
     assert total > 0.0 and abs(die.sum() - total) <= 1e-9 * total
     ratio = die / h.face[band]

@@ -32,6 +32,7 @@ on one face would penetrate the other by 2 h_i - c_i, join it when released, and
 face a different mid-surface apart; at c_i / 2 it lies in the clearance's middle on either face.
 """
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,6 +54,22 @@ class ContactControls:
     trust: float = 0.5  # the largest nodal update of one Newton iteration, in thicknesses
     holder_spread: str = "area"  # a spread rule of holder_split.py
     trace: bool = False  # log every pass, step and iterate (the largest residuals) and each node that switches
+
+
+@dataclass(frozen=True)
+class SetView:
+    """What another part reads of the contact set, and all it may: the owned nodes on the die
+    (where the closed holder pinches), on the open holder's face and off every tool, each node's
+    net normal force, and the set's two tolerances. Nothing writes through it: a part's decisions
+    about the set (the holder's nodes onto its face or back onto the die, the die's face forces
+    under it) return to the set, which applies them."""
+
+    on_die: Callable[[], np.ndarray]
+    on_face: Callable[[], np.ndarray]
+    free: Callable[[], np.ndarray]
+    net_normal_forces: Callable[[], np.ndarray]
+    penetration: float  # how far a free node may penetrate a tool
+    known_tolerance: float  # |known corrections| at convergence
 
 
 class ContactSet(Part):
@@ -85,6 +102,12 @@ class ContactSet(Part):
         self.residual = None  # the driver's residual with its reactions (bind)
         self.comm = None
         self.committed = None
+
+    def view(self) -> SetView:
+        """The set as another part may read it (SetView)."""
+        return SetView(lambda: self.tool == self.die, lambda: self.tool == self.holder_tool,
+                       lambda: self.tool == FREE, self.net_normal_forces, self.controls.penetration,
+                       self.known_tolerance)
 
     def bind(self, driver) -> None:
         self.residual = lambda: driver.residual_full
@@ -136,7 +159,7 @@ class ContactSet(Part):
             touch = (gap <= self.controls.penetration) & (self.tool == FREE)
             self.tool[touch] = k
         if self.holder is not None:
-            self.holder.close_on(x, self)
+            self._press(*self.holder.close_on(x))
         self.committed = self._copy()
 
     def _copy(self):
@@ -157,10 +180,10 @@ class ContactSet(Part):
         self.net = net
         self.pressure = np.maximum(net, 0.0)
         if self.holder is not None:
-            self.holder.faces(self._x, net, self)
+            self._press(*self.holder.faces(self._x, net))
         return net
 
-    def press(self, nodes, values) -> None:
+    def _press(self, nodes, values) -> None:
         """Set the tool face's normal force of `nodes` (the holder's split on the die under it)."""
         self.pressure[nodes] = values
 
@@ -291,8 +314,7 @@ class ContactSet(Part):
         under = self._under(x)
         holder_changes = 0
         if self.holder is not None:
-            self.holder.pinch(under, self, grow=True)
-            holder_changes = self.holder.settle(x, under, net, lam, self)
+            holder_changes = self._settle_holder(x, under, net, lam)
         join, release, deepest = self._changes(x, lam, under, net, tensile=1e-8)
         if self.controls.trace:
             X = self.nodes.X
@@ -303,7 +325,7 @@ class ContactSet(Part):
         self.tool[release] = FREE
         self.tool[join] = deepest[join]
         if self.holder is not None:
-            self.holder.pinch(under, self, grow=True)  # the nodes drawn under the closed holder
+            self.holder.pinch(under, grow=True)  # the nodes drawn under the closed holder
         switched = release | join
         self.switched = switched
         self.pressure[switched] = 0.0
@@ -313,6 +335,20 @@ class ContactSet(Part):
             np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum())]),
             op=MPI.SUM)
         return Change(int(count), int(back), True, f"{int(count)} set changes")
+
+    def _settle_holder(self, x, under, net, lam) -> int:
+        """The holder's state after a converged pass (PinchingHolder.settle): its nodes moved onto
+        its face or back onto the die, where a node that changes faces carries its new face's
+        force (`net` turns its sign there), then its pinch and faces again. Returns its changes."""
+        self.holder.pinch(under, grow=True)
+        changes, to_face, to_die = self.holder.settle(x, under, net, lam)
+        moved = to_face | to_die
+        net[moved & (self.tool != FREE)] *= -1  # die minus holder <-> the face's own normal force
+        self.tool[to_face] = self.holder_tool
+        self.tool[to_die] = self.die
+        self.holder.pinch(under, grow=True)
+        self._press(*self.holder.faces(x, net))
+        return changes
 
     def commit(self, lam: float) -> None:
         self.toggles[:] = 0

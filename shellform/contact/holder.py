@@ -31,7 +31,10 @@ every node beneath it but its boundary. The pinched set only
 grows within an increment (a node drawn out from under the holder leaves at the next one), so
 that a node at the holder's edge cannot switch from one pass to the next. The holder switches
 (opens or closes) at most `max_toggles` times per increment. Its state machine runs in the
-contact set's update (contact_set.py), whose tools its open face joins.
+contact set's update (contact_set.py), whose tools its open face joins. The holder reads the set
+through its view (contact_set.SetView: the nodes on the die, on its face, off the tools, their
+net normal forces) and writes nothing there: it returns its decisions (the nodes that go onto
+its face or back onto the die, the die's face forces under it) and the set applies them.
 """
 
 import numpy as np
@@ -67,7 +70,7 @@ class PinchingHolder(Part):
         self.edge = np.zeros(n)  # the edge load's shares e_i at the last split (0 off the band)
         self.band = np.zeros(n, dtype=bool)  # the edge's band at the last split
         self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
-        self.contact = None
+        self.view = None  # what it reads of the contact set (compose)
         self.committed = None
 
     def bind(self, driver) -> None:
@@ -82,9 +85,10 @@ class PinchingHolder(Part):
     def lift(self, value: float) -> None:
         self.lifted_face.lift = float(value)
 
-    def compose(self, contact) -> None:
-        """The contact set whose die the holder pinches onto and whose tools its open face joins."""
-        self.contact = contact
+    def compose(self, view) -> None:
+        """The view (contact_set.SetView) of the contact set whose die the holder pinches onto and
+        whose tools its open face joins: what it reads there; it writes nothing there."""
+        self.view = view
 
     @property
     def edge_load(self) -> float:
@@ -130,11 +134,11 @@ class PinchingHolder(Part):
         inner, total_edge = self.split.demands(self.pinched, net, edge, band)
         return inner > self.force or not self.rides(self.split.edge_share(inner, total_edge), tolerance)
 
-    def may_ride(self, x: np.ndarray, under: np.ndarray, contact) -> bool:
+    def may_ride(self, x: np.ndarray, under: np.ndarray) -> bool:
         """Whether the open holder, closed on the flange on the die under it, could carry at
         least the share of its edge load that keeps riding within the contact's tolerance."""
-        total = self._sum(self.edge_shares(x, under & contact.on(contact.die))[0])
-        return self.rides(self.split.edge_share(0.0, total), contact.controls.penetration)
+        total = self._sum(self.edge_shares(x, under & self.view.on_die())[0])
+        return self.rides(self.split.edge_share(0.0, total), self.view.penetration)
 
     def held_down(self, net: np.ndarray) -> tuple[float, float, float]:
         """(E_in + f E_e, E_e, E_in) / F of the closed holder at its last split (HolderSplit.held_down)."""
@@ -166,11 +170,11 @@ class PinchingHolder(Part):
     def _tops(self, x):
         return x[:, 2] + self.nodes.half_thickness
 
-    def pinch(self, under, contact, grow: bool) -> None:
+    def pinch(self, under, grow: bool) -> None:
         """The pinched nodes: on the die, under the closed holder (mask `under`); with `grow`
         the set only grows within the increment (module docstring). The nodes under the open
         holder, whose slopes it holds flat, follow the same rule."""
-        on_die = contact.on(contact.die)
+        on_die = self.view.on_die()
         now = self.closed & under & on_die
         self.pinched = (self.pinched | now) if grow else now
         self.pinched &= self.closed & on_die
@@ -184,67 +188,70 @@ class PinchingHolder(Part):
         beneath it."""
         return self.pinched | self.under_now if self.is_open else self.pinched.copy()
 
-    def faces(self, x, net, contact) -> None:
-        """The face forces of the holder (and of the die under it) from the nodes' net normal
-        forces `net` (die minus holder on a pinched node), at positions x: the closed holder's
-        split; the open holder's face takes the force of the nodes on it."""
+    def faces(self, x, net) -> tuple[np.ndarray, np.ndarray]:
+        """The face forces of the holder from the nodes' net normal forces `net` (die minus
+        holder on a pinched node), at positions x: the closed holder's split; the open holder's
+        face takes the force of the nodes on it. Returns the die's face forces under it, (nodes,
+        values), for the contact set to press: the split's on the pinched nodes, 0 on the open
+        face's nodes (they do not touch the die)."""
         if self.closed:
             self.edge, self.band = self.edge_shares(x, self.pinched)
             d, self.face = self.split.forces(self.pinched, net, self._tops(x), self.edge, self.band)
-            contact.press(self.pinched, d[self.pinched])
-        else:
-            self.edge, self.band = np.zeros(net.size), np.zeros(net.size, dtype=bool)
-            on = contact.on(contact.holder_tool)
-            self.face = np.where(on, np.maximum(net, 0.0), 0.0)
-            contact.press(on, 0.0)
+            return self.pinched.copy(), d[self.pinched]
+        self.edge, self.band = np.zeros(net.size), np.zeros(net.size, dtype=bool)
+        on = self.view.on_face()
+        self.face = np.where(on, np.maximum(net, 0.0), 0.0)
+        return on, np.zeros(int(on.sum()))
 
-    def close_on(self, x, contact) -> None:
-        """At the start: the holder closes on the flange when it has a force."""
+    def close_on(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """At the start: the holder closes on the flange when it has a force. Returns the die's
+        face forces under it (faces)."""
         self.closed = self.force > 0
-        self.pinch(self.under(x), contact, grow=False)
-        self.faces(x, np.zeros(x.shape[0]), contact)
+        self.pinch(self.under(x), grow=False)
+        pressed = self.faces(x, np.zeros(x.shape[0]))
         self.committed = self._copy()
+        return pressed
 
     def _copy(self):
         return {"closed": self.closed, "lift": self.lift, "face": self.face.copy()}
 
     def _lift_floor_over(self, x, under) -> float:
         """The closed position of the lift over the nodes on the die under the holder."""
-        on_die = under & self.contact.on(self.contact.die)
+        on_die = under & self.view.on_die()
         return self.lift_floor(self._tops(x)[on_die])
 
     def on_face(self):
         """The owned nodes on the open holder's face, and their number on all ranks."""
-        on = self.contact.on(self.contact.holder_tool)
+        on = self.view.on_face()
         return on, self.comm.allreduce(int(on.sum()), op=MPI.SUM)
 
-    def settle(self, x, under, net, lam, contact) -> int:
+    def settle(self, x, under, net, lam) -> tuple[int, np.ndarray, np.ndarray]:
         """After a converged pass: open the holder if the flange lifts it (its holding-down off the
         edge's band, E_in, passes F): the pinched nodes it holds down (R0 < 0) go onto its face, the others stay on
         the die, the face at its closed position. Close it once its lift is below that position
         by more than the contact set's known tolerance (within a pass the lift may pass it),
         unless that would spend its last switch of the increment or its edge load would lift it
-        again (may_ride); lower an open holder that
-        touches nothing onto the nearest node. Then its face forces. `net`, the nodes' net normal
-        forces, is updated where a node changes faces. Returns the changes (the same on all ranks)."""
+        again (may_ride); its face's nodes go back onto the die. Lower an open holder that
+        touches nothing onto the nearest node, which goes onto its face. `net`: the nodes' net
+        normal forces. Returns (changes, onto its face, back onto the die): the changes the same
+        on all ranks, the nodes for the contact set to move (a node that changes faces then
+        carries its new face's force: the set turns its R0's sign). The set then pinches and
+        splits again (pinch, faces)."""
         changes = 0
+        to_face, to_die = np.zeros(net.size, dtype=bool), np.zeros(net.size, dtype=bool)
         if self.toggles < self.max_toggles and self.force > 0:
-            if self.closed and self.lifted(net, *self.edge_shares(x, self.pinched), contact.controls.penetration):
+            if self.closed and self.lifted(net, *self.edge_shares(x, self.pinched), self.view.penetration):
                 self.closed = False
                 self.lift = self.lift_floor(self._tops(x)[self.pinched])
-                held = self.pinched & (net < 0)
-                contact.assign(held, contact.holder_tool)
-                net[held] *= -1  # now the force of the face they lie on, along its normal
+                to_face = self.pinched & (net < 0)  # held down: onto its face
                 changes = 1
-            elif (not self.closed and self.toggles + 1 < self.max_toggles and self.may_ride(x, under, contact)
-                  and self.lift < self._lift_floor_over(x, under) - contact.known_tolerance):
+            elif (not self.closed and self.toggles + 1 < self.max_toggles and self.may_ride(x, under)
+                  and self.lift < self._lift_floor_over(x, under) - self.view.known_tolerance):
                 # the face presses into the flange on the die: closed (if it may still open
                 # again in this increment: closed with its switches spent, it could be left
                 # holding more than F)
                 self.closed = True
-                held = contact.on(contact.holder_tool)
-                contact.assign(held, contact.die)  # then pinched (the face is at the sheet)
-                net[held] *= -1  # die minus holder
+                to_die = self.view.on_face()  # then pinched (the face is at the sheet)
                 changes = 1
             elif not self.closed and self.on_face()[1] == 0:
                 gap = self.face_gap(x, self.nodes.half_thickness)[0]
@@ -254,24 +261,21 @@ class PinchingHolder(Part):
                     changes = 1
                 elif np.isfinite(nearest):
                     self.lift -= nearest  # the face comes down onto the nearest node
-                    free = contact.on(-1)
-                    contact.assign(under & (gap <= nearest + contact.controls.penetration) & free,
-                                   contact.holder_tool)
+                    to_face = under & (gap <= nearest + self.view.penetration) & self.view.free()
                     changes = 1
             self.toggles += changes
             if self.trace and changes:
+                face = (self.view.on_face() & ~to_die) | to_face
                 say(f"    holder: {'closed' if self.closed else 'open'}, lift {self.lift:.3e} mm, "
-                    f"{self.on_face()[1]} nodes on its face")
-        self.pinch(under, contact, grow=True)
-        self.faces(x, net, contact)
-        return changes
+                    f"{self.comm.allreduce(int(face.sum()), op=MPI.SUM)} nodes on its face")
+        return changes, to_face, to_die
 
     # -- the part's protocol -------------------------------------------------------------------
     def start(self, lam: float, predicting: bool) -> None:
         c = self.committed
         self.closed, self.lift, self.face = c["closed"], c["lift"], c["face"].copy()
         self.toggles = 0
-        self.pinch(self.under(self.nodes.x_n), self.contact, grow=False)
+        self.pinch(self.under(self.nodes.x_n), grow=False)
 
     def constrain(self, c, lam: float) -> None:
         """The holder's flat faces hold the flange flat: the slopes of w are known on the nodes
@@ -299,7 +303,7 @@ class PinchingHolder(Part):
         on, count = self.on_face()
         if count == 0:
             return 0.0
-        return self.force - self._sum(self.contact.net_normal_forces()[on])
+        return self.force - self._sum(self.view.net_normal_forces()[on])
 
     def border(self, driver) -> float:
         """The open holder's lift in this Newton iteration, solved with the sheet

@@ -61,7 +61,7 @@ class SemiInverseDriver(Driver):
         self.drawbeads = Drawbeads(drawbeads, model.V, model.dofs, E, t, model.cell_size, nodes.held[:, :2],
                                    nodes) if drawbeads else None
         if self.holder is not None:
-            self.holder.compose(self.contact)
+            self.holder.compose(self.contact.view())  # what the holder reads of the set
         self.ironing = Ironing(model, nodes, self.contact) if ironing else None
         if self.ironing is not None:
             self.contact.bound_by(self.ironing)  # between two tools the sheet's faces lie at the bounded thickness
