@@ -98,6 +98,7 @@ class ContactSet(Part):
         self.slid_off = np.zeros(n, dtype=bool)  # nodes that slid off their tool's extent (this iterate)
         self.switched = np.zeros(n, dtype=bool)  # nodes that switched in the last update
         self.net = np.zeros(n)  # the net normal forces of the last refresh
+        self.following = False  # the faces follow the reactions (the iterates after a pass's first)
         self.frozen = 0
         self.residual = None  # the driver's residual with its reactions (bind)
         self.comm = None
@@ -174,8 +175,9 @@ class ContactSet(Part):
         return np.where(self.tool != FREE, rows[:, 2], 0.0)
 
     def refresh(self, R) -> np.ndarray:
-        """The faces' normal forces from the reactions of this iterate (R: before friction):
-        the tool's face max(R0, 0), the holder's faces split from R0. Returns R0."""
+        """The faces' normal forces from the reactions of this iterate (R: the sheet's and the
+        drawbeads' forces, before friction): the tool's face max(R0, 0), the holder's faces split
+        from R0. Returns R0."""
         net = self.net_normal_forces(R)
         self.net = net
         self.pressure = np.maximum(net, 0.0)
@@ -211,6 +213,18 @@ class ContactSet(Part):
         return np.where(on, tool, 0.0), np.where(on, holder, 0.0)
 
     # -- the part's protocol -------------------------------------------------------------------
+    def stepped(self, yes: bool) -> None:
+        """On the iterates after a pass's first the faces follow the reactions (add_residual); on
+        a pass's first they keep the update's."""
+        self.following = yes
+
+    def add_residual(self, R) -> None:
+        """The faces' normal forces from this iterate's reactions (refresh), where they follow
+        them: friction presses with them (the parts before the set add the drawbeads' forces,
+        the set adds none)."""
+        if self.following:
+            self.refresh(R)
+
     def start(self, lam: float, predicting: bool) -> None:
         c = self.committed
         self.tool, self.pressure = c["tool"].copy(), c["pressure"].copy()

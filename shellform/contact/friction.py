@@ -212,13 +212,12 @@ class CoulombFriction(Part):
         self.slip(idx, shift, x, self.nodes.x_n, F, self.normal)
 
     def add_residual(self, R: np.ndarray) -> None:
-        """R -= f; on the iterates after a pass's first, p from this iterate's reactions first
-        (R before friction), the return mapping again with it."""
+        """R -= f; on the iterates after a pass's first, p from this iterate's faces first (the
+        contact set's, which follow the reactions there), the return mapping again with it."""
         n = self.nodes.n_owned
         if not self.active:
             return
         if self.refreshing:
-            self.contact.refresh(R)
             self.normal = self.contact.face_forces()
             self._map()
         subtract_nodal_forces(R[: n * BS].reshape(-1, BS)[:, :3], self.frames[:n], self.force)
