@@ -8,7 +8,8 @@ displacement (it follows the tool) and an unknown normal force, the residual of 
 
     SheetNodes      positions, tributary areas, half thicknesses (nodes.py)
     Drawbeads       restraining and uplift forces along the beads' lines (drawbead.py)
-    ContactSet      which node lies on which tool, its frame, the tools' curvature (contact_set.py)
+    ContactSet      which node lies on which tool, its frame, the tools' curvature, the faces' forces
+                    (contact_set.py; the holder reads it through a view)
     PinchingHolder  the pinch onto the die, the open holder's lift and its equation (holder.py)
     Ironing         the faces' bound on the thickness between two tools (ironing.py; with the
                     effect 'ironing')
