@@ -2,10 +2,12 @@
 on sheets of known shape, the measured profile's answers, and a tiny run of the study."""
 
 import csv
+import json
 
 import numpy as np
 import pytest
 
+from shellform.results import run_folder
 from shellform.results.vtu import last_step, read_vtu
 from shellform.studies import esaform_cup as ec
 
@@ -102,6 +104,26 @@ def test_errors_and_goals():
     assert not r["goals_met"]
     r = ec.with_errors({**r, "h45": 40.0, "d0": 1.0}, m)
     assert not r["ears_right"]
+
+
+def test_the_study_reuses_a_run_of_this_scene_by_this_code_only(tmp_path, monkeypatch):
+    """A run folder is reused, not drawn again, only where its run.json names this scene and this
+    code version and its results are there; a run of other code (stopped or not) is drawn again."""
+    drawn = []
+    monkeypatch.setattr(ec, "run_cup", lambda s, d: drawn.append(d))
+    monkeypatch.setattr(ec, "tables", lambda out, levels: [])
+    s = ec.scene_of("yld2000", 6, ec.QUICK_STROKE)
+    d = ec.folder(tmp_path, ec.run_name("yld2000", 6))
+    d.mkdir(parents=True)
+    for name in ("summary.json", "cup.pvd"):
+        (d / name).write_text("{}")
+    manifest = {"scene_hash": run_folder.scene_hash(s), "code_version": run_folder.code_version()}
+    (d / run_folder.MANIFEST).write_text(json.dumps(manifest))
+    ec.run(tmp_path, levels=(6,), models=("yld2000",), stroke=ec.QUICK_STROKE)
+    assert drawn == []
+    (d / run_folder.MANIFEST).write_text(json.dumps({**manifest, "code_version": "0+src.another"}))
+    ec.run(tmp_path, levels=(6,), models=("yld2000",), stroke=ec.QUICK_STROKE)
+    assert drawn == [d]
 
 
 @pytest.mark.slow

@@ -190,8 +190,12 @@ def run_name(model: str, n: int) -> str:
 
 
 def _finished_here(d: Path, s) -> bool:
+    """Whether d holds a run of scene s by this code (run.json's scene hash and code version),
+    finished or stopped, with its results: a run of other code is drawn again, its numbers may
+    not be this code's."""
     m = run_folder.read_manifest(d)
-    return bool(m) and m.get("scene_hash") == run_folder.scene_hash(s) and (d / "summary.json").exists() \
+    return bool(m) and m.get("scene_hash") == run_folder.scene_hash(s) \
+        and m.get("code_version") == run_folder.code_version() and (d / "summary.json").exists() \
         and (d / "cup.pvd").exists()
 
 
@@ -312,8 +316,8 @@ def plot(path: Path, rows: list[dict], out: Path) -> None:
 
 
 def run(out: Path, levels=LEVELS, models=("yld2000", "hill48"), stroke=None) -> list[dict]:
-    """Draw each yield function on each level into out (a finished run of the same scene there
-    is reused), then the tables and the plot."""
+    """Draw each yield function on each level into out (a run of the same scene by the same
+    code there is reused), then the tables and the plot."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     stroke = stroke or (QUICK_STROKE if tuple(levels) == QUICK_LEVELS else STROKE)
