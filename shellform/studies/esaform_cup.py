@@ -95,8 +95,12 @@ MODELS = {  # name: (label, the scene's material changes)
                          {"tools.die_radius": 31.6}),
     "yld2000-gap-holder": ("Yld2000-2d, the holder at the benchmark's 1.04 mm gap",
                            {"tools.holder": "gap", "tools.holder_gap": 1.04}),
+    # suspect (b) of the gap holder's d0: the fit's biaxial strain ratio left free (r_b = 1 assumed)
+    "yld2000-gap-holder-free-rb": ("Yld2000-2d fitted without r_b, the holder at the 1.04 mm gap",
+                                   {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.r_b": 0.0}),
 }
 HYPOTHESES = ("yld2000-wide-die", "yld2000-gap-holder")  # run apart: `hypotheses`'s docstring
+GAP_HOLDER = ("yld2000-gap-holder", "yld2000-gap-holder-free-rb")  # drawn through on n >= 16: `gap_holder`
 # github.com/stefanSCS/PolyN, CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt:
 # (angle in degrees, measured cup height in mm)
 MEASURED = np.array([
@@ -339,6 +343,15 @@ def hypotheses(out: Path, n: int = 12) -> list[dict]:
         python -c "from shellform.studies import esaform_cup as e; e.hypotheses('docs/results/esaform_hypotheses')"
     """
     return run(out, levels=(n,), models=HYPOTHESES)
+
+
+def gap_holder(out: Path, levels=(16, 20, 24)) -> list[dict]:
+    """Yld2000-2d with the holder at the benchmark's gap, with the fit's r_b assumed (1) and left
+    free (GAP_HOLDER), on the levels where it draws through, into their own folder:
+
+        python -c "from shellform.studies import esaform_cup as e; e.gap_holder('docs/results/esaform_gap_holder')"
+    """
+    return run(out, levels=levels, models=GAP_HOLDER)
 
 
 def tables(out: Path, levels: dict) -> list[dict]:
