@@ -18,7 +18,9 @@ stiffening in a concave shoulder).
 The set is settled between Newton passes (``update``): nodes that penetrate a tool by more than
 `penetration` join it, nodes (not pinched) whose normal force turned tensile leave it, nodes
 drawn under the closed holder join the die; a node may switch at most `max_toggles` times per
-increment (no chattering). A pass may end before it converges where the set will change anyway,
+increment (no chattering). A node so frozen off the tools that penetrates one beyond `penetration`
+leaves the set unsettled: the increment is not accepted with a node inside a tool, and is cut back
+if further passes do not move it out (a shorter step needs fewer switches). A pass may end before it converges where the set will change anyway,
 once Newton's steps are below `early_step` penetrations (a step that long judges the set on an
 iterate still moving; after such passes fail, they end only near convergence, early_step 1).
 Newton's steps are bounded by `trust` thicknesses of nodal move (largest_move).
@@ -281,7 +283,7 @@ class ContactSet(Part):
             return False
         x = self.nodes.positions()
         under = self._under(x)
-        join, release, _ = self._changes(x, lam, under, self.net_normal_forces(), tensile=1e-3)
+        join, release, _, _ = self._changes(x, lam, under, self.net_normal_forces(), tensile=1e-3)
         return self.comm.allreduce(int(np.sum(join | release)), op=MPI.SUM) > 0
 
     def retry(self) -> str | None:
@@ -301,7 +303,8 @@ class ContactSet(Part):
         """The nodes that join a tool (penetrating it by more than `penetration`, or drawn under
         the closed holder: onto the die) and those that leave theirs (not pinched, pulled off by
         more than `tensile` times the largest normal force), among the nodes that may still
-        switch in this increment; with the tool each joining node joins."""
+        switch in this increment; with the tool each joining node joins, and the nodes frozen
+        off the tools that penetrate one (sunk, whose switches are spent)."""
         on, can = self.tool != FREE, self.toggles < self.controls.max_toggles
         scale = max(self.comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
         pinched = self.holder.pinched if self.holder is not None else np.zeros_like(on)
@@ -313,8 +316,8 @@ class ContactSet(Part):
         allowed = np.full(len(x), self.controls.penetration)
         if self.holder is not None and self.holder.is_open:  # between its faces: as tight as the pinch it opened
             allowed[self.holder.under_now] = self.known_tolerance
-        join = ~on & ((depth.min(axis=0) < -allowed) | enters) & can
-        return join, release, deepest
+        penetrating = ~on & ((depth.min(axis=0) < -allowed) | enters)
+        return penetrating & can, release, deepest, penetrating & ~can
 
     def update(self, lam: float, changes: int) -> Change:
         """After a converged pass: normal forces from the reactions, the holder's state and
@@ -329,7 +332,7 @@ class ContactSet(Part):
         holder_changes = 0
         if self.holder is not None:
             holder_changes = self._settle_holder(x, under, net, lam)
-        join, release, deepest = self._changes(x, lam, under, net, tensile=1e-8)
+        join, release, deepest, sunk = self._changes(x, lam, under, net, tensile=1e-8)
         if self.controls.trace:
             X = self.nodes.X
             for i in np.flatnonzero(release | join):
@@ -345,10 +348,11 @@ class ContactSet(Part):
         self.pressure[switched] = 0.0
         self.toggles[switched] += 1
         self.frozen = int((self.toggles >= self.controls.max_toggles).sum())
-        count, back = self.comm.allreduce(
-            np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum())]),
-            op=MPI.SUM)
-        return Change(int(count), int(back), True, f"{int(count)} set changes")
+        count, back, sunk = self.comm.allreduce(
+            np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum()),
+                      int(sunk.sum())]), op=MPI.SUM)
+        line = f"{int(count)} set changes" + (f", {int(sunk)} nodes frozen off a tool inside it" if sunk else "")
+        return Change(int(count), int(back), not sunk, line)
 
     def _settle_holder(self, x, under, net, lam) -> int:
         """The holder's state after a converged pass (PinchingHolder.settle): its nodes moved onto
