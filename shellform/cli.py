@@ -37,6 +37,7 @@ STUDIES = {
     "plastic": "limit load and springback of an elastic-plastic cantilever",
     "strip": "finite-strain plasticity: a strip pulled to a stretch of 1.5 against closed forms",
     "ironing": "a strip squeezed between faces and drawn through a gap against plane-strain closed forms",
+    "binder-wrap": "a strip wrapped onto a cylindrical binder, its springback against the closed form of a bend",
     "assembly": "assembly benchmark",
     "newton": "one Newton iteration of the plastic sheet, benchmark",
     "cup-hard": "the square cup's five hard cases",

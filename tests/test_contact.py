@@ -74,6 +74,27 @@ def test_a_support_in_a_turned_frame_is_corrected_towards_its_value():
     assert np.allclose(delta.reshape(-1, BS)[bottom, 1], -1e-3, rtol=1e-12)
 
 
+def test_a_node_frozen_off_a_tool_inside_it_leaves_the_set_unsettled():
+    """A node whose switches are spent is not moved onto the tool it penetrates (no chattering),
+    but the set does not settle either: the increment is cut back rather than accepted with the
+    node inside the tool. Within the tolerance, or with a switch left, the set behaves as
+    before."""
+    rect, model, bcs = plate()
+    d = SemiInverseDriver(model, bcs, [FlatTool(0.5, 15.0, 15.0)], [-2.0], verbose=False)
+    cs = d.contact
+    node = np.flatnonzero(cs.on(0))[0]  # under the punch, which touches the plate at the start
+    cs.assign(node, FREE)
+    q = d.q.x.array.reshape(-1, BS)
+    q[node, 2] += cs.gaps(d.positions(), 0.0)[0][0][node] + 5.0 * cs.controls.penetration  # 5 tolerances into it
+    cs.toggles[node] = cs.controls.max_toggles
+    change = cs.update(0.0, 0)
+    assert (change.changes, change.settled) == (0, False) and not cs.on(0)[node]
+    assert "1 nodes frozen off a tool inside it" in change.line
+    cs.toggles[node] = cs.controls.max_toggles - 1  # a switch left: it joins the punch
+    change = cs.update(0.0, 0)
+    assert (change.changes, change.settled) == (1, True) and cs.on(0)[node]
+
+
 def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading():
     """A flat rigid punch pushes a simply supported plate 2 mm down and goes back: the punch's
     contact force equals the support reactions (to 1e-8), no node penetrates, the contact set

@@ -348,11 +348,15 @@ class ContactSet(Part):
         self.pressure[switched] = 0.0
         self.toggles[switched] += 1
         self.frozen = int((self.toggles >= self.controls.max_toggles).sum())
-        count, back, sunk = self.comm.allreduce(
+        count, back, sunk_count = self.comm.allreduce(
             np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum()),
                       int(sunk.sum())]), op=MPI.SUM)
-        line = f"{int(count)} set changes" + (f", {int(sunk)} nodes frozen off a tool inside it" if sunk else "")
-        return Change(int(count), int(back), not sunk, line)
+        line = f"{int(count)} set changes"
+        if sunk_count:
+            depth = -min(g[sunk].min(initial=0.0) for g, _ in self.gaps(x, lam))
+            depth = self.comm.allreduce(depth, op=MPI.MAX)
+            line += f", {int(sunk_count)} nodes frozen off a tool inside it (up to {depth:.3g} deep)"
+        return Change(int(count), int(back), not sunk_count, line)
 
     def _settle_holder(self, x, under, net, lam) -> int:
         """The holder's state after a converged pass (PinchingHolder.settle): its nodes moved onto

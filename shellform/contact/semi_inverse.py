@@ -44,12 +44,13 @@ class SemiInverseDriver(Driver):
     `die` (default: the last tool); friction: mu, one coefficient for every tool or one per tool
     in contact order then the holder's (friction.py: CoulombFriction); drawbeads: DrawbeadLine's (drawbead.py);
     holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge);
-    ironing: the tools' faces bound the sheet's thickness where two face each other (ironing.py).
+    ironing: the tools' faces bound the sheet's thickness where two face each other (ironing.py);
+    pressure: a dead pressure along +z at lambda = 1 (Driver's).
     """
 
     def __init__(self, model, bcs, tools, travel, friction=0.0, holder=None, holder_force=0.0,
                  prescribed=None, contact=None, controls=None, checkpoint_dir=None, verbose=True, die=None,
-                 drawbeads=(), holder_edge=None, ironing=False):
+                 drawbeads=(), holder_edge=None, ironing=False, pressure=0.0):
         c = contact or ContactControls(penetration=1e-3 * model.thickness)
         t, E, comm = model.thickness, model.material[0], model.mesh.comm
         self.nodes = nodes = SheetNodes(model, bcs)
@@ -68,8 +69,8 @@ class SemiInverseDriver(Driver):
             self.contact.bound_by(self.ironing)  # between two tools the sheet's faces lie at the bounded thickness
         parts = [p for p in (nodes, self.drawbeads, self.contact, self.holder, self.ironing, self.friction)
                  if p is not None]
-        super().__init__(model, bcs, prescribed=prescribed, controls=controls, checkpoint_dir=checkpoint_dir,
-                         verbose=verbose, parts=parts, trace=c.trace)
+        super().__init__(model, bcs, prescribed=prescribed, pressure=pressure, controls=controls,
+                         checkpoint_dir=checkpoint_dir, verbose=verbose, parts=parts, trace=c.trace)
         self.tools, self.travel = self.contact.tools, self.contact.travel
 
     # -- measurements ----------------------------------------------------------------------------
