@@ -18,11 +18,12 @@ stiffening in a concave shoulder).
 The set is settled between Newton passes (``update``): nodes that penetrate a tool by more than
 `penetration` join it, nodes (not pinched) whose normal force turned tensile leave it, nodes
 drawn under the closed holder join the die; a node may switch at most `max_toggles` times per
-increment (no chattering). A node so frozen off the tools that penetrates one beyond `penetration`
-leaves the set unsettled: the increment is not accepted with a node inside a tool, and is cut back
-if further passes do not move it out (a shorter step needs fewer switches). A pass may end before it converges where the set will change anyway,
-once Newton's steps are below `early_step` penetrations (a step that long judges the set on an
-iterate still moving; after such passes fail, they end only near convergence, early_step 1).
+increment (no chattering). A node so frozen off the tools that penetrates one beyond
+`penetration` leaves the set unsettled: the increment is not accepted with a node inside a tool,
+and is cut back if further passes do not move it out (a shorter step needs fewer switches). A pass
+may end before it converges where the set will change anyway, once Newton's steps are below
+`early_step` penetrations (a step that long judges the set on an iterate still moving; after such
+passes fail, they end only near convergence, early_step 1).
 Newton's steps are bounded by `trust` thicknesses of nodal move (largest_move).
 
 A node's faces lie its half thickness h_i from its mid-surface. Where two tools face each other

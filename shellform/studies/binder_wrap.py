@@ -208,7 +208,8 @@ def wrapped(radius: float, n: int, closing: str = "holder", mat=None, comm=MPI.C
     sprung = release(driver)
     springback = (turned - turn(X[:owned], sprung.q.x.array.reshape(-1, BS)[:owned], comm)[0]) / arc
     return {"closing": closing, "R_mm": radius, "n": n, "pressure_MPa": pressure, "kappa_loaded": loaded,
-            "springback": springback, "kappa_sprung": loaded - springback, "overbend": float((np.max(path, axis=0)[inner] / final[inner]).max()),
+            "springback": springback, "kappa_sprung": loaded - springback,
+            "overbend": float((np.max(path, axis=0)[inner] / final[inner]).max()),
             "segment_spread": float(final[inner].max() / final[inner].min()),
             "increments": len(driver.history), "iterations": sum(h.iterations for h in driver.history),
             "unloading_plastic_layers": int(sum(h.plastic_layers for h in sprung.history)),
@@ -258,8 +259,9 @@ def run(outdir: Path, levels=LEVELS) -> list[dict]:
             say(f"binder wrap, {closing}, R {R:g} mm, n {n}: stopped: {err}")
             continue
         r = rows[-1]
-        say(f"binder wrap, {closing}, R {R:g} mm, n {n}: loaded {r['kappa_loaded']:.6g} ({100 * r['err_loaded']:+.2f} %), "
-            f"springback {r['springback']:.6g} ({100 * r['err_springback']:+.1f} %), overbend {r['overbend']:.3f}")
+        say(f"binder wrap, {closing}, R {R:g} mm, n {n}: loaded {r['kappa_loaded']:.6g} "
+            f"({100 * r['err_loaded']:+.2f} %), springback {r['springback']:.6g} "
+            f"({100 * r['err_springback']:+.1f} %), overbend {r['overbend']:.3f}")
     write_csv(outdir / "binder_wrap.csv", rows, COLUMNS)
     (outdir / "binder_wrap.md").write_text(markdown(as_written(rows)) + "".join(
         f"\n{r['closing']}, R {r['R_mm']:g} mm, {r['n']} cells along: stopped ({r['stopped']})\n" for r in stopped))
