@@ -71,7 +71,7 @@ def test_a_strip_closed_onto_an_elastic_binder_takes_its_radius_and_springs_back
     r = bw.with_closed_form(bw.wrapped(bw.ELASTIC_R, 16, "holder")[0])
     assert abs(r["err_loaded"]) < 0.2 * clearance_bound(r)  # the bound is 15 %: the elastic strip fills it little
     assert abs(r["err_springback"]) < 5e-3  # M / D = kappa: flat again
-    assert abs(r["kappa_sprung"]) < 1e-3 * r["kappa_loaded"]
+    assert abs(r["kappa_sprung"]) < 5e-3 * r["kappa_loaded"]  # the two measures of the curvature agree that far
     assert r["unloading_plastic_layers"] == 0 and r["M_over_D_kappa"] == pytest.approx(1.0, abs=1e-9)
 
 

@@ -74,25 +74,27 @@ def test_a_support_in_a_turned_frame_is_corrected_towards_its_value():
     assert np.allclose(delta.reshape(-1, BS)[bottom, 1], -1e-3, rtol=1e-12)
 
 
-def test_a_node_frozen_off_a_tool_inside_it_leaves_the_set_unsettled():
-    """A node whose switches are spent is not moved onto the tool it penetrates (no chattering),
-    but the set does not settle either: the increment is cut back rather than accepted with the
-    node inside the tool. Within the tolerance, or with a switch left, the set behaves as
-    before."""
+def test_a_node_frozen_off_a_tool_inside_it_joins_it_when_the_set_would_settle():
+    """A node whose switches are spent and that lies inside a tool when nothing else in the set
+    changes joins the tool (a last switch), so that no increment is accepted with a node inside
+    a tool; while other nodes still switch it waits (their passes may move it out). It cannot
+    leave again in the increment."""
     rect, model, bcs = plate()
     d = SemiInverseDriver(model, bcs, [FlatTool(0.5, 15.0, 15.0)], [-2.0], verbose=False)
     cs = d.contact
-    node = np.flatnonzero(cs.on(0))[0]  # under the punch, which touches the plate at the start
-    cs.assign(node, FREE)
+    on = np.flatnonzero(cs.on(0))  # under the punch, which touches the plate at the start
+    node, other = on[0], on[-1]
     q = d.q.x.array.reshape(-1, BS)
-    q[node, 2] += cs.gaps(d.positions(), 0.0)[0][0][node] + 5.0 * cs.controls.penetration  # 5 tolerances into it
+    for i in (node, other):
+        cs.assign(i, FREE)
+        q[i, 2] += cs.gaps(d.positions(), 0.0)[0][0][i] + 5.0 * cs.controls.penetration  # 5 tolerances inside
     cs.toggles[node] = cs.controls.max_toggles
-    change = cs.update(0.0, 0)
-    assert (change.changes, change.settled) == (0, False) and not cs.on(0)[node]
-    assert "1 nodes frozen off a tool inside it" in change.line
-    cs.toggles[node] = cs.controls.max_toggles - 1  # a switch left: it joins the punch
-    change = cs.update(0.0, 0)
-    assert (change.changes, change.settled) == (1, True) and cs.on(0)[node]
+    change = cs.update(0.0, 0)  # `other` may still switch: it joins, `node` waits
+    assert change.changes == 1 and cs.on(0)[other] and not cs.on(0)[node] and "frozen" not in change.line
+    change = cs.update(0.0, 0)  # nothing else changes: the frozen node joins
+    assert (change.changes, change.back) == (1, 1) and cs.on(0)[node]
+    assert "1 nodes frozen off a tool join it from 0.005 inside" in change.line
+    assert cs.toggles[node] == cs.controls.max_toggles + 1
 
 
 def test_flat_punch_on_a_plate_balances_the_supports_and_releases_on_unloading():

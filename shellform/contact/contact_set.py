@@ -18,9 +18,9 @@ stiffening in a concave shoulder).
 The set is settled between Newton passes (``update``): nodes that penetrate a tool by more than
 `penetration` join it, nodes (not pinched) whose normal force turned tensile leave it, nodes
 drawn under the closed holder join the die; a node may switch at most `max_toggles` times per
-increment (no chattering). A node so frozen off the tools that penetrates one beyond
-`penetration` leaves the set unsettled: the increment is not accepted with a node inside a tool,
-and is cut back if further passes do not move it out (a shorter step needs fewer switches). A pass
+increment (no chattering). A node so frozen off the tools that still penetrates one beyond
+`penetration` when the set would otherwise settle joins it, a last switch, and stays on it for the
+rest of the increment: no increment is accepted with a node inside a tool. A pass
 may end before it converges where the set will change anyway, once Newton's steps are below
 `early_step` penetrations (a step that long judges the set on an iterate still moving; after such
 passes fail, they end only near convergence, early_step 1).
@@ -305,7 +305,7 @@ class ContactSet(Part):
         the closed holder: onto the die) and those that leave theirs (not pinched, pulled off by
         more than `tensile` times the largest normal force), among the nodes that may still
         switch in this increment; with the tool each joining node joins, and the nodes frozen
-        off the tools that penetrate one (sunk, whose switches are spent)."""
+        off the tools that penetrate one (sunk: their switches are spent, update decides)."""
         on, can = self.tool != FREE, self.toggles < self.controls.max_toggles
         scale = max(self.comm.allreduce(float(np.abs(net).max(initial=0.0)), op=MPI.MAX), 1e-300)
         pinched = self.holder.pinched if self.holder is not None else np.zeros_like(on)
@@ -334,6 +334,13 @@ class ContactSet(Part):
         if self.holder is not None:
             holder_changes = self._settle_holder(x, under, net, lam)
         join, release, deepest, sunk = self._changes(x, lam, under, net, tensile=1e-8)
+        pending, sunk_count = self.comm.allreduce(
+            np.array([holder_changes + int((join | release).sum()), int(sunk.sum())]), op=MPI.SUM)
+        line = ""
+        if sunk_count and not pending:  # the set would settle with nodes frozen inside a tool: they join it
+            depth = self.comm.allreduce(-min(g[sunk].min(initial=0.0) for g, _ in self.gaps(x, lam)), op=MPI.MAX)
+            line = f", {int(sunk_count)} nodes frozen off a tool join it from {depth:.3g} inside"
+            join = sunk
         if self.controls.trace:
             X = self.nodes.X
             for i in np.flatnonzero(release | join):
@@ -349,15 +356,10 @@ class ContactSet(Part):
         self.pressure[switched] = 0.0
         self.toggles[switched] += 1
         self.frozen = int((self.toggles >= self.controls.max_toggles).sum())
-        count, back, sunk_count = self.comm.allreduce(
-            np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum()),
-                      int(sunk.sum())]), op=MPI.SUM)
-        line = f"{int(count)} set changes"
-        if sunk_count:
-            depth = -min(g[sunk].min(initial=0.0) for g, _ in self.gaps(x, lam))
-            depth = self.comm.allreduce(depth, op=MPI.MAX)
-            line += f", {int(sunk_count)} nodes frozen off a tool inside it (up to {depth:.3g} deep)"
-        return Change(int(count), int(back), not sunk_count, line)
+        count, back = self.comm.allreduce(
+            np.array([holder_changes + int(switched.sum()), holder_changes + int((self.toggles[switched] > 1).sum())]),
+            op=MPI.SUM)
+        return Change(int(count), int(back), True, f"{int(count)} set changes" + line)
 
     def _settle_holder(self, x, under, net, lam) -> int:
         """The holder's state after a converged pass (PinchingHolder.settle): its nodes moved onto
