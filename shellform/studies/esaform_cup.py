@@ -98,9 +98,15 @@ MODELS = {  # name: (label, the scene's material changes)
     # suspect (b) of the gap holder's d0: the fit's biaxial strain ratio left free (r_b = 1 assumed)
     "yld2000-gap-holder-free-rb": ("Yld2000-2d fitted without r_b, the holder at the 1.04 mm gap",
                                    {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.r_b": 0.0}),
+    # and the two assumptions left for its d0: the wall's ironing, the fit's exponent
+    "yld2000-gap-holder-wide-die": ("Yld2000-2d, the holder at the 1.04 mm gap, die radius 31.6 mm (no ironing at the wall)",
+                                    {"tools.holder": "gap", "tools.holder_gap": 1.04, "tools.die_radius": 31.6}),
+    "yld2000-gap-holder-a6": ("Yld2000-2d with a = 6 (fitted again), the holder at the 1.04 mm gap",
+                              {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.a": 6.0}),
 }
 HYPOTHESES = ("yld2000-wide-die", "yld2000-gap-holder")  # run apart: `hypotheses`'s docstring
 GAP_HOLDER = ("yld2000-gap-holder", "yld2000-gap-holder-free-rb")  # drawn through on n >= 16: `gap_holder`
+GAP_HOLDER_SUSPECTS = ("yld2000-gap-holder-wide-die", "yld2000-gap-holder-a6")  # on the first level only
 # github.com/stefanSCS/PolyN, CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt:
 # (angle in degrees, measured cup height in mm)
 MEASURED = np.array([
@@ -347,11 +353,14 @@ def hypotheses(out: Path, n: int = 12) -> list[dict]:
 
 def gap_holder(out: Path, levels=(16, 20, 24)) -> list[dict]:
     """Yld2000-2d with the holder at the benchmark's gap, with the fit's r_b assumed (1) and left
-    free (GAP_HOLDER), on the levels where it draws through, into their own folder:
+    free (GAP_HOLDER), on the levels where it draws through, and on the first of them each
+    assumption left for its d0 changed in turn (GAP_HOLDER_SUSPECTS), into their own folder:
 
         python -c "from shellform.studies import esaform_cup as e; e.gap_holder('docs/results/esaform_gap_holder')"
     """
-    return run(out, levels=levels, models=GAP_HOLDER)
+    run(out, levels=levels, models=GAP_HOLDER)
+    run(out, levels=levels[:1], models=GAP_HOLDER_SUSPECTS)
+    return tables(out, {**{m: levels for m in GAP_HOLDER}, **{m: levels[:1] for m in GAP_HOLDER_SUSPECTS}})
 
 
 def tables(out: Path, levels: dict) -> list[dict]:
