@@ -217,16 +217,18 @@ def stretched(tmp_path_factory):
 def test_stop_at_neck_ends_the_stroke_at_the_neck(stretched):
     """With stop_at_neck the stroke ends, as a finished run, at the first increment whose least
     stability is <= 0 (19.69 mm); the onset lies within that increment (19.58 mm), at the punch's
-    plan corner (initial (25, 31.25) mm), where the cell has thinned by 0.11 (its most strained
-    quadrature point, equivalent plastic strain 0.25, lost its stability first); summary.json
-    and the closing line say so."""
+    plan corner (initial (25, 31.25) mm, or its mirror (31.25, 25)), where the cell has thinned by
+    0.11 (its most strained quadrature point, equivalent plastic strain 0.25, lost its stability
+    first); summary.json and the closing line say so."""
     summary = stretched[True]
     neck = summary["neck"]
     assert summary["stopped"] is None and summary.exit_status() == 0
     assert summary["stroke_mm"] == pytest.approx(neck["increment_stroke_mm"])
     assert 19.0 < neck["stroke_mm"] <= neck["increment_stroke_mm"] < 20.0
     assert neck["stability"] <= 0.0
-    assert neck["initial_xy_mm"] == pytest.approx([25.0, 31.25])
+    # the punch's plan corner, (25, 31.25) mm or its mirror across the diagonal: the cup is symmetric
+    # about it, and which of the two mirror cells loses its stability first is the round-off's choice
+    assert sorted(neck["initial_xy_mm"]) == pytest.approx([25.0, 31.25])
     assert -0.12 < neck["thickness_strain"] < -0.09
     assert summary.closing_line().count(
         f"neck from stroke {neck['stroke_mm']:.4g} mm at initial ({neck['initial_xy_mm'][0]:.4g}, "
