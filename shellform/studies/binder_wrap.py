@@ -51,6 +51,7 @@ over it, the elastic unloading's own measure; the curvature after release is the
 writes binder_wrap.csv and binder_wrap.md.
 """
 
+import functools
 import time
 from pathlib import Path
 
@@ -86,8 +87,13 @@ U, W, U_X, W_X = (COMPONENTS.index(c) for c in ("u", "w", "u_x", "w_x"))
 
 def section_moment(mat, kappa: float, t: float = T, points: int = 400, steps: int = 4000):
     """(M, the residual stresses' largest ratio to the yield stress after elastic unloading) of
-    the plane-strain bend to curvature kappa (module docstring): M per unit width (N mm / mm)."""
-    E, nu = mat.E, mat.nu
+    the plane-strain bend to curvature kappa (module docstring): M per unit width (N mm / mm).
+    Computed once per material and curvature (every row of one radius asks for the same)."""
+    return _section_moment(mat.E, mat.nu, mat.K, mat.eps0, mat.n, float(kappa), t, points, steps)
+
+
+@functools.lru_cache(maxsize=None)
+def _section_moment(E, nu, K, eps0, n_swift, kappa, t, points, steps):
     C = E / (1 - nu * nu) * np.array([[1.0, nu], [nu, 1.0]])
     P = np.array([[1.0, -0.5], [-0.5, 1.0]])
     zeta, w = np.polynomial.legendre.leggauss(points)
@@ -95,7 +101,7 @@ def section_moment(mat, kappa: float, t: float = T, points: int = 400, steps: in
     s, p = np.zeros((points, 2)), np.zeros(points)
 
     def flow(p):  # Swift: (sigma, dsigma/dp)
-        return mat.K * (mat.eps0 + p) ** mat.n, mat.n * mat.K * (mat.eps0 + p) ** (mat.n - 1)
+        return K * (eps0 + p) ** n_swift, n_swift * K * (eps0 + p) ** (n_swift - 1)
 
     def equivalent(s):
         return np.sqrt(np.einsum("ni,ij,nj->n", s, P, s))
@@ -122,12 +128,17 @@ def section_moment(mat, kappa: float, t: float = T, points: int = 400, steps: in
         s[yielding], p[yielding] = x, p[yielding] + dp
         s[~yielding] = trial[~yielding]
     M = 2.0 * float(np.sum(w * s[:, 0] * z))
-    unloaded = s - (M / bending_stiffness(mat, t) * z)[:, None] * C[:, 0]  # unloaded by dkappa = M / D
+    unloaded = s - (M / _plate_stiffness(E, nu, t) * z)[:, None] * C[:, 0]  # unloaded by dkappa = M / D
     return M, float((equivalent(unloaded) / flow(p)[0]).max())
 
 
 def bending_stiffness(mat, t: float = T) -> float:
-    return mat.E * t**3 / (12 * (1 - mat.nu**2))
+    """D = E t^3 / (12 (1 - nu^2)), the plane-strain section's elastic moment per curvature."""
+    return _plate_stiffness(mat.E, mat.nu, t)
+
+
+def _plate_stiffness(E, nu, t):
+    return E * t**3 / (12 * (1 - nu * nu))
 
 
 def centre_line(X: np.ndarray, q: np.ndarray, comm):

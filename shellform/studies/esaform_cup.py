@@ -99,8 +99,9 @@ MODELS = {  # name: (label, the scene's material changes)
     "yld2000-gap-holder-free-rb": ("Yld2000-2d fitted without r_b, the holder at the 1.04 mm gap",
                                    {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.r_b": 0.0}),
     # and the two assumptions left for its d0: the wall's ironing, the fit's exponent
-    "yld2000-gap-holder-wide-die": ("Yld2000-2d, the holder at the 1.04 mm gap, die radius 31.6 mm (no ironing at the wall)",
-                                    {"tools.holder": "gap", "tools.holder_gap": 1.04, "tools.die_radius": 31.6}),
+    "yld2000-gap-holder-wide-die": (
+        "Yld2000-2d, the holder at the 1.04 mm gap, die radius 31.6 mm (no ironing at the wall)",
+        {"tools.holder": "gap", "tools.holder_gap": 1.04, "tools.die_radius": 31.6}),
     "yld2000-gap-holder-a6": ("Yld2000-2d with a = 6 (fitted again), the holder at the 1.04 mm gap",
                               {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.a": 6.0}),
 }
