@@ -81,7 +81,7 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            keys=("material.r", "material.m", "material.yield_function", "material.rolling_direction",
                  "material.r0", "material.r45", "material.r90", "material.r_b", "material.sigma0",
                  "material.sigma45", "material.sigma90", "material.sigma_b", "material.alpha", "material.a",
-                 "material.fit_angles", "material.fit_r", "material.fit_sigma"),
+                 "material.fit_angles", "material.fit_r", "material.fit_sigma", "material.coefficients"),
            doc="r != 1 or m != 2 in the Hill 1979 yield function, or a planar-anisotropic one "
                "(material.yield_function, its parameters, material.rolling_direction); it adds no term"),
     Effect("finite_strain", "sheet part", "shellform.material.hencky", (SHEET, TOOLS),

@@ -32,6 +32,10 @@ ANGLES = range(0, 91, 15)
 AA2090 = [0.4865, 1.3783, 0.7536, 1.0246, 1.0363, 0.9036, 1.2321, 1.4858]
 AA2090_DATA = {"sigma0": 1.0, "sigma45": 0.8114, "sigma90": 0.9102, "sigma_b": 1.0350,
                "r0": 0.2115, "r45": 1.5769, "r90": 0.6923, "r_b": 0.6700}
+# Poly6 fitted to the ESAFORM 2021 AA6016-T4 data (demos/esaform2021_cup.toml)
+POLY6_DATA = {"fit_angles": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0],
+              "fit_r": [0.526, 0.344, 0.301, 0.253, 0.294, 0.393, 0.601],
+              "fit_sigma": [1.000, 0.944, 0.913, 0.908, 0.898, 0.928, 0.983], "sigma_b": 1.0, "r_b": 1.0}
 
 
 def hill48_material(values, rolling_direction=0.0, hardening="swift", **curve):
@@ -101,9 +105,11 @@ def test_hill48_with_equal_r_is_hill79_with_m_2(r):
 
 def test_each_registered_criterion_is_dispatched_to_its_file():
     """The packed id of every name in CRITERIA is its place there and reaches that criterion's own
-    yield_function (the three give different values at this stress)."""
+    yield_function (the four give different values at this stress)."""
     mats = {"hill79": SheetMaterial(E, NU, 1.7, 6.0, "swift", K=500.0, eps0=0.02, n=0.25).pack(),
-            "hill48": hill48_material(STEEL, 25.0).pack(), "yld2000": yld2000_material(25.0).pack()}
+            "hill48": hill48_material(STEEL, 25.0).pack(), "yld2000": yld2000_material(25.0).pack(),
+            "poly6": SheetMaterial(E, NU, hardening="swift", K=500.0, eps0=0.02, n=0.25, yield_function="poly6",
+                                   rolling_direction=25.0, yield_parameters=POLY6_DATA).pack()}
     assert set(mats) == set(criteria.CRITERIA)
     s = np.array([210.0, -80.0, 55.0])
     values = [criteria.yield_function(*s, mat, 0)[0] for mat in mats.values()]

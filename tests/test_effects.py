@@ -70,7 +70,7 @@ def test_keys_of_an_effect_that_is_off_keep_their_defaults():
               "material.rolling_direction": 30.0, "material.r0": 1.8, "material.r45": 1.5, "material.r90": 2.3,
               "material.sigma0": 1.0, "material.sigma45": 1.0, "material.sigma90": 1.0, "material.sigma_b": 1.0, "material.r_b": 0.7, "material.a": 8.0,
               "material.alpha": [1.0] * 8, "material.fit_angles": [0.0, 45.0, 90.0], "material.fit_r": [0.5] * 3,
-              "material.fit_sigma": [1.0] * 3,
+              "material.fit_sigma": [1.0] * 3, "material.coefficients": [1.0] * 16,
               "material.Q": 100.0, "material.beta": 10.0, "material.swift_weight": 0.5, "material.flow_curve": "c.csv",
               "material.extrapolation": "swift", "material.forming_limit_curve": "flc.csv",
               "tools.friction": 0.1, "tools.punch_friction": 0.02, "tools.die_friction": 0.1,

@@ -133,19 +133,19 @@ class SheetMaterial:
         return mat
 
     def describe(self) -> str:
-        """One line: the yield function (its parameters, Yld2000-2d's alphas and errors where
-        fitted by least squares, the rolling direction) and the flow curve (a table's
+        """One line: the yield function (its parameters, what its ``describe`` adds, such as a
+        least-squares fit's parameters and errors, the rolling direction) and the flow curve (a table's
         extrapolation as fitted), for a run's log."""
         words = [f"yield function {self.yield_function}"]
         if self.yield_function == "hill79":
             words.append(f"r {self.r:g}, m {self.m:g}")
         else:
             words.append(", ".join(f"{k} {v}" for k, v in self.yield_parameters.items()))
-            if self.yield_function == "yld2000":
-                from shellform.material import yld2000, yld2000_fit
+            from shellform.material import criteria
 
-                if yld2000_fit.given(self.yield_parameters):
-                    words.append(yld2000.least_squares(self.yield_parameters, self.yield_parameters["a"]).text)
+            more = getattr(criteria.CRITERIA[self.yield_function], "describe", lambda values: "")
+            if text := more(self.yield_parameters):
+                words.append(text)
             words.append(f"rolling direction {float(self.rolling_direction):g} deg from x")
         words.append(f"hardening {self.hardening}")
         if self.hardening == "table":

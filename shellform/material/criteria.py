@@ -13,6 +13,12 @@ A yield function is one module of shellform/material/ that declares everything a
                               rolling-direction axes, and for order > 0 its gradient (3)
                               and Hessian (6, upper triangle), as one 10-tuple
 
+and may declare
+
+    check(values)             validates its keys before any computation (InputError naming the
+                              field): scene checking calls it
+    describe(values)          words for a run's log beyond its keys (a fit's errors), or ""
+
 Registering it is one line: its module's name in REGISTRY. Its id (the packed
 mat[CRITERION_]) is its place there; CRITERIA maps the NAMEs to the modules in that order.
 
@@ -32,7 +38,7 @@ from shellform import _jit as jit
 from shellform import registry
 from shellform.material.layout import CRITERION_
 
-REGISTRY = ("hill79", "hill48", "yld2000")  # modules of shellform.material; the id of each is its place here
+REGISTRY = ("hill79", "hill48", "yld2000", "poly6")  # modules of shellform.material; the id of each is its place here
 
 DECLARES = ("NAME", "PARAMETERS", "PLANAR_ISOTROPIC", "parameters", "yield_function")
 

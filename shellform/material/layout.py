@@ -11,7 +11,7 @@ from shellform.errors import InputError
 E_, NU_, LAW_, CRITERION_, COS_, SIN_, ROTATED_ = range(7)
 H_, NH = 8, 8  # hardening parameters
 A_, B_, C_ = H_, H_ + 1, H_ + 2
-PAR_, NPAR = H_ + NH, 12  # yield-function parameters
+PAR_, NPAR = H_ + NH, 16  # yield-function parameters
 TABLE_ = PAR_ + NPAR
 SIZE = TABLE_ + 1  # without a table
 LAW_ELASTIC, LAW_POWER, LAW_SWIFT, LAW_VOCE, LAW_SWIFT_VOCE, LAW_TABLE = range(6)

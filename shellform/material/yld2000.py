@@ -222,6 +222,17 @@ def predicted(alpha, a: float, angles) -> tuple[np.ndarray, np.ndarray, float, f
     return out[:, 0], out[:, 1], b["sigma_b"], b["r_b"]
 
 
+def check(values: dict) -> None:
+    """The least-squares data, where given, validated before the fit runs (InputError)."""
+    if yld2000_fit.given(values):
+        yld2000_fit.data(values)
+
+
+def describe(values: dict) -> str:
+    """The least-squares fit's alphas and largest errors, where the alphas are fitted so."""
+    return least_squares(values, values["a"]).text if yld2000_fit.given(values) and "a" in values else ""
+
+
 def least_squares(values: dict, a: float) -> yld2000_fit.Fit:
     """alpha1..alpha8 by least squares to the material's fit_angles, fit_r, fit_sigma, sigma_b
     (and r_b), and the table of their errors: yld2000_fit.fit told this criterion's predictions."""

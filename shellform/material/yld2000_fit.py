@@ -44,7 +44,9 @@ and the table of measured, fitted and error per datum (``Fit.rows``).
 **The design.** The fit lies below the criterion: it imports nothing of it, and is told the
 criterion's predictions (``fit(values, a, predicted)``). The criterion's parameters complete
 alpha from the lists with it (``yld2000.least_squares``), so the dependency runs one way,
-yld2000 -> yld2000_fit.
+yld2000 -> yld2000_fit. Poly6 (shellform.material.poly6) takes the same data, residuals and
+table (``data``, ``residuals``, ``table``) with its own solver, which adds a convexity
+constraint.
 """
 
 from dataclasses import dataclass
@@ -80,13 +82,14 @@ class Data:
 
 @dataclass(frozen=True)
 class Fit:
-    """alpha1..alpha8 (sigma_bar the rolling direction's uniaxial yield stress), the exponent,
-    and per datum a row {quantity, angle_deg, measured, fitted, error} (quantity "r",
+    """alpha1..alpha8 (sigma_bar the rolling direction's uniaxial yield stress; or another
+    criterion's parameters, such as Poly6's c1..c16), the exponent, and per datum a row {quantity, angle_deg, measured, fitted, error} (quantity "r",
     "sigma/sigma0", "sigma_b/sigma0" or "r_b"; angle_deg "" for the biaxial data)."""
 
     alpha: tuple[float, ...]
     a: float
     rows: tuple[dict, ...]
+    label: str = "alpha"  # the parameters' name in ``text`` (Poly6: its coefficients)
 
     def worst(self, quantity: str) -> float:
         """The largest |error| of the rows of that quantity."""
@@ -94,10 +97,10 @@ class Fit:
 
     @property
     def text(self) -> str:
-        """One line for a run's log: the alphas and the largest errors."""
+        """One line for a run's log: the parameters and the largest errors."""
         alphas = ", ".join(f"{x:.4f}" for x in self.alpha)
         b = [f"{r['quantity']} {r['error']:+.4f}" for r in self.rows if r["angle_deg"] == ""]
-        return (f"least-squares fit to {sum(r['quantity'] == 'r' for r in self.rows)} angles: alpha {alphas}; "
+        return (f"least-squares fit to {sum(r['quantity'] == 'r' for r in self.rows)} angles: {self.label} {alphas}; "
                 f"max |r error| {self.worst('r'):.4f}, max |sigma/sigma0 error| {self.worst('sigma/sigma0'):.4f}, "
                 + ", ".join(b))
 
@@ -115,11 +118,12 @@ def _list(values: dict, key: str) -> list[float]:
     return [number(f"material.{key}", x) for x in v]
 
 
-def data(values: dict) -> Data:
+def data(values: dict, least: int = ALPHAS, name: str = "Yld2000-2d") -> Data:
     """The least-squares data from the material's keys, validated: fit_angles in [0, 90] degrees,
     0 among them, none twice; fit_r and fit_sigma one positive number per angle; sigma_b > 0
-    (the units of fit_sigma), r_b > 0 where given; at least 8 equations; none of r0 .. sigma90
-    beside them. InputError names the field."""
+    (the units of fit_sigma), r_b > 0 where given; at least `least` equations (Yld2000-2d's 8
+    alphas; the criterion `name`); none of r0 .. sigma90 beside them. InputError names the
+    field."""
     for k in DIRECTIONAL:
         require(k not in values, f"material.{k}",
                 "give the directional data either as r0, r45, r90, sigma0, sigma45, sigma90 (fitted exactly) or as "
@@ -148,8 +152,8 @@ def data(values: dict) -> Data:
         require(r_b > 0.0, "material.r_b", f"must be positive, got {r_b:g}")
     s0 = sigma[angles.index(0.0)]
     d = Data(tuple(angles), tuple(r), tuple(x / s0 for x in sigma), sigma_b / s0, r_b)
-    require(d.count >= ALPHAS, "material.fit_angles",
-            f"Yld2000-2d has {ALPHAS} alphas: give at least {ALPHAS} data (here {len(angles)} angles give "
+    require(d.count >= least, "material.fit_angles",
+            f"{name} has {least} parameters: give at least {least} data (here {len(angles)} angles give "
             f"{d.count} with sigma_b{' and r_b' if r_b is not None else ''}: 2 per angle, 1 for sigma_b, 1 for r_b)")
     return d
 
@@ -183,6 +187,12 @@ def fit(values: dict, a: float, predicted) -> Fit:
     alpha, status = _solve(d, float(a), predicted)
     require(status > 0 and all(math.isfinite(x) for x in alpha), "material.fit_angles",
             f"the least-squares fit of Yld2000-2d (a = {a:g}) to these data did not converge (status {status})")
+    return table(d, alpha, a, predicted)
+
+
+def table(d: Data, alpha, a: float, predicted, label: str = "alpha") -> Fit:
+    """The Fit of the parameters alpha (named `label`): per datum of d the measured, fitted and
+    error (the criterion's predictions, ``fit``'s `predicted`)."""
     sigma, r, sigma_b, r_b = predicted(alpha, a, d.angles)
     s0 = sigma[d.angles.index(0.0)]
     rows = []
@@ -195,4 +205,4 @@ def fit(values: dict, a: float, predicted) -> Fit:
         rows.append({"quantity": "r_b", "angle_deg": "", "measured": d.r_b, "fitted": float(r_b)})
     for row in rows:
         row["error"] = row["fitted"] - row["measured"]
-    return Fit(alpha, float(a), tuple(rows))
+    return Fit(tuple(alpha), float(a), tuple(rows), label)

@@ -13,7 +13,7 @@ import numpy as np
 
 from shellform import effects as registry
 from shellform.errors import InputError
-from shellform.material import yld2000_fit
+from shellform.material.criteria import CRITERIA
 from shellform.mesh import outline
 from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
@@ -157,11 +157,12 @@ def _validate_material(s) -> None:
         require(not v or name in YIELD_PARAMETERS[mat.yield_function], f"material.{name}",
                 f"is no parameter of yield_function = {mat.yield_function!r} "
                 f"(its parameters: {', '.join(YIELD_PARAMETERS[mat.yield_function])})")
-    if mat.yield_function == "yld2000" and any(getattr(mat, k) for k in yld2000_fit.KEYS):
-        # the least-squares data (lists of one length, angles in [0, 90], positive r and stresses)
-        # are checked by yld2000_fit itself, here before the material's fit runs
-        yld2000_fit.data({**{k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0},
-                          **{k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)}})
+    check_keys = getattr(CRITERIA[mat.yield_function], "check", None)
+    if check_keys is not None:
+        # the criterion checks its own keys (a fit's data: lists of one length, angles in [0, 90],
+        # positive r and stresses), here before the material's fit runs
+        check_keys({**{k: getattr(mat, k) for k in ANISOTROPY_PARAMETERS if getattr(mat, k) != 0.0},
+                    **{k: list(getattr(mat, k)) for k in ANISOTROPY_LISTS if getattr(mat, k)}})
     for name, default in (("r", 1.0), ("m", 2.0)):
         require(mat.yield_function == "hill79" or getattr(mat, name) == default, f"material.{name}",
                 f"is Hill 1979's; yield_function = {mat.yield_function!r} takes its own parameters")

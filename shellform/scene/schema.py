@@ -116,6 +116,7 @@ class Material:
     fit_r: list[float] = field(default_factory=list, metadata={"items": "numbers"})
     fit_sigma: list[float] = field(default_factory=list, metadata={"items": "numbers"})
     a: float = 0.0  # yld2000: the exponent (6 bcc, 8 fcc; >= 2)
+    coefficients: list[float] = field(default_factory=list, metadata={"items": "numbers"})  # poly6: c1..c16
 
 
 # The yield functions' keys beyond Hill 1979's r and m (which SheetMaterial takes itself): the

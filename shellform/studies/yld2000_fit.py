@@ -1,13 +1,16 @@
-"""Yld2000-2d fitted by least squares to the ESAFORM 2021 AA6016-T4 data: the errors per angle.
+"""Yld2000-2d and Poly6 fitted by least squares to the ESAFORM 2021 AA6016-T4 data: the errors
+per angle.
 
-    shellform study yld2000-fit --out docs/results/yld2000_fit        # about 5 s
+    shellform study yld2000-fit --out docs/results/yld2000_fit        # about 20 s
 
 The data and the exponent are those of demos/esaform2021_cup.toml's [material] (r values and
 yield stresses at 0, 15, ..., 90 degrees to the rolling direction, sigma_b, r_b; their sources
 are in docs/references.md); shellform.material.yld2000_fit states the fit and its weights.
 Writes residuals.csv (quantity, angle, measured, fitted, error: one row per datum),
-alphas.csv and fit.png (r and sigma/sigma0 against the angle, measured and fitted on a
-1-degree grid). tests/test_yld2000_fit.py checks the table against a new fit.
+alphas.csv, the same of Poly6 fitted to the same data (poly6_residuals.csv,
+poly6_coefficients.csv; shellform.material.poly6) and fit.png (r and sigma/sigma0 against the
+angle, measured and both fits on a 1-degree grid). tests/test_yld2000_fit.py and
+tests/test_poly6.py check the tables against new fits.
 """
 
 from pathlib import Path
@@ -15,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from shellform import demos, scene
-from shellform.material import yld2000, yld2000_fit
+from shellform.material import poly6, yld2000, yld2000_fit
 from shellform.results.log import say
 from shellform.results.tables import write_csv
 
@@ -26,6 +29,12 @@ def fit_of(path=SCENE) -> yld2000_fit.Fit:
     """The least-squares fit of a scene's [material] (its yield_parameters as the run takes them)."""
     values = scene.load(path).hill79().yield_parameters
     return yld2000.least_squares(values, values["a"])
+
+
+def poly6_fit_of(path=SCENE) -> yld2000_fit.Fit:
+    """Poly6 fitted to the same data (the scene's fit lists, sigma_b and r_b)."""
+    values = scene.load(path).hill79().yield_parameters
+    return poly6.least_squares({k: v for k, v in values.items() if k in poly6.PARAMETERS})
 
 
 def run(outdir, path=SCENE) -> list[dict]:
@@ -41,11 +50,16 @@ def run(outdir, path=SCENE) -> list[dict]:
         say(f"{r['quantity']:>15s} {angle}  measured {r['measured']:.4f}  fitted {r['fitted']:.4f}  "
             f"error {r['error']:+.4f}")
     say(fit.text)
-    plot(outdir / "fit.png", fit)
+    other = poly6_fit_of(path)
+    write_csv(outdir / "poly6_residuals.csv", list(other.rows), yld2000_fit.COLUMNS)
+    write_csv(outdir / "poly6_coefficients.csv", [{"name": f"c{i + 1}", "value": x} for i, x in enumerate(other.alpha)],
+              ["name", "value"])
+    say("poly6: " + other.text)
+    plot(outdir / "fit.png", fit, other)
     return rows
 
 
-def plot(path: Path, fit: yld2000_fit.Fit) -> None:
+def plot(path: Path, fit: yld2000_fit.Fit, other: yld2000_fit.Fit) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -53,12 +67,15 @@ def plot(path: Path, fit: yld2000_fit.Fit) -> None:
 
     theta = np.linspace(0.0, 90.0, 91)
     sigma, r, _, _ = yld2000.predicted(fit.alpha, fit.a, theta)
+    sigma6, r6, _, _ = poly6.predicted(other.alpha, other.a, theta)
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.6))
-    for ax, quantity, curve, label in ((axes[0], "r", r, "r value"),
-                                       (axes[1], "sigma/sigma0", sigma / sigma[0], "sigma / sigma0")):
+    for ax, quantity, curve, curve6, label in ((axes[0], "r", r, r6, "r value"),
+                                               (axes[1], "sigma/sigma0", sigma / sigma[0], sigma6 / sigma6[0],
+                                                "sigma / sigma0")):
         data = [row for row in fit.rows if row["quantity"] == quantity]
         ax.plot([row["angle_deg"] for row in data], [row["measured"] for row in data], "ko", label="measured")
         ax.plot(theta, curve, "C0-", label=f"Yld2000-2d, a = {fit.a:g}, least squares")
+        ax.plot(theta, curve6, "C1--", label="Poly6, least squares, convex")
         ax.set_xlabel("angle to the rolling direction (degrees)")
         ax.set_ylabel(label)
         ax.set_xticks(range(0, 91, 15))
