@@ -109,10 +109,20 @@ MODELS = {  # name: (label, the scene's material changes)
     "poly6-gap-holder": ("Poly6 fitted to the same data, the holder at the 1.04 mm gap",
                          {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.yield_function": "poly6",
                           "material.a": 0.0}),
+    # and the part of the yield locus the data leave free: PolyN's own Poly6 of this sheet
+    # (stefanSCS/PolyN, CM_Data/AA6016_Parameters/AA6016T4_P6_deg6_Err_and_Coeff.txt)
+    "poly6-polyn-gap-holder": ("Poly6 with PolyN's coefficients, the holder at the 1.04 mm gap", {
+        "tools.holder": "gap", "tools.holder_gap": 1.04, "material.yield_function": "poly6", "material.a": 0.0,
+        "material.fit_angles": [], "material.fit_r": [], "material.fit_sigma": [], "material.sigma_b": 0.0,
+        "material.r_b": 0.0, "material.coefficients": [
+            1.0, -2.0681520314547837, 6.868121692756133, -10.55917923225223, 7.39574824063295, -2.4963948816328827,
+            1.1083550209357307, 14.776642100088036, -2.5895869697823395, 6.271731518600609, -3.255124509890244,
+            17.457821116365473, 27.153617310650084, 9.892687851715271, 27.98321894414102, 13.513644513646144]}),
 }
 HYPOTHESES = ("yld2000-wide-die", "yld2000-gap-holder")  # run apart: `hypotheses`'s docstring
 GAP_HOLDER = ("yld2000-gap-holder", "yld2000-gap-holder-free-rb")  # drawn through on n >= 16: `gap_holder`
 GAP_HOLDER_SUSPECTS = ("yld2000-gap-holder-wide-die", "yld2000-gap-holder-a6")  # on the first level only
+POLY6 = ("poly6-gap-holder", "poly6-polyn-gap-holder")  # the criterion with more coefficients: `poly6`
 # github.com/stefanSCS/PolyN, CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt:
 # (angle in degrees, measured cup height in mm)
 MEASURED = np.array([
@@ -367,6 +377,15 @@ def gap_holder(out: Path, levels=(16, 20, 24)) -> list[dict]:
     run(out, levels=levels, models=GAP_HOLDER)
     run(out, levels=levels[:1], models=GAP_HOLDER_SUSPECTS)
     return tables(out, {**{m: levels for m in GAP_HOLDER}, **{m: levels[:1] for m in GAP_HOLDER_SUSPECTS}})
+
+
+def poly6(out: Path, levels=(16, 20, 24)) -> list[dict]:
+    """The gap holder's cup with Poly6 (shellform.material.poly6) fitted to the demo's data, and
+    with PolyN's own Poly6 of the sheet (POLY6), into their own folder:
+
+        python -c "from shellform.studies import esaform_cup as e; e.poly6('docs/results/esaform_poly6')"
+    """
+    return run(out, levels=levels, models=POLY6)
 
 
 def tables(out: Path, levels: dict) -> list[dict]:
