@@ -93,6 +93,26 @@ def test_the_measured_profile():
     assert m["folded"]["h0"] == pytest.approx(0.5 * (34.498 + 35.25), abs=0.01)
 
 
+def test_the_peers_profiles(tmp_path):
+    """A quadrant mirrored onto the circle repeats it at 180 - a, 180 + a and 360 - a; the peers'
+    Poly6 profiles (PolyN at 4c62d0af): PolyN's Abaqus run h(0) 34.208, h(90) 34.525 and the
+    45-degree trough 31.00 mm read off its file's points (d0 3.21, d90 3.52), the paper's Fig. 103
+    d0 1.87, d90 1.80; written to peers.csv."""
+    q = np.array([(0.0, 1.0), (30.0, 2.0), (90.0, 3.0)])
+    c = ec.circle(q)
+    assert c[0].tolist() == [0.0, 1.0] and c[-1].tolist() == [360.0, 1.0]
+    got = ec.measured_at([0.0, 30.0, 150.0, 210.0, 330.0, 90.0, 270.0], c)
+    np.testing.assert_allclose(got, [1.0, 2.0, 2.0, 2.0, 2.0, 3.0, 3.0], atol=1e-12)
+    rows = {r["peer"]: r for r in ec.peers(tmp_path)}
+    abaqus = rows["PolyN's Abaqus run of its Poly6"]
+    assert abaqus["h0"] == pytest.approx(34.2081) and abaqus["h90"] == pytest.approx(34.5245)
+    assert abaqus["h45"] == pytest.approx(31.00, abs=0.01)
+    assert abaqus["d0"] == pytest.approx(3.21, abs=0.01) and abaqus["d90"] == pytest.approx(3.52, abs=0.01)
+    fig103 = rows["the benchmark's Poly6 participant (Fig. 103)"]
+    assert fig103["d0"] == pytest.approx(1.87, abs=0.01) and fig103["d90"] == pytest.approx(1.80, abs=0.01)
+    assert (tmp_path / "peers.csv").exists()
+
+
 def test_errors_and_goals():
     m = ec.measured()
     r = {f"h{a:g}": m["first"][f"h{a:g}"] for a in ec.ANGLES}

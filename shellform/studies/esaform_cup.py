@@ -132,6 +132,31 @@ MEASURED = np.array([
     (224.764, 34.0467), (239.871, 33.7252), (255.365, 34.2284), (269.698, 34.7177), (285.192, 34.7038),
     (299.912, 33.83), (315.019, 33.152), (330.127, 33.2009), (344.846, 33.9698), (359.954, 34.515)])
 
+# Published profiles of peers' Poly6 models of this cup (first quadrant, angle in degrees, height
+# in mm; the peers mirror it), from github.com/stefanSCS/PolyN at commit 4c62d0af,
+# CM_Data/AA6016_CupProfiles: references, not the truth (docs/cup.md).
+PEERS = {
+    # AA6016T4_P6_deg6_FEdata_cpdrwPROFILE_angle.txt: PolyN's own Abaqus run of its Poly6 (the
+    # coefficients of model poly6-polyn-gap-holder, the holder at 1.04 mm); every second point
+    "PolyN's Abaqus run of its Poly6": np.array([
+    (0.0000, 34.2081), (3.8298, 34.0980), (7.6596, 33.7956), (11.4894, 33.3697), (15.3191, 32.9052),
+    (19.1489, 32.4689), (22.9787, 32.0898), (26.8085, 31.7664), (30.6383, 31.4915), (34.4681, 31.2656),
+    (38.2979, 31.0983), (42.1277, 31.0052), (45.9574, 30.9993), (49.7872, 31.0791), (53.6170, 31.2282),
+    (57.4468, 31.4273), (61.2766, 31.6677), (65.1064, 31.9555), (68.9362, 32.3104), (72.7660, 32.7515),
+    (76.5957, 33.2685), (80.4255, 33.7990), (84.2553, 34.2405), (88.0851, 34.4914), (90.0000, 34.5245)
+    ]),
+    # AA6016T4_Poly6_Dig_Profile_Fig103_angle.txt: the benchmark paper's Fig. 103, a participant's
+    # Poly6 profile, digitised
+    "the benchmark's Poly6 participant (Fig. 103)": np.array([
+    (0.0000, 34.0919), (3.0042, 34.1155), (6.8963, 34.1527), (11.0998, 34.1257), (14.0578, 34.0210),
+    (16.3931, 33.8892), (18.8841, 33.7102), (20.5966, 33.4941), (22.1534, 33.3016), (24.0216, 33.0955),
+    (26.0455, 32.8591), (28.0694, 32.6531), (30.8718, 32.4673), (33.6741, 32.3255), (36.4764, 32.2478),
+    (44.4163, 32.2208), (51.7335, 32.2174), (55.1585, 32.2647), (57.9609, 32.3896), (59.9848, 32.5653),
+    (62.6314, 32.7747), (65.1224, 33.0280), (66.9906, 33.2374), (68.5474, 33.4569), (70.5713, 33.6461),
+    (72.5952, 33.8352), (74.9305, 33.9838), (77.2658, 34.0818), (79.7567, 34.1155), (83.1818, 34.0953),
+    (86.2955, 34.0480), (90.0000, 34.0176)
+    ]),
+}
 
 def _periodic(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The distinct rows over one period (the last repeats the first), sorted."""
@@ -379,13 +404,35 @@ def gap_holder(out: Path, levels=(16, 20, 24)) -> list[dict]:
     return tables(out, {**{m: levels for m in GAP_HOLDER}, **{m: levels[:1] for m in GAP_HOLDER_SUSPECTS}})
 
 
+def circle(quadrant: np.ndarray) -> np.ndarray:
+    """A profile over the circle (the last row repeating the first, as MEASURED) from its first
+    quadrant mirrored about 90, 180 and 270 degrees."""
+    a, h = quadrant[:, 0], quadrant[:, 1]
+    angles = np.concatenate([a, 180.0 - a[::-1][1:], 180.0 + a[1:], 360.0 - a[::-1][1:]])
+    return np.column_stack([angles, np.concatenate([h, h[::-1][1:], h[1:], h[::-1][1:]])])
+
+
+def peers(out: Path) -> list[dict]:
+    """The peers' published profiles (PEERS) as rows of the runs' table: h at the angles, the mean,
+    d0, d90 and their errors against the measured profile; written to peers.csv."""
+    rows = []
+    for name, quadrant in PEERS.items():
+        ref = measured(circle(quadrant))
+        rows.append(with_errors({"peer": name, **ref["first"], "mean": ref["mean"]}))
+    write_csv(Path(out) / "peers.csv", rows, list(rows[0]))
+    return rows
+
+
 def poly6(out: Path, levels=(16, 20, 24)) -> list[dict]:
     """The gap holder's cup with Poly6 (shellform.material.poly6) fitted to the demo's data, and
-    with PolyN's own Poly6 of the sheet (POLY6), into their own folder:
+    with PolyN's own Poly6 of the sheet (POLY6), into their own folder, and the peers' published
+    profiles of their Poly6 (peers.csv):
 
         python -c "from shellform.studies import esaform_cup as e; e.poly6('docs/results/esaform_poly6')"
     """
-    return run(out, levels=levels, models=POLY6)
+    rows = run(out, levels=levels, models=POLY6)
+    peers(out)
+    return rows
 
 
 def tables(out: Path, levels: dict) -> list[dict]:
