@@ -1,7 +1,8 @@
 """Poly6 (shellform.material.poly6): von Mises's coefficients give von Mises; a fitted set's
 gradient and Hessian against central differences; the ESAFORM 2021 AA6016-T4 fit's errors and
 its convexity on a dense sample; the material point's r and yield stress against the closed
-forms; the consistent tangent with a turned rolling direction; input errors naming the field."""
+forms; input errors naming the field (the consistent tangent with a turned rolling direction:
+tests/test_anisotropy.py, with the other criteria)."""
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
@@ -11,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from criterion_checks import assert_derivatives
 from shellform import demos, scene
 from shellform.errors import InputError
-from shellform.material import PAR_, SheetMaterial, criteria, flow_stress, point, poly6, return_map, yld2000
+from shellform.material import PAR_, SheetMaterial, criteria, point, poly6, yld2000
 
 E, NU, SY = 70000.0, 0.33, 140.0
 # PolyN's Poly6 for AA6016-T4 (stefanSCS/PolyN, CM_Data/AA6016_Parameters/AA6016T4_P6_deg6_Err_and_Coeff.txt)
@@ -63,17 +65,7 @@ def test_value_and_derivatives_of_the_fitted_set(fit):
     mat = material(25.0).pack()
     assert criteria.yield_function(100.0, 20.0, 30.0, mat, 2) == poly6.yield_function(100.0, 20.0, 30.0, mat, 2)
     rng = np.random.default_rng(7)
-    for s in list(rng.normal(scale=150.0, size=(10, 3))) + [np.array([1.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])]:
-        out = np.array(poly6.yield_function(*s, mat, 2))
-        assert s @ out[1:4] == pytest.approx(out[0], rel=1e-13)
-        h = 1e-6 * np.linalg.norm(s)
-        H = out[[4, 5, 6, 5, 7, 8, 6, 8, 9]].reshape(3, 3)
-        for j in range(3):
-            ds = np.zeros(3)
-            ds[j] = h
-            up, dn = np.array(poly6.yield_function(*(s + ds), mat, 2)), np.array(poly6.yield_function(*(s - ds), mat, 2))
-            assert (up[0] - dn[0]) / (2 * h) == pytest.approx(out[1 + j], rel=1e-7, abs=1e-9)
-            np.testing.assert_allclose((up[1:4] - dn[1:4]) / (2 * h), H[:, j], rtol=1e-5, atol=1e-7 * np.abs(H).max())
+    assert_derivatives(mat, list(rng.normal(scale=150.0, size=(10, 3))) + [[1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
 
 
 def test_the_esaform_fit_meets_the_data_and_is_convex(fit):
@@ -140,29 +132,6 @@ def test_material_point_r_and_yield_stress_against_the_closed_forms(theta):
     i = ESAFORM["fit_angles"].index(float(theta))
     assert r == pytest.approx(ESAFORM["fit_r"][i], abs=1e-3)
     assert sigma == pytest.approx(ESAFORM["fit_sigma"][i] / ESAFORM["fit_sigma"][0], abs=6e-3)
-
-
-def test_consistent_tangent_with_a_turned_rolling_direction():
-    """Rolling direction 30 degrees: return_map's D equals the central difference of its stress
-    to 1e-6 and is symmetric, on plastic steps in 7 directions."""
-    mat = material(30.0).pack()
-    ey = flow_stress(0.0, mat)[0] / E
-    ep_n, p_n = np.array([0.003, -0.001, 0.002]), 0.004
-    h = 1e-5 * ey
-
-    def rmap(e):
-        s, D, ep = np.zeros(3), np.zeros((3, 3)), np.zeros(3)
-        _, st = return_map(e, ep_n, p_n, mat, s, D, ep)
-        return s, D, st
-
-    for d in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [1.0, -0.3, 0.8], [0.2, 0.5, -1.5],
-              [-1.0, 0.4, 0.6], [0.0, 0.0, 1.0]]:
-        e = ep_n + 3 * ey * np.array(d) / np.linalg.norm(d)
-        _, D, st = rmap(e)
-        assert st == 1
-        D_fd = np.column_stack([(rmap(e + dj)[0] - rmap(e - dj)[0]) / (2 * h) for dj in h * np.eye(3)])
-        assert np.abs(D - D_fd).max() <= 1e-6 * np.abs(D).max()
-        np.testing.assert_allclose(D, D.T, atol=1e-12 * E)
 
 
 @pytest.mark.parametrize("material_keys, field", [
