@@ -82,6 +82,12 @@ def as_written(rows: list[dict]) -> list[dict]:
     return [{k: (float(_cell(v)) if isinstance(v, float) else v) for k, v in row.items()} for row in rows]
 
 
+def markdown_table(headers: list[str], rows: list[list[str]]) -> str:
+    """A Markdown table: the header row, its rule, and one row per list of cells (text as given)."""
+    lines = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
+    return "\n".join(lines + ["| " + " | ".join(cells) + " |" for cells in rows]) + "\n"
+
+
 def write_csv(path: Path, rows: list[dict], columns: list[str]) -> None:
     """rows to path with the given columns, floats to six significant digits."""
     if MPI.COMM_WORLD.rank != 0:

@@ -66,7 +66,7 @@ from shellform.mesh import rectangle
 from shellform.nonlinear.driver import Controls, ConvergenceFailure
 from shellform.nonlinear.model import SheetModel
 from shellform.results.log import say
-from shellform.results.tables import as_written, write_csv
+from shellform.results.tables import as_written, markdown_table, write_csv
 from shellform.studies.strip import mild_steel
 from shellform.tools.cylinder import Cylinder
 
@@ -245,14 +245,14 @@ COLUMNS = ["closing", "R_mm", "n", "pressure_MPa", "kappa_closed", "kappa_loaded
 
 
 def markdown(rows: list[dict]) -> str:
-    head = ("| wrapped by | R (mm) | cells along | loaded curvature, error | springback: closed form M / D, "
-            "measured, error | curvature after release | largest overbend, spread of the segments | "
-            "increments, iterations | s |\n" + "|---" * 9 + "|\n")
-    return head + "".join(
-        f"| {r['closing']} | {r['R_mm']:g} | {r['n']} | {r['kappa_loaded']:.6g}, {100 * r['err_loaded']:+.2f} % | "
-        f"{r['springback_closed']:.6g}, {r['springback']:.6g}, {100 * r['err_springback']:+.1f} % | "
-        f"{r['kappa_sprung']:.4g} | {r['overbend']:.3f}, {r['segment_spread']:.3f} | "
-        f"{r['increments']}, {r['iterations']} | {r['seconds']:.0f} |\n" for r in rows)
+    return markdown_table(
+        ["wrapped by", "R (mm)", "cells along", "loaded curvature, error",
+         "springback: closed form M / D, measured, error", "curvature after release",
+         "largest overbend, spread of the segments", "increments, iterations", "s"],
+        [[r["closing"], f"{r['R_mm']:g}", f"{r['n']}", f"{r['kappa_loaded']:.6g}, {100 * r['err_loaded']:+.2f} %",
+          f"{r['springback_closed']:.6g}, {r['springback']:.6g}, {100 * r['err_springback']:+.1f} %",
+          f"{r['kappa_sprung']:.4g}", f"{r['overbend']:.3f}, {r['segment_spread']:.3f}",
+          f"{r['increments']}, {r['iterations']}", f"{r['seconds']:.0f}"] for r in rows])
 
 
 def run(outdir: Path, levels=LEVELS) -> list[dict]:

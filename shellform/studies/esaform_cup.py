@@ -72,7 +72,7 @@ import numpy as np
 from shellform.contact.run import run as run_cup
 from shellform.results import run_folder
 from shellform.results.log import say
-from shellform.results.tables import as_written, write_csv
+from shellform.results.tables import as_written, markdown_table, write_csv
 from shellform.results.vtu import last_step, read_vtu
 from shellform.studies.cup_convergence import richardson
 from shellform.studies.cup_hard import folder, variant
@@ -366,9 +366,9 @@ def plot(path: Path, rows: list[dict], out: Path) -> None:
     plt.close(fig)
 
 
-def run(out: Path, levels=LEVELS, models=("yld2000", "hill48"), stroke=None) -> list[dict]:
-    """Draw each yield function on each level into out (a run of the same scene by the same
-    code there is reused), then the tables and the plot."""
+def draw(out: Path, levels, models, stroke=None) -> None:
+    """Draw each model on each level into out (a run of the same scene by the same code there is
+    reused)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     stroke = stroke or (QUICK_STROKE if tuple(levels) == QUICK_LEVELS else STROKE)
@@ -380,6 +380,11 @@ def run(out: Path, levels=LEVELS, models=("yld2000", "hill48"), stroke=None) -> 
                 continue
             say(f"esaform-cup: {run_name(model, n)}")
             run_cup(s, d)
+
+
+def run(out: Path, levels=LEVELS, models=("yld2000", "hill48"), stroke=None) -> list[dict]:
+    """Draw each model on each level into out (``draw``), then the tables and the plot."""
+    draw(out, levels, models, stroke)
     return tables(out, {m: levels for m in models})
 
 
@@ -399,8 +404,8 @@ def gap_holder(out: Path, levels=(16, 20, 24)) -> list[dict]:
 
         python -c "from shellform.studies import esaform_cup as e; e.gap_holder('docs/results/esaform_gap_holder')"
     """
-    run(out, levels=levels, models=GAP_HOLDER)
-    run(out, levels=levels[:1], models=GAP_HOLDER_SUSPECTS)
+    draw(out, levels, GAP_HOLDER)
+    draw(out, levels[:1], GAP_HOLDER_SUSPECTS)
     return tables(out, {**{m: levels for m in GAP_HOLDER}, **{m: levels[:1] for m in GAP_HOLDER_SUSPECTS}})
 
 
@@ -414,12 +419,16 @@ def circle(quadrant: np.ndarray) -> np.ndarray:
 
 def peers(out: Path) -> list[dict]:
     """The peers' published profiles (PEERS) as rows of the runs' table: h at the angles, the mean,
-    d0, d90 and their errors against the measured profile; written to peers.csv."""
+    d0, d90 and their errors against the measured profile; written to peers.csv and peers.md."""
     rows = []
     for name, quadrant in PEERS.items():
         ref = measured(circle(quadrant))
         rows.append(with_errors({"peer": name, **ref["first"], "mean": ref["mean"]}))
     write_csv(Path(out) / "peers.csv", rows, list(rows[0]))
+    (Path(out) / "peers.md").write_text(markdown_table(  # the CSV's own digits
+        ["peer's published profile", *(f"h({a:g})" for a in ANGLES), "mean", "d0 (error)", "d90 (error)"],
+        [[r["peer"], *(f"{r[f'h{a:g}']:.2f}" for a in ANGLES), f"{r['mean']:.2f} ({_pct(r['err_mean'])})",
+          f"{r['d0']:.2f} ({_pct(r['err_d0'])})", f"{r['d90']:.2f} ({_pct(r['err_d90'])})"] for r in as_written(rows)]))
     return rows
 
 
@@ -430,9 +439,9 @@ def poly6(out: Path, levels=(16, 20, 24)) -> list[dict]:
 
         python -c "from shellform.studies import esaform_cup as e; e.poly6('docs/results/esaform_poly6')"
     """
-    rows = run(out, levels=levels, models=POLY6)
+    draw(out, levels, POLY6)
     peers(out)
-    return rows
+    return tables(out, {m: levels for m in POLY6})
 
 
 def tables(out: Path, levels: dict) -> list[dict]:

@@ -29,7 +29,7 @@ import numpy as np
 from shellform import demos, scene
 from shellform.contact.run import run as run_cup
 from shellform.results.log import say
-from shellform.results.tables import write_csv
+from shellform.results.tables import markdown_table, write_csv
 
 SCENE = demos.path("nakajima.toml")
 SPECIMEN = demos.path("meshes/nakajima/specimen.geo")
@@ -125,15 +125,16 @@ def tables(out: Path, widths, n: int) -> list[dict]:
 
 
 def markdown(rows: list[dict]) -> str:
-    head = ("| waist W mm | cells | limit dome height mm | where | critical element (initial x, y) "
-            "| major, minor at the limit | minor / major | peak thinning | peak force kN "
-            "| increments, iterations, cut-backs | worst balance | wall s |\n" + "|---" * 12 + "|\n")
-    return head + "".join(
-        f"| {'disc' if r['width_mm'] >= 180 else format(r['width_mm'], 'g')} | {r['cells']} | "
-        f"{r['limit_stroke_mm']:.2f}{'' if r['reached'] else ' (not reached)'} | {r['where']} | "
-        f"({r['x0_mm']:.1f}, {r['y0_mm']:.1f}) | {r['major']:.3f}, {r['minor']:.3f} | {r['strain_ratio']:.2f} | "
-        f"{r['peak_thinning']:.3f} | {r['punch_force_kN']:.1f} | {r['increments']}, {r['newton_iterations']}, "
-        f"{r['cutbacks']} | {r['worst_balance']:.1e} | {r['wall_s']:.0f} |\n" for r in rows)
+    return markdown_table(
+        ["waist W mm", "cells", "limit dome height mm", "where", "critical element (initial x, y)",
+         "major, minor at the limit", "minor / major", "peak thinning", "peak force kN",
+         "increments, iterations, cut-backs", "worst balance", "wall s"],
+        [[f"{'disc' if r['width_mm'] >= 180 else format(r['width_mm'], 'g')}", f"{r['cells']}",
+          f"{r['limit_stroke_mm']:.2f}{'' if r['reached'] else ' (not reached)'}", f"{r['where']}",
+          f"({r['x0_mm']:.1f}, {r['y0_mm']:.1f})", f"{r['major']:.3f}, {r['minor']:.3f}", f"{r['strain_ratio']:.2f}",
+          f"{r['peak_thinning']:.3f}", f"{r['punch_force_kN']:.1f}",
+          f"{r['increments']}, {r['newton_iterations']}, {r['cutbacks']}", f"{r['worst_balance']:.1e}",
+          f"{r['wall_s']:.0f}"] for r in rows])
 
 
 def plot(path: Path, rows: list[dict], paths: list[dict]) -> None:
