@@ -118,11 +118,17 @@ MODELS = {  # name: (label, the scene's material changes)
             1.0, -2.0681520314547837, 6.868121692756133, -10.55917923225223, 7.39574824063295, -2.4963948816328827,
             1.1083550209357307, 14.776642100088036, -2.5895869697823395, 6.271731518600609, -3.255124509890244,
             17.457821116365473, 27.153617310650084, 9.892687851715271, 27.98321894414102, 13.513644513646144]}),
+    # and the data: Poly6 fitted to the other laboratory's (UA) r values and stresses of the same
+    # sheet (docs/references.md section 6; its biaxial stress 0.975, r_b = 1 assumed as above)
+    "poly6-ua-gap-holder": ("Poly6 fitted to the UA data, the holder at the 1.04 mm gap", {
+        "tools.holder": "gap", "tools.holder_gap": 1.04, "material.yield_function": "poly6", "material.a": 0.0,
+        "material.fit_r": [0.525, 0.359, 0.303, 0.248, 0.297, 0.387, 0.429],
+        "material.fit_sigma": [1.000, 0.963, 0.904, 0.867, 0.919, 0.948, 0.926], "material.sigma_b": 0.975}),
 }
 HYPOTHESES = ("yld2000-wide-die", "yld2000-gap-holder")  # run apart: `hypotheses`'s docstring
 GAP_HOLDER = ("yld2000-gap-holder", "yld2000-gap-holder-free-rb")  # drawn through on n >= 16: `gap_holder`
 GAP_HOLDER_SUSPECTS = ("yld2000-gap-holder-wide-die", "yld2000-gap-holder-a6")  # on the first level only
-POLY6 = ("poly6-gap-holder", "poly6-polyn-gap-holder")  # the criterion with more coefficients: `poly6`
+POLY6 = ("poly6-gap-holder", "poly6-polyn-gap-holder", "poly6-ua-gap-holder")  # more coefficients: `poly6`
 # github.com/stefanSCS/PolyN, CM_Data/AA6016_CupProfiles/AA6016_Experiment_Fig91_CupProfile_angle.txt:
 # (angle in degrees, measured cup height in mm)
 MEASURED = np.array([
@@ -433,9 +439,9 @@ def peers(out: Path) -> list[dict]:
 
 
 def poly6(out: Path, levels=(16, 20, 24)) -> list[dict]:
-    """The gap holder's cup with Poly6 (shellform.material.poly6) fitted to the demo's data, and
-    with PolyN's own Poly6 of the sheet (POLY6), into their own folder, and the peers' published
-    profiles of their Poly6 (peers.csv):
+    """The gap holder's cup with Poly6 (shellform.material.poly6) fitted to the demo's data, with
+    PolyN's own Poly6 of the sheet, and fitted to the other laboratory's data (POLY6), into their
+    own folder, and the peers' published profiles of their Poly6 (peers.csv, peers.md):
 
         python -c "from shellform.studies import esaform_cup as e; e.poly6('docs/results/esaform_poly6')"
     """
