@@ -38,7 +38,8 @@ def test_the_pages_tables_are_their_studies_files():
     assert included == {f"results/{s}.md" for s in (
         "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper",
         "cup_strain/cup_strain", "esaform_cup/esaform_cup", "esaform_gap_holder/esaform_cup",
-        "esaform_hypotheses/esaform_hypotheses", "binder_wrap/binder_wrap", "levy/levy",
+        "esaform_hypotheses/esaform_hypotheses", "esaform_poly6/esaform_cup", "esaform_poly6/peers",
+        "binder_wrap/binder_wrap", "levy/levy",
         "nakajima/nakajima", "numisheet93/numisheet",
         "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic", "plate/plate_convergence",
         "rollup/rollup", "sensitivity/sensitivity", "shell/shell_convergence", "strip/strip")}
