@@ -42,6 +42,7 @@ import math
 import numpy as np
 
 from shellform.material import yld2000_fit
+from shellform.material.yld2000 import directions
 from shellform.material.layout import PAR_, number, require
 from shellform import _jit as jit
 
@@ -155,8 +156,6 @@ def constraint_directions(n=CONSTRAINT_POINTS) -> np.ndarray:
     of RING_POINTS in the plane z = 0 (the normal stresses' yield locus, where the fitted
     polynomial bends most sharply: without the ring it turns concave between the lattice's
     points there)."""
-    from shellform.material.yld2000 import directions
-
     d = directions(n)
     phi = np.linspace(-0.25 * math.pi, 0.75 * math.pi, RING_POINTS, endpoint=False)
     ring = np.column_stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)])
@@ -196,7 +195,6 @@ def _solve(d: yld2000_fit.Data) -> tuple[tuple[float, ...], bool, str]:
     for the constraint at infinitely many directions) at the EXCHANGE worst of the check
     directions where the solution is not convex there, solved again, up to ROUNDS times."""
     from scipy.optimize import minimize
-    from shellform.material.yld2000 import directions
 
     points = constraint_directions()
     check = np.vstack([quarter(directions(CHECK_POINTS)), quarter(directions())])
@@ -258,8 +256,6 @@ def parameters(values: dict) -> list[float]:
     """The packed c1..c16, given (scaled to c1 = 1) or from the least-squares fit; InputError
     (naming material.coefficients or material.fit_angles) where sigma_bar vanishes somewhere or
     is not convex on yld2000's guard directions."""
-    from shellform.material.yld2000 import directions
-
     given = values.get("coefficients")
     if given:
         require(not yld2000_fit.given(values), "material.coefficients",
