@@ -83,6 +83,17 @@ def test_the_esaform_fit_meets_the_data_and_is_convex(fit):
     assert poly6.parameters(ESAFORM) == list(fit.alpha)
 
 
+def test_the_runs_log_names_the_fit(fit):
+    """The criterion's `describe` (the registry's optional hook) adds the fit's coefficients and
+    largest errors to the run's material line; given coefficients add nothing."""
+    line = material().describe()
+    assert "yield function poly6" in line and fit.text in line
+    assert "max |r error| 0.0008" in line and "coefficients 1.0000, -2.06" in line
+    given = SheetMaterial(E, NU, hardening="swift", K=400.0, eps0=0.01, n=0.22, yield_function="poly6",
+                          yield_parameters={"coefficients": POLYN})
+    assert "least-squares" not in given.describe()
+
+
 def test_the_studys_table_is_a_new_fits(fit):
     """docs/results/yld2000_fit/poly6_residuals.csv (`shellform study yld2000-fit`, 6 significant
     digits), which docs/material.md cites: per datum the measured, fitted and error of a new fit,
