@@ -37,12 +37,11 @@ def materials():
     if "yld2000" in criteria.CRITERIA:
         aa2090 = {"alpha": [0.4865, 1.3783, 0.7536, 1.0246, 1.0363, 0.9036, 1.2321, 1.4858], "a": 8.0}
         out["yld2000 a=8"] = SheetMaterial(206e3, 0.3, **SWIFT, yield_function="yld2000", yield_parameters=aa2090)
-    if "poly6" in criteria.CRITERIA:  # PolyN's Poly6 of AA6016-T4 (tests/test_poly6.py)
-        polyn = [1.0, -2.0681520314547837, 6.868121692756133, -10.55917923225223, 7.39574824063295,
-                 -2.4963948816328827, 1.1083550209357307, 14.776642100088036, -2.5895869697823395, 6.271731518600609,
-                 -3.255124509890244, 17.457821116365473, 27.153617310650084, 9.892687851715271, 27.98321894414102,
-                 13.513644513646144]
-        out["poly6"] = SheetMaterial(206e3, 0.3, **SWIFT, yield_function="poly6", yield_parameters={"coefficients": polyn})
+    if "poly6" in criteria.CRITERIA:  # PolyN's Poly6 of AA6016-T4, as the ESAFORM study runs it
+        from shellform.studies.esaform_cup import POLYN
+
+        out["poly6"] = SheetMaterial(206e3, 0.3, **SWIFT, yield_function="poly6",
+                                     yield_parameters={"coefficients": POLYN})
     return out
 
 

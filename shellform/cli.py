@@ -52,7 +52,8 @@ STUDIES = {
     "cup-convergence": "the aluminium and the square cup on a sequence of meshes: observed orders, Richardson estimates",
     "pinch-edge": "the holder's edge load resolved below the thickness: a plane-strain strip",
     "nakajima": "the Nakajima test: specimens of eleven widths stretched to the forming limit, their strain paths",
-    "yld2000-fit": "Yld2000-2d and Poly6 fitted by least squares to the ESAFORM 2021 AA6016-T4 data: errors per angle",
+    "yld2000-fit": "Yld2000-2d and Poly6 fitted by least squares to the ESAFORM 2021 AA6016-T4 data: "
+                   "errors per angle",
     "esaform-cup": "the ESAFORM 2021 cup drawn through, Yld2000-2d and Hill 1948: the height profile against the measured one",
     "sensitivity": "sensitivities from one run against closed forms and finite differences of two runs",
 }

@@ -16,12 +16,10 @@ from criterion_checks import assert_derivatives
 from shellform import demos, scene
 from shellform.errors import InputError
 from shellform.material import PAR_, SheetMaterial, criteria, point, poly6, yld2000
+from shellform.studies import esaform_cup
 
 E, NU, SY = 70000.0, 0.33, 140.0
-# PolyN's Poly6 for AA6016-T4 (stefanSCS/PolyN, CM_Data/AA6016_Parameters/AA6016T4_P6_deg6_Err_and_Coeff.txt)
-POLYN = [1.0, -2.0681520314547837, 6.868121692756133, -10.55917923225223, 7.39574824063295, -2.4963948816328827,
-         1.1083550209357307, 14.776642100088036, -2.5895869697823395, 6.271731518600609, -3.255124509890244,
-         17.457821116365473, 27.153617310650084, 9.892687851715271, 27.98321894414102, 13.513644513646144]
+POLYN = esaform_cup.POLYN  # PolyN's Poly6 for AA6016-T4, as the ESAFORM study runs it
 TABLE = Path(__file__).resolve().parents[1] / "docs" / "results" / "yld2000_fit" / "poly6_residuals.csv"
 ESAFORM = {k: v for k, v in scene.load(demos.path("esaform2021_cup.toml")).hill79().yield_parameters.items()
            if k in poly6.PARAMETERS}

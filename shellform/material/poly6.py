@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from shellform.material import yld2000_fit
-from shellform.material.yld2000 import directions
+from shellform.material.yld2000 import directions, smallest_curvature
 from shellform.material.layout import PAR_, number, require
 from shellform import _jit as jit
 
@@ -170,18 +170,14 @@ def _mat(c) -> np.ndarray:
 
 def uniaxial(c, theta_deg: float) -> tuple[float, float]:
     """(sigma(theta)/sigma_bar, r(theta)) of uniaxial tension at theta degrees to the rolling
-    direction (yld2000_fit's docstring: the flow normal to the yield surface)."""
-    co, si = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
-    sb, a0, a1, a2 = yield_function(co * co, si * si, co * si, _mat(c), 1)[:4]
-    return 1.0 / sb, (si * si * a0 + co * co * a1 - si * co * a2) / -(a0 + a1)
+    direction (yld2000_fit.uniaxial)."""
+    return yld2000_fit.uniaxial(yield_function, _mat(c), theta_deg)
 
 
 def predicted(c, a, angles) -> tuple[np.ndarray, np.ndarray, float, float]:
     """sigma(theta)/sigma_bar and r(theta) at the angles, sigma_b/sigma_bar and r_b of the
-    coefficients c (a, the exponent yld2000_fit passes, is 6 here and unused)."""
-    out = np.array([uniaxial(c, t) for t in angles]).reshape(-1, 2)
-    sb, a0, a1, _ = yield_function(1.0, 1.0, 0.0, _mat(c), 1)[:4]
-    return out[:, 0], out[:, 1], 1.0 / sb, a1 / a0
+    coefficients c (yld2000_fit.predictions; a, the exponent yld2000_fit passes, is unused)."""
+    return yld2000_fit.predictions(yield_function, _mat(c), angles)
 
 
 def quarter(d: np.ndarray) -> np.ndarray:
@@ -240,16 +236,8 @@ def describe(values: dict) -> str:
 
 def convexity(c, points) -> float:
     """The smallest curvature of sigma_bar over the directions (rows of points): the smallest
-    eigenvalue of Hess sigma_bar times sigma_bar (-inf where f <= 0)."""
-    mat, low = _mat(c), math.inf
-    for s in points:
-        out = yield_function(s[0], s[1], s[2], mat, 2)
-        if not out[0] > 0.0:
-            return -math.inf
-        h = out[4:]
-        H = np.array([[h[0], h[1], h[2]], [h[1], h[3], h[4]], [h[2], h[4], h[5]]])
-        low = min(low, float(np.linalg.eigvalsh(H).min() * out[0]))
-    return low
+    eigenvalue of Hess sigma_bar times sigma_bar (-inf where f <= 0; yld2000.smallest_curvature)."""
+    return smallest_curvature(yield_function, _mat(c), points)
 
 
 def parameters(values: dict) -> list[float]:
@@ -273,6 +261,7 @@ def parameters(values: dict) -> list[float]:
         c = list(least_squares(values).alpha)
         field = "material.fit_angles"
     low = convexity(c, directions())
-    require(low > -math.inf, field, "give a Poly6 that vanishes or turns negative for some stress: not a yield function")
+    require(low > -math.inf, field,
+            "give a Poly6 that vanishes or turns negative for some stress: not a yield function")
     require(low >= -1e-9, field, f"give a Poly6 that is not convex (curvature {low:.3g})")
     return c

@@ -107,15 +107,6 @@ def parameters(values: dict) -> list[float]:
             f"must list the 8 coefficients alpha1..alpha8, got {alpha!r}")
     alpha = [number("material.alpha", v) for v in alpha]
     par = pack(alpha, a)
-    mat = np.zeros(PAR_ + len(par))
-    mat[PAR_:] = par
-    values_, hessians = [], []
-    for s in directions():
-        out = yield_function(s[0], s[1], s[2], mat, 2)
-        values_.append(out[0])
-        h = out[4:]
-        hessians.append(np.array([[h[0], h[1], h[2]], [h[1], h[3], h[4]], [h[2], h[4], h[5]]]))
-    values_ = np.array(values_)
     # sigma_bar vanishes at s != 0 exactly where rho', rho'' and m'' all do: where the linear map
     # s -> (d', t', d'', t'', m'') has a kernel
     L1, L2 = matrices(alpha)
@@ -123,7 +114,7 @@ def parameters(values: dict) -> list[float]:
     sv = np.linalg.svd(rows, compute_uv=False)
     require(sv[-1] > 1e-8 * sv[0], "material.alpha",
             "gives a yield function that vanishes for some stress (an open yield surface): not a yield function")
-    low = min(np.linalg.eigvalsh(H).min() * sb for H, sb in zip(hessians, values_))
+    low = smallest_curvature(yield_function, _packed(alpha, a), directions())
     require(low >= -1e-9, "material.alpha", f"gives a yield function that is not convex (curvature {low:.3g})")
     return par
 
@@ -190,36 +181,49 @@ def yield_function(s0, s1, s2, mat, order):
     return sb, a0, a1, a2, h00, h01, h02, h11, h12, h22
 
 
-def uniaxial(alpha, a, theta_deg: float) -> tuple[float, float]:
-    """(sigma(theta)/sigma_bar, r(theta)) of uniaxial tension at theta degrees to the rolling
-    direction: s = sigma (c^2, s^2, c s) on the yield surface, r the width over the thickness
-    plastic strain rate of the flow a(s): (s^2 a0 + c^2 a1 - s c a2) / -(a0 + a1)."""
+def _packed(alpha, a) -> np.ndarray:
     mat = np.zeros(PAR_ + 11)
     mat[PAR_:] = pack(alpha, a)
-    c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
-    sb, a0, a1, a2 = yield_function(c * c, s * s, c * s, mat, 1)[:4]
-    return 1.0 / sb, (s * s * a0 + c * c * a1 - s * c * a2) / -(a0 + a1)
+    return mat
+
+
+def uniaxial(alpha, a, theta_deg: float) -> tuple[float, float]:
+    """(sigma(theta)/sigma_bar, r(theta)) of uniaxial tension at theta degrees to the rolling
+    direction (yld2000_fit.uniaxial)."""
+    return yld2000_fit.uniaxial(yield_function, _packed(alpha, a), theta_deg)
 
 
 def uniaxial_and_biaxial(alpha, a) -> dict:
     """The yield stresses (over sigma_bar) and Lankford values of the alpha set: sigma and r at
     0, 45, 90 degrees to the rolling direction, and the balanced-biaxial sigma_b and
     r_b = dep22/dep11 there."""
-    mat = np.zeros(PAR_ + 11)
-    mat[PAR_:] = pack(alpha, a)
+    sigma, r, sigma_b, r_b = predicted(alpha, a, (0, 45, 90))
     out = {}
-    for theta in (0, 45, 90):
-        out[f"sigma{theta}"], out[f"r{theta}"] = uniaxial(alpha, a, theta)
-    sb, a0, a1, _ = yield_function(1.0, 1.0, 0.0, mat, 1)[:4]
-    out["sigma_b"], out["r_b"] = 1.0 / sb, a1 / a0
+    for theta, s, rr in zip((0, 45, 90), sigma, r):
+        out[f"sigma{theta}"], out[f"r{theta}"] = float(s), float(rr)
+    out["sigma_b"], out["r_b"] = sigma_b, r_b
     return out
 
 
 def predicted(alpha, a: float, angles) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """sigma(theta)/sigma_bar and r(theta) at the angles, sigma_b/sigma_bar and r_b, of the set."""
-    out = np.array([uniaxial(alpha, a, t) for t in angles]).reshape(-1, 2)
-    b = uniaxial_and_biaxial(alpha, a)
-    return out[:, 0], out[:, 1], b["sigma_b"], b["r_b"]
+    """sigma(theta)/sigma_bar and r(theta) at the angles, sigma_b/sigma_bar and r_b, of the set
+    (yld2000_fit.predictions)."""
+    return yld2000_fit.predictions(yield_function, _packed(alpha, a), angles)
+
+
+def smallest_curvature(yield_function, mat: np.ndarray, points) -> float:
+    """The smallest curvature of a packed material's sigma_bar over the directions (rows of
+    points): the smallest eigenvalue of Hess sigma_bar times sigma_bar, -inf where sigma_bar
+    vanishes (every criterion's convexity guard: this one's ``parameters``, poly6's)."""
+    low = math.inf
+    for s in points:
+        out = yield_function(s[0], s[1], s[2], mat, 2)
+        if not out[0] > 0.0:
+            return -math.inf
+        h = out[4:]
+        H = np.array([[h[0], h[1], h[2]], [h[1], h[3], h[4]], [h[2], h[4], h[5]]])
+        low = min(low, float(np.linalg.eigvalsh(H).min() * out[0]))
+    return low
 
 
 def check(values: dict) -> None:

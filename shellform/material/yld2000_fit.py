@@ -16,9 +16,9 @@ s^2 g0 + c^2 g1 - s c g2 and -(g0 + g1), so the Lankford value is
     r(theta) = (s^2 g0 + c^2 g1 - s c g2) / -(g0 + g1).
 
 **Balanced-biaxial tension** u = (1, 1, 0): sigma_b = sigma_bar / sigma_bar(1, 1, 0) and
-r_b = dep22/dep11 = g1/g0 (1 for an isotropic sheet). ``yld2000.uniaxial`` and
-``yld2000.uniaxial_and_biaxial`` evaluate these forms, ``yld2000.predicted`` at the data's
-angles.
+r_b = dep22/dep11 = g1/g0 (1 for an isotropic sheet). ``uniaxial`` and ``predictions``
+evaluate these forms for any criterion's packed yield function (``yld2000.predicted`` and
+``poly6.predicted`` at the data's angles).
 
 **The fit.** The data are r_i and sigma_i at the angles theta_i of ``fit_angles`` (0 among
 them), sigma_b and optionally r_b. The stresses count as ratios q_i = sigma_i/sigma(0),
@@ -83,8 +83,9 @@ class Data:
 @dataclass(frozen=True)
 class Fit:
     """alpha1..alpha8 (sigma_bar the rolling direction's uniaxial yield stress; or another
-    criterion's parameters, such as Poly6's c1..c16), the exponent, and per datum a row {quantity, angle_deg, measured, fitted, error} (quantity "r",
-    "sigma/sigma0", "sigma_b/sigma0" or "r_b"; angle_deg "" for the biaxial data)."""
+    criterion's parameters, such as Poly6's c1..c16), the exponent, and per datum a row
+    {quantity, angle_deg, measured, fitted, error} (quantity "r", "sigma/sigma0",
+    "sigma_b/sigma0" or "r_b"; angle_deg "" for the biaxial data)."""
 
     alpha: tuple[float, ...]
     a: float
@@ -103,6 +104,24 @@ class Fit:
         return (f"least-squares fit to {sum(r['quantity'] == 'r' for r in self.rows)} angles: {self.label} {alphas}; "
                 f"max |r error| {self.worst('r'):.4f}, max |sigma/sigma0 error| {self.worst('sigma/sigma0'):.4f}, "
                 + ", ".join(b))
+
+
+def uniaxial(yield_function, mat: np.ndarray, theta_deg: float) -> tuple[float, float]:
+    """(sigma(theta)/sigma_bar, r(theta)) of uniaxial tension at theta degrees to the rolling
+    direction for a packed material's yield_function(s0, s1, s2, mat, order): s = sigma
+    (c^2, s^2, c s) on the yield surface, r the width over the thickness plastic strain rate of
+    the flow a(s): (s^2 a0 + c^2 a1 - s c a2) / -(a0 + a1)."""
+    c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
+    sb, a0, a1, a2 = yield_function(c * c, s * s, c * s, mat, 1)[:4]
+    return 1.0 / sb, (s * s * a0 + c * c * a1 - s * c * a2) / -(a0 + a1)
+
+
+def predictions(yield_function, mat: np.ndarray, angles) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """sigma(theta)/sigma_bar and r(theta) at the angles (``uniaxial``), and the balanced-biaxial
+    sigma_b/sigma_bar and r_b = dep22/dep11 = a1/a0 at (1, 1, 0)."""
+    out = np.array([uniaxial(yield_function, mat, t) for t in angles]).reshape(-1, 2)
+    sb, a0, a1, _ = yield_function(1.0, 1.0, 0.0, mat, 1)[:4]
+    return out[:, 0], out[:, 1], 1.0 / sb, a1 / a0
 
 
 def given(values: dict) -> bool:

@@ -84,6 +84,13 @@ QUICK_LEVELS = (6,)
 QUICK_STROKE = 4.0
 ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)
 GOALS = {"mean": 0.03, "d0": 0.25, "d90": 0.25}
+GAP = {"tools.holder": "gap", "tools.holder_gap": 1.04}  # the benchmark's holder at its fixed gap
+POLY6_KEYS = {"material.yield_function": "poly6", "material.a": 0.0}  # Poly6 on the demo's fit data
+# PolyN's own Poly6 of this sheet (stefanSCS/PolyN at 4c62d0af,
+# CM_Data/AA6016_Parameters/AA6016T4_P6_deg6_Err_and_Coeff.txt), c1..c16 in poly6's order
+POLYN = [1.0, -2.0681520314547837, 6.868121692756133, -10.55917923225223, 7.39574824063295, -2.4963948816328827,
+         1.1083550209357307, 14.776642100088036, -2.5895869697823395, 6.271731518600609, -3.255124509890244,
+         17.457821116365473, 27.153617310650084, 9.892687851715271, 27.98321894414102, 13.513644513646144]
 MODELS = {  # name: (label, the scene's material changes)
     "yld2000": ("Yld2000-2d, least squares (the demo)", {}),
     "hill48": ("Hill 1948, r0 / r45 / r90", {
@@ -93,36 +100,27 @@ MODELS = {  # name: (label, the scene's material changes)
     # the two assumptions docs/cup.md suspects, one at a time on the demo's Yld2000-2d
     "yld2000-wide-die": ("Yld2000-2d, die radius 31.6 mm (1.6 mm clearance: the rim not ironed)",
                          {"tools.die_radius": 31.6}),
-    "yld2000-gap-holder": ("Yld2000-2d, the holder at the benchmark's 1.04 mm gap",
-                           {"tools.holder": "gap", "tools.holder_gap": 1.04}),
+    "yld2000-gap-holder": ("Yld2000-2d, the holder at the benchmark's 1.04 mm gap", GAP),
     # suspect (b) of the gap holder's d0: the fit's biaxial strain ratio left free (r_b = 1 assumed)
     "yld2000-gap-holder-free-rb": ("Yld2000-2d fitted without r_b, the holder at the 1.04 mm gap",
-                                   {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.r_b": 0.0}),
+                                   {**GAP, "material.r_b": 0.0}),
     # and the two assumptions left for its d0: the wall's ironing, the fit's exponent
     "yld2000-gap-holder-wide-die": (
         "Yld2000-2d, the holder at the 1.04 mm gap, die radius 31.6 mm (no ironing at the wall)",
-        {"tools.holder": "gap", "tools.holder_gap": 1.04, "tools.die_radius": 31.6}),
+        {**GAP, "tools.die_radius": 31.6}),
     "yld2000-gap-holder-a6": ("Yld2000-2d with a = 6 (fitted again), the holder at the 1.04 mm gap",
-                              {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.a": 6.0}),
+                              {**GAP, "material.a": 6.0}),
     # the criterion: Poly6, 16 coefficients fitted to the same data (Yld2000-2d's 8 leave errors that
     # alternate in sign along the angle)
-    "poly6-gap-holder": ("Poly6 fitted to the same data, the holder at the 1.04 mm gap",
-                         {"tools.holder": "gap", "tools.holder_gap": 1.04, "material.yield_function": "poly6",
-                          "material.a": 0.0}),
-    # and the part of the yield locus the data leave free: PolyN's own Poly6 of this sheet
-    # (stefanSCS/PolyN, CM_Data/AA6016_Parameters/AA6016T4_P6_deg6_Err_and_Coeff.txt)
+    "poly6-gap-holder": ("Poly6 fitted to the same data, the holder at the 1.04 mm gap", {**GAP, **POLY6_KEYS}),
+    # and the part of the yield locus the data leave free: PolyN's own coefficients instead of the fit
     "poly6-polyn-gap-holder": ("Poly6 with PolyN's coefficients, the holder at the 1.04 mm gap", {
-        "tools.holder": "gap", "tools.holder_gap": 1.04, "material.yield_function": "poly6", "material.a": 0.0,
-        "material.fit_angles": [], "material.fit_r": [], "material.fit_sigma": [], "material.sigma_b": 0.0,
-        "material.r_b": 0.0, "material.coefficients": [
-            1.0, -2.0681520314547837, 6.868121692756133, -10.55917923225223, 7.39574824063295, -2.4963948816328827,
-            1.1083550209357307, 14.776642100088036, -2.5895869697823395, 6.271731518600609, -3.255124509890244,
-            17.457821116365473, 27.153617310650084, 9.892687851715271, 27.98321894414102, 13.513644513646144]}),
+        **GAP, **POLY6_KEYS, "material.fit_angles": [], "material.fit_r": [], "material.fit_sigma": [],
+        "material.sigma_b": 0.0, "material.r_b": 0.0, "material.coefficients": POLYN}),
     # and the data: Poly6 fitted to the other laboratory's (UA) r values and stresses of the same
     # sheet (docs/references.md section 6; its biaxial stress 0.975, r_b = 1 assumed as above)
     "poly6-ua-gap-holder": ("Poly6 fitted to the UA data, the holder at the 1.04 mm gap", {
-        "tools.holder": "gap", "tools.holder_gap": 1.04, "material.yield_function": "poly6", "material.a": 0.0,
-        "material.fit_r": [0.525, 0.359, 0.303, 0.248, 0.297, 0.387, 0.429],
+        **GAP, **POLY6_KEYS, "material.fit_r": [0.525, 0.359, 0.303, 0.248, 0.297, 0.387, 0.429],
         "material.fit_sigma": [1.000, 0.963, 0.904, 0.867, 0.919, 0.948, 0.926], "material.sigma_b": 0.975}),
 }
 HYPOTHESES = ("yld2000-wide-die", "yld2000-gap-holder")  # run apart: `hypotheses`'s docstring
