@@ -39,6 +39,7 @@ def test_the_pages_tables_are_their_studies_files():
         "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper",
         "cup_strain/cup_strain", "esaform_cup/esaform_cup", "esaform_gap_holder/esaform_cup",
         "esaform_hypotheses/esaform_hypotheses", "esaform_poly6/esaform_cup", "esaform_poly6/peers",
+        "yld2000_fit/residuals", "yld2000_fit/poly6_residuals",
         "binder_wrap/binder_wrap", "levy/levy",
         "nakajima/nakajima", "numisheet93/numisheet",
         "numisheet_cost/numisheet_cost", "outlines/outlines", "plastic/plastic", "plate/plate_convergence",

@@ -85,6 +85,9 @@ def test_the_esaform_fit_has_the_documented_errors():
     s = scene.from_dict({"effects": SHEET, "material": {**VOCE, **ESAFORM}})
     np.testing.assert_allclose(s.hill79().pack()[PAR_:PAR_ + 11], yld2000.pack(fit.alpha, 8.0), rtol=1e-12)
     assert study.fit_of().alpha == fit.alpha
+    table = study.markdown(fit, "Yld2000-2d").splitlines()  # docs/material.md includes the study's table
+    assert len(table) == 2 + 7 + 1 and table[4] == "| 30 | 0.301 | 0.2677 | -0.0333 | 0.913 | 0.9124 | -0.0006 |"
+    assert table[-1].startswith("| biaxial | r_b 1 | 1.0010 | +0.0010 | sigma_b/sigma0 1 | 0.9991 |")
 
 
 def test_our_yld2000_gives_polyns_table_for_the_siegen_alphas():

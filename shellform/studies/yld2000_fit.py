@@ -6,9 +6,9 @@ per angle.
 The data and the exponent are those of demos/esaform2021_cup.toml's [material] (r values and
 yield stresses at 0, 15, ..., 90 degrees to the rolling direction, sigma_b, r_b; their sources
 are in docs/references.md); shellform.material.yld2000_fit states the fit and its weights.
-Writes residuals.csv (quantity, angle, measured, fitted, error: one row per datum),
-alphas.csv, the same of Poly6 fitted to the same data (poly6_residuals.csv,
-poly6_coefficients.csv; shellform.material.poly6) and fit.png (r and sigma/sigma0 against the
+Writes residuals.csv (quantity, angle, measured, fitted, error: one row per datum) and
+residuals.md (the table docs/material.md includes), alphas.csv, the same of Poly6 fitted to the same data (poly6_residuals.csv,
+poly6_residuals.md, poly6_coefficients.csv; shellform.material.poly6) and fit.png (r and sigma/sigma0 against the
 angle, measured and both fits on a 1-degree grid). tests/test_yld2000_fit.py and
 tests/test_poly6.py check the tables against new fits.
 """
@@ -20,7 +20,7 @@ import numpy as np
 from shellform import demos, scene
 from shellform.material import poly6, yld2000, yld2000_fit
 from shellform.results.log import say
-from shellform.results.tables import write_csv
+from shellform.results.tables import as_written, markdown_table, write_csv
 
 SCENE = demos.path("esaform2021_cup.toml")
 
@@ -50,13 +50,33 @@ def run(outdir, path=SCENE) -> list[dict]:
         say(f"{r['quantity']:>15s} {angle}  measured {r['measured']:.4f}  fitted {r['fitted']:.4f}  "
             f"error {r['error']:+.4f}")
     say(fit.text)
+    (outdir / "residuals.md").write_text(markdown(fit, "Yld2000-2d"))
     other = poly6_fit_of(path)
     write_csv(outdir / "poly6_residuals.csv", list(other.rows), yld2000_fit.COLUMNS)
+    (outdir / "poly6_residuals.md").write_text(markdown(other, "Poly6"))
     write_csv(outdir / "poly6_coefficients.csv", [{"name": f"c{i + 1}", "value": x} for i, x in enumerate(other.alpha)],
               ["name", "value"])
     say("poly6: " + other.text)
     plot(outdir / "fit.png", fit, other)
     return rows
+
+
+def markdown(fit: yld2000_fit.Fit, name: str) -> str:
+    """The fit's errors as docs/material.md shows them (the CSV's own digits): per angle r and
+    sigma/sigma0 measured, fitted and the error, then the biaxial data."""
+    rows = as_written(list(fit.rows))
+    at = {(r["quantity"], r["angle_deg"]): r for r in rows}
+    cells = []
+    for r in (r for r in rows if r["quantity"] == "r"):
+        s = at["sigma/sigma0", r["angle_deg"]]
+        cells.append([f"{r['angle_deg']:g}", f"{r['measured']:g}", f"{r['fitted']:.4f}", f"{r['error']:+.4f}",
+                      f"{s['measured']:g}", f"{s['fitted']:.4f}", f"{s['error']:+.4f}"])
+    b, rb = at["sigma_b/sigma0", ""], at.get(("r_b", ""))
+    cells.append(["biaxial", f"r_b {rb['measured']:g}" if rb else "r_b not given",
+                  f"{rb['fitted']:.4f}" if rb else "", f"{rb['error']:+.4f}" if rb else "",
+                  f"sigma_b/sigma0 {b['measured']:g}", f"{b['fitted']:.4f}", f"{b['error']:+.4f}"])
+    return markdown_table(["theta (deg)", "r measured", f"{name} r", "error", "sigma/sigma0 measured", name, "error"],
+                          cells)
 
 
 def plot(path: Path, fit: yld2000_fit.Fit, other: yld2000_fit.Fit) -> None:
