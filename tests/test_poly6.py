@@ -77,7 +77,7 @@ def test_the_esaform_fit_meets_the_data_and_is_convex(fit):
     assert fit.worst("r") > 1e-4  # a compromise, not an interpolation: 15 data, 16 coefficients, one degenerate
     dense = yld2000.directions(300_000)
     assert poly6.convexity(fit.alpha, dense[::30]) >= -1e-12  # 0 along s itself, to round-off
-    assert poly6._curvatures(np.array(fit.alpha), dense).min() > 0.0
+    assert poly6.tangent_curvatures(np.array(fit.alpha), dense).min() > 0.0
     assert poly6.parameters(ESAFORM) == list(fit.alpha)
 
 

@@ -128,7 +128,7 @@ def yield_function(s0, s1, s2, mat, order):
 
 
 @jit.njit
-def _curvatures(c, points):
+def tangent_curvatures(c, points):
     """Per direction s (rows of points): the smallest eigenvalue of the tangent part of
     M / f^(5/3) (module docstring), -1e3 where f <= 0."""
     out = np.empty(points.shape[0])
@@ -201,11 +201,10 @@ def _solve(d: yld2000_fit.Data) -> tuple[tuple[float, ...], bool, str]:
 
     c = np.array(VON_MISES)
     for _ in range(ROUNDS):
-        sol = minimize(objective, c, method="SLSQP",
-                       constraints=[{"type": "ineq", "fun": lambda c, p=points: _curvatures(c, p) - CONVEXITY_MARGIN}],
-                       options={"maxiter": 1000, "ftol": 1e-14})
+        convex = {"type": "ineq", "fun": lambda c, p=points: tangent_curvatures(c, p) - CONVEXITY_MARGIN}
+        sol = minimize(objective, c, method="SLSQP", constraints=[convex], options={"maxiter": 1000, "ftol": 1e-14})
         c = sol.x
-        k = _curvatures(c, check)
+        k = tangent_curvatures(c, check)
         if not sol.success or k.min() >= 0.0:
             break
         points = np.vstack([points, check[np.argsort(k)[:EXCHANGE]]])
