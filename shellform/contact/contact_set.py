@@ -7,8 +7,10 @@ normal contact force R0 is *unknown*, the residual of that known row (the paper'
     K11 dq1 = dp1 - K12 dq*      (27)  free increments, the known ones lifted to the right
     dp*     = K21 dq1 + K22 dq*  (28)  contact forces: the residual on the known rows
 
-The tools are given in contact order (punch, die); tool k moves by lambda travel[k] along its
-axis (tool.axis: +z for the analytic tools, any direction for a placed one, placement.py).
+The tools are given in contact order (punch, die); tool k moves by paths[k].at(lambda) along its
+axis (tool.axis: +z for the analytic tools, any direction for a placed one, placement.py); its
+travel is a number (a Linear path of that rate) or a path of shellform.tools.travel (a holder
+that stops at its gap over a curved binder: Capped).
 The open holder's face is one more tool (holder.py), the last. Each tool gives its gap,
 normal and shape operator H = dn/dx (tools.py). A node moving along a curved tool turns its
 frame; its tangential rows t_a . R, with R ~ R0 n, then change by R0 n . dt_a = -R0 W_ab dx_b,
@@ -45,6 +47,7 @@ from shellform.assembly.sheet_element import BS
 from shellform.nonlinear.frames import nodal_frames
 from shellform.nonlinear.parts import Change, Part
 from shellform.results.log import say
+from shellform.tools.travel import path as travel_path
 
 FREE = -1
 
@@ -82,7 +85,9 @@ class ContactSet(Part):
     EARLY_STEP = 10.0  # a pass ends once the set will change and the steps are below this many penetrations
 
     def __init__(self, nodes, tools, travel, controls: ContactControls, thickness: float, die=None, holder=None):
-        self.nodes, self.tools, self.travel = nodes, list(tools), np.asarray(travel, dtype=float)
+        self.nodes, self.tools = nodes, list(tools)
+        self.paths = [travel_path(t) for t in travel]
+        self.travel = np.array([p.rate for p in self.paths])  # the rates (the checkpoint's)
         self.axes = np.array([tool.axis for tool in self.tools], dtype=float).reshape(-1, 3)
         self.controls, self.thickness = controls, thickness
         self.die = len(self.tools) - 1 if die is None else int(die)
@@ -139,7 +144,7 @@ class ContactSet(Part):
         return gaps
 
     def _gaps(self, x, h, lam):
-        gaps = [tool.gap(x, h, lam * dz) for tool, dz in zip(self.tools, self.travel)]
+        gaps = [tool.gap(x, h, p.at(lam)) for tool, p in zip(self.tools, self.paths)]
         if self.holder is not None:
             gaps.append(self.holder.face_gap(x, h))
         return gaps
@@ -254,10 +259,10 @@ class ContactSet(Part):
             c.flags[on, 2] = True
             if k == self.holder_tool:
                 continue  # flat, and still in plan
-            H = self.tools[k].shape(x[on], 0.0, lam * self.travel[k])  # dn/dx
+            H = self.tools[k].shape(x[on], 0.0, self.paths[k].at(lam))  # dn/dx
             t = c.frames[on][:, :2]
             self.curvature[on] = np.einsum("nai,nij,nbj->nab", t, H, t)  # W_ab = t_a . H t_b
-            self.shift[on] = (lam - self.lam_n) * self.travel[k] * self.axes[k]
+            self.shift[on] = self.paths[k].between(self.lam_n, lam) * self.axes[k]
 
     def add_tangent(self, K, R, fixed) -> None:
         """K_ab += -R0 W_ab on the tangent slots of the nodes on curved tools (module

@@ -56,14 +56,14 @@ class DrawingProblem(SheetFields):
         # the coefficient of each tool of the contact set, in its order: punch, die, the holder's face
         mu = tuple(t.friction_per_tool().values()) if "friction" in s.effects else 0.0
         beads = tuple(DrawbeadLine(tuple(map(tuple, b.points)), b.restraint, b.uplift) for b in t.drawbead)
+        paths = kind.travel(t)
         if t.holder == "gap":  # a third rigid tool: the holder's face holder_gap above the die's top
-            holder = tools["holder"]
-            face = dataclasses.replace(holder, z_face=holder.z_face - s.material.thickness + t.holder_gap)
-            rigid, travel = [tools["punch"], tools["die"], face], [-t.stroke, 0.0, 0.0]
+            face = tools["holder"].at_gap(t.holder_gap, s.material.thickness)
+            rigid, travel = [tools["punch"], tools["die"], face], [paths["punch"], paths["die"], paths["holder"]]
             holder, force, edge = None, 0.0, None
         else:
-            rigid, travel, holder, force = [tools["punch"], tools["die"]], [-t.stroke, 0.0], tools["holder"], \
-                t.blank_holder_force / symmetry
+            rigid, travel, holder, force = [tools["punch"], tools["die"]], [paths["punch"], paths["die"]], \
+                tools["holder"], t.blank_holder_force / symmetry
             edge = edge_load(material, s.material.thickness, tools["die"], tools["holder"])
         driver = SemiInverseDriver(
             model, bcs, rigid, travel, friction=mu, holder=holder, holder_force=force, drawbeads=beads, die=DIE,
@@ -323,8 +323,8 @@ class DrawingProblem(SheetFields):
         holder's face rests on the sheet's highest top under it (holder_height), or lies at its
         lift when open."""
         d = self.driver
-        out = {name: (tool, float(d.lam * dz), name == "punch")
-               for name, tool, dz in zip(("punch", "die"), d.tools, d.travel)}
+        out = {name: (tool, float(path.at(d.lam)), name != "die")  # the gap holder is the third tool
+               for name, tool, path in zip(("punch", "die", "blank_holder"), d.tools, d.paths)}
         if d.holder is not None:
             face = d.holder.tool
             top = self.holder_height()

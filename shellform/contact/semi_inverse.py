@@ -39,8 +39,8 @@ class SemiInverseDriver(Driver):
     drawbeads.
 
     tools: rigid tools with ``gap(x, offset, dz) -> (gap, normal)`` and ``shape(x, offset, dz)``
-    in contact order (e.g. punch, die); ``travel[k]`` is tool k's z-travel at lambda = 1 (punch:
-    -stroke); holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool
+    in contact order (e.g. punch, die); ``travel[k]`` is tool k's travel along its axis at
+    lambda = 1 (punch: -stroke), or its path (shellform.tools.travel); holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool
     `die` (default: the last tool); friction: mu, one coefficient for every tool or one per tool
     in contact order then the holder's (friction.py: CoulombFriction); drawbeads: DrawbeadLine's (drawbead.py);
     holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge);
@@ -71,7 +71,7 @@ class SemiInverseDriver(Driver):
                  if p is not None]
         super().__init__(model, bcs, prescribed=prescribed, pressure=pressure, controls=controls,
                          checkpoint_dir=checkpoint_dir, verbose=verbose, parts=parts, trace=c.trace)
-        self.tools, self.travel = self.contact.tools, self.contact.travel
+        self.tools, self.travel, self.paths = self.contact.tools, self.contact.travel, self.contact.paths
 
     # -- measurements ----------------------------------------------------------------------------
     def positions(self) -> np.ndarray:

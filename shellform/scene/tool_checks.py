@@ -11,7 +11,6 @@ import numpy as np
 from shellform.scene.rules import keys_of_effects, require
 from shellform.scene.schema import FRICTION_TOOLS, HOLDERS, SIDES, SPREADS, TOOL_SHAPES
 from shellform.tools import kinds as tool_kinds
-from shellform.tools.analytic import rounded_square_sdf
 
 # tools.drawbead: the points of all beads together. Every Newton iteration clips each segment to
 # the sheet's cells near it (shellform.contact.drawbead); a bead's line needs no segment shorter
@@ -19,7 +18,7 @@ from shellform.tools.analytic import rounded_square_sdf
 MAX_DRAWBEAD_POINTS = 1000
 
 
-def _validate_drawbead(bead, name: str, flat: float, corner: float) -> None:
+def _validate_drawbead(bead, name: str, plan) -> None:
     """A drawbead: a polyline of at least two distinct points, all on the die's flat top (outside
     its opening and shoulder, where the holder pinches the flange), and forces >= 0."""
     pts = bead.points
@@ -34,10 +33,10 @@ def _validate_drawbead(bead, name: str, flat: float, corner: float) -> None:
     p = np.asarray(pts, dtype=float)
     along = np.linspace(0.0, 1.0, 21)[:, None, None]
     samples = (p[:-1] + along * (p[1:] - p[:-1])).reshape(-1, 2)  # 21 points on every segment
-    distance, _, _ = rounded_square_sdf(samples[:, 0], samples[:, 1], flat, corner)
+    distance = plan.distance(samples[:, 0], samples[:, 1])
     require(bool(np.all(distance >= 0)), f"{name}.points",
             f"must lie on the die's flat top, outside its opening and shoulder (the rounded square of "
-            f"half-width {flat}, where the holder begins); "
+            f"half-width {plan.half_width}, where the holder begins); "
             f"{samples[int(np.argmin(distance))].tolist()} lies within it")
 
 
@@ -60,11 +59,13 @@ def validate_tools(s) -> None:
     for name in ("blank_holder_force", "friction"):
         require(getattr(t, name) >= 0, f"tools.{name}", f"must be >= 0, got {getattr(t, name)}")
     _validate_friction_per_tool(s, t)
-    flat, corner, what = tool_kinds.kind(t.shape).check(s)
+    plan = tool_kinds.kind(t.shape).check(s)
+    flat, what = plan.half_width, plan.keys
     g = s.geometry
     if g.shape == "rectangle":
-        side = "lx" if g.lx <= g.ly else "ly"
-        require(min(g.lx, g.ly) / 2 > flat, f"geometry.{side}",
+        sides = [k for k in ("lx", "ly") if k[1] in plan.across]
+        side = min(sides, key=lambda k: getattr(g, k))
+        require(getattr(g, side) / 2 > flat, f"geometry.{side}",
                 f"the blank does not reach the blank holder and the die's flat top: half its size "
                 f"{getattr(g, side) / 2} must exceed {what} = {flat}")
     elif g.shape == "circle":
@@ -78,7 +79,7 @@ def validate_tools(s) -> None:
             f"holds {points:,} points in all; at most {MAX_DRAWBEAD_POINTS:,} (each segment is clipped to the "
             "sheet's cells at every Newton iteration: a bead needs no segment shorter than a cell)")
     for i, bead in enumerate(t.drawbead):
-        _validate_drawbead(bead, f"tools.drawbead[{i}]", flat, corner)
+        _validate_drawbead(bead, f"tools.drawbead[{i}]", plan)
     if g.shape == "rectangle":
         outer = ("right", "top") if g.region == "quarter" else SIDES
     else:  # an outline's edges are free or symmetry lines

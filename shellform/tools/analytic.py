@@ -231,6 +231,11 @@ class BlankHolder:
         sd = np.where(s >= 0.0, (self.z_face + dz) - x[:, 2], np.inf)
         return sd - offset, np.tile(DOWN, (len(x), 1))
 
+    def at_gap(self, gap: float, thickness: float) -> "BlankHolder":
+        """The same face held `gap` over the die's top (tools.holder = "gap"): this face rests on
+        the sheet's upper surface, thickness above the die's."""
+        return BlankHolder(self.edge, self.z_face - thickness + gap)
+
     def edge_offset(self, x):
         """(s, j) of points x: s their plan distance from the face's inner edge (> 0 under the
         face), j the length of the edge per unit length of the offset line through them

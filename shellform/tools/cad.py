@@ -15,7 +15,7 @@ from shellform.tools.analytic import BlankHolder
 from shellform.tools.holder_edge import OutlineEdge, RoundedSquareEdge, signed_area
 from shellform.tools.mesh_tool import MESH_SUFFIXES, MeshTool
 from shellform.tools.placement import UP, Placed, rotation
-from shellform.tools.protocol import BinderPlan
+from shellform.tools.protocol import BinderPlan, ram_travel
 from shellform.tools.surface_tool import SurfaceTool
 
 NAME = "cad"
@@ -198,6 +198,7 @@ def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
 
 
 tools = cad_cup_tools
+travel = ram_travel
 
 
 def check_placement(tools: dict, x, half, planes, comm, tolerance: float) -> None:

@@ -16,6 +16,8 @@ A kind is one module of shellform/tools/ that declares everything about itself:
     tools(spec, thickness)    the factory: {"punch", "die", "holder"} (protocol.Tool; the
                               holder a protocol.Binder) around a sheet of that thickness whose
                               mid-surface is z = 0
+    travel(spec)              their paths along their axes (travel.py): {"punch", "die",
+                              "holder"} (protocol.ram_travel: the punch travels the stroke)
     check_placement(tools, x, half, planes, comm, tolerance)   the tools against the blank's
                               nodes x before the run (InputError; nothing for analytic tools)
     LINES                     its output: the cup's thickness lines, name -> nodes on it
@@ -32,10 +34,10 @@ import importlib
 
 from shellform import registry
 
-REGISTRY = ("square", "round", "cad")  # modules of shellform.tools
+REGISTRY = ("square", "round", "cad", "channel")  # modules of shellform.tools
 
-DECLARES = ("NAME", "FIELDS", "refuse", "complete", "check", "tools", "check_placement", "LINES", "RIM",
-            "picture_depth")
+DECLARES = ("NAME", "FIELDS", "refuse", "complete", "check", "tools", "travel", "check_placement", "LINES",
+            "RIM", "picture_depth")
 
 
 def _checked(modules: tuple) -> dict:

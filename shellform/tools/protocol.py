@@ -18,6 +18,8 @@ mid-surface. The binder face (the blank holder's, shellform.tools.analytic.Blank
 tool that also gives its inner edge in plan, where the die's flat top begins:
 
     edge            distance(x, y), offset(x, y), reach(), length() (holder_edge.py)
+    at_gap(gap, t)  the same face held `gap` over the die's (tools.holder = "gap"; the
+                    channel's curved binder gives only this: channel.ChannelHolder)
     z_face          the height of its face
     edge_offset(x)  (s, j): the plan distance from the edge and the edge's length per unit
                     length of the offset line (holder_edge.py)
@@ -29,6 +31,9 @@ from a scene's [tools].
 from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
+
+from shellform.tools.analytic import rounded_square_sdf
+from shellform.tools.travel import Linear
 
 
 @runtime_checkable
@@ -46,6 +51,8 @@ class Binder(Tool, Protocol):
     z_face: float
 
     def edge_offset(self, x) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def at_gap(self, gap: float, thickness: float) -> Tool: ...
 
 
 def surface_mesh(tool, dz: float, bounds, z_range, above: bool, n: int = 96):
@@ -91,10 +98,24 @@ def surface_mesh(tool, dz: float, bounds, z_range, above: bool, n: int = 96):
 
 class BinderPlan(NamedTuple):
     """Where the die's flat top (and the holder's face) begins, as a scene gives it: the rounded
-    square of half-width `half_width` and plan corner radius `corner_radius`, and the keys that
+    square of half-width `half_width` and plan corner radius `corner_radius`, or across x only
+    (`across` ("x",): the lines |x| = half_width of a channel running along y), and the keys that
     give it (named in the scene's messages: the blank must reach beyond it, drawbeads lie outside
     it)."""
 
     half_width: float
     corner_radius: float
     keys: str
+    across: tuple = ("x", "y")
+
+    def distance(self, x, y) -> np.ndarray:
+        """The plan distance of points (x, y) from where the flat top begins (> 0 on it)."""
+        if "y" not in self.across:
+            return np.abs(np.asarray(x, dtype=float)) - self.half_width
+        return rounded_square_sdf(x, y, self.half_width, self.corner_radius)[0]
+
+
+def ram_travel(spec) -> dict:
+    """The tools' paths (travel.py) of a single-action draw: the punch travels the stroke down
+    its axis, the die and the holder's face stay."""
+    return {"punch": Linear(-spec.stroke), "die": Linear(0.0), "holder": Linear(0.0)}

@@ -42,5 +42,6 @@ def check(s) -> BinderPlan:
 
 
 tools = square.square_cup_tools
+travel = square.travel
 check_placement = square.check_placement
 picture_depth = square.picture_depth

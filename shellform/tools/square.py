@@ -13,7 +13,7 @@ import numpy as np
 from shellform.errors import require
 from shellform.tools.analytic import BlankHolder, Die, Punch
 from shellform.tools.holder_edge import RoundedSquareEdge
-from shellform.tools.protocol import BinderPlan
+from shellform.tools.protocol import BinderPlan, ram_travel
 
 NAME = "square"
 
@@ -104,6 +104,7 @@ def square_cup_tools(spec, thickness: float) -> dict:
 
 
 tools = square_cup_tools
+travel = ram_travel
 
 
 def check_placement(tools: dict, x, half, planes, comm, tolerance: float) -> None:
