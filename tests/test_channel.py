@@ -162,3 +162,25 @@ def test_the_holder_closes_the_blank_onto_the_curved_binder():
     assert np.all(x[flange & (X[:, 1] > 39.0), 2] < -5.0)  # the ends went down with the holder
     centre = np.abs(X[:, 0]) < 1e-9
     assert np.all(np.abs(off[centre]) < 0.5 + 0.01 * T)
+
+
+def test_the_studys_channels_wrap_onto_the_binder_and_order_by_the_punchs_friction():
+    """docs/results/channel_binder (shellform study channel-binder): on n 16 and 24 the flange
+    closed onto the binder lies within the holder's clearance and the contact's tolerance of the
+    wrapped radius; with the die and holder at 0.12, the punch's coefficient 0.02 < 0.12 < 0.3
+    orders the draw-in and the peak punch force upward and the peak thinning's magnitude
+    downward (docs/tools.md: the direction and the literature)."""
+    import csv
+
+    rows = list(csv.DictReader(open(Path(__file__).resolve().parents[1] / "docs" / "results" / "channel_binder"
+                                    / "channel_binder.csv")))
+    curved = [r for r in rows if float(r["binder_radius_mm"]) > 0]
+    assert len(curved) == 4
+    for r in curved:
+        assert 0 < float(r["wrap_flange_mm"]) <= (0.8 - T) + 0.01 * T
+    by = {r["case"]: r for r in curved if r["n"] == "16"}
+    order = [by[c] for c in ("lubricated punch", "one coefficient", "dry punch")]
+    assert [float(r["mu_punch"]) for r in order] == [0.02, 0.12, 0.3]
+    for key, sign in (("DX_mm", 1), ("force_peak_kN", 1), ("peak_thinning", 1)):
+        values = [sign * float(r[key]) for r in order]
+        assert values[0] < values[1] < values[2], key
