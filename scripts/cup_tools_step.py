@@ -4,7 +4,8 @@ analytic tools of shellform/tools/analytic.py built from the same dimensions, fo
 
     python scripts/cup_tools_step.py SCENE.toml OUT_FOLDER
 
-writes OUT_FOLDER/punch.step and OUT_FOLDER/die.step from the scene's square [tools]. The punch's
+writes OUT_FOLDER/punch.step and OUT_FOLDER/die.step from the scene's square [tools]
+(`holder` builds a flat holder's plate: tests/test_channel.py's flat binder from a file). The punch's
 face lies at z = 0, the die's flat top at z = 0: the scene places them with punch_translation
 [0, 0, t/2 + punch_gap] and die_translation [0, 0, -t/2] (the sheet's mid-surface is z = 0).
 
@@ -56,6 +57,22 @@ def die(gmsh, half_width, corner_radius, profile_radius, z_top=0.0, outer=100.0,
     (_, vol), = gmsh.model.getEntities(3)
     rim = _edges(gmsh, lambda x0, y0, z0, x1, y1, z1: z0 > z_top - 1e-6 and max(x1, y1) < outer - 1e-6)
     occ.fillet([vol], rim, [profile_radius])
+    occ.synchronize()
+
+
+def holder(gmsh, half_width, corner_radius, z_face=0.0, outer=100.0, height=20.0):
+    """A flat blank holder in the current gmsh model: a plate whose face (its bottom) lies at
+    z_face over |x|, |y| <= outer, with the opening of half-width half_width (plan corner radius
+    corner_radius > 0) through it; its face's inner edge is sharp, as the analytic holder's
+    (shellform/tools/analytic.py, BlankHolder) ends there."""
+    occ, a = gmsh.model.occ, half_width
+    plate = occ.addBox(-outer, -outer, z_face, 2 * outer, 2 * outer, height)
+    hole = occ.addBox(-a, -a, z_face - 1.0, 2 * a, 2 * a, height + 2.0)
+    occ.synchronize()
+    occ.fillet([hole], _edges(gmsh, _vertical), [corner_radius])
+    occ.synchronize()
+    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != plate]
+    occ.cut([(3, plate)], [(3, hole)])
     occ.synchronize()
 
 

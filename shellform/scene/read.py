@@ -277,7 +277,7 @@ def load(path: str | Path) -> Scene:
             material = data["material"] = {**material, key: str(path.parent / material[key])}
     tools = data.get("tools")
     if isinstance(tools, dict):
-        for key in ("punch_file", "die_file"):
+        for key in ("punch_file", "die_file", "holder_file"):
             if isinstance(tools.get(key), str) and tools[key]:
                 tools[key] = str(path.parent / tools[key])  # relative to the scene
     return from_dict(data)

@@ -1,7 +1,8 @@
 """The kind of tools "cad": the punch and the die as CAD surfaces (surface_tool.py) or surface
 meshes (.stl, .msh: mesh_tool.py, by the file's suffix), placed in the scene by a rotation and
-a translation (placement.py), the blank holder the flat analytic one; the checks of their keys,
-and of their placement around the blank at the start."""
+a translation (placement.py), the blank holder the flat analytic one or, held at a gap
+(tools.holder = "gap"), a face from a file too (a curved binder: HolderFace); the checks of
+their keys, and of their placement around the blank at the start."""
 
 import math
 from pathlib import Path
@@ -31,6 +32,11 @@ FIELDS = (
     ("punch_direction", [0.0, 0.0, -1.0], "the way the punch travels"),
     ("punch_normals", "outward", "'outward' (the faces' normals point to the sheet) or 'inward'"),
     ("die_normals", "outward", "as punch_normals"),
+    ("holder_file", "", "the holder's face from a file, placed resting on the sheet (holder = 'gap' only; "
+     "'': the flat analytic holder)"),
+    ("holder_translation", [0.0, 0.0, 0.0], "mm"),
+    ("holder_rotation", [0.0, 0.0, 0.0], "degrees"),
+    ("holder_normals", "outward", "as punch_normals"),
     ("holder_half_width", 0.0, "the holder's inner edge, a rounded square (where the die's flat top begins; "
      "0: the die's own)"),
     ("holder_corner_radius", 0.0, "its corner radius"),
@@ -63,13 +69,19 @@ def cad_cup_tools(spec, thickness: float) -> dict:
     surface outside its inner edge: the rounded square (holder_half_width, holder_corner_radius),
     or where holder_half_width is 0 the inner boundary of the die's flat top (die_opening). It
     pinches the flange onto the die's flat top, which check_start asks to lie on the sheet's
-    lower surface there."""
+    lower surface there. With holder_file the holder's face is that file's, placed by its
+    rotation and translation resting on the sheet's upper surface (HolderFace; holder = "gap"
+    only)."""
     def placed(name, axis=UP):
         path = getattr(spec, f"{name}_file")
         tool = _tool(path).from_file(path, normals=getattr(spec, f"{name}_normals"), field=f"tools.{name}_file")
         return Placed(tool, rotation(getattr(spec, f"{name}_rotation")), getattr(spec, f"{name}_translation"), axis)
 
     die = placed("die")
+    if spec.holder_file:
+        face = placed("holder")
+        return dict(punch=placed("punch", -np.asarray(spec.punch_direction, dtype=float)), die=die,
+                    holder=HolderFace(face.tool, face.R, face.translation))
     if spec.holder_half_width > 0:
         edge = RoundedSquareEdge(spec.holder_half_width, spec.holder_corner_radius)
     else:
@@ -79,6 +91,16 @@ def cad_cup_tools(spec, thickness: float) -> dict:
         die=die,
         holder=BlankHolder(edge, thickness / 2),
     )
+
+
+class HolderFace(Placed):
+    """The holder's face from a file (a CAD model or a surface mesh), placed resting on the
+    sheet's upper surface; ``at_gap(gap, t)`` raises it by gap - t along z, its face then `gap`
+    over the die's binder face under it (tools.holder = "gap": a third rigid tool). A binder of
+    any shape: the force-controlled holder needs the flat analytic face (holder.py)."""
+
+    def at_gap(self, gap: float, thickness: float) -> "HolderFace":
+        return HolderFace(self.tool, self.R, self.translation + (gap - thickness) * UP, self.axis)
 
 
 def die_opening(die: Placed) -> OutlineEdge:
@@ -112,8 +134,9 @@ def read_tool_file(path, field: str):
 def check_files(spec) -> None:
     """The punch's and the die's files checked as a run checks them (read_tool_file), before
     anything is computed: `shellform check` refuses what `shellform run` refuses."""
-    for name in ("punch", "die"):
-        read_tool_file(getattr(spec, f"{name}_file"), f"tools.{name}_file")
+    for name in ("punch", "die", "holder"):
+        if name != "holder" or spec.holder_file:
+            read_tool_file(getattr(spec, f"{name}_file"), f"tools.{name}_file")
 
 
 class ToolSymmetryWarning(UserWarning):
@@ -140,7 +163,9 @@ def check_mirrors(tools: dict, x, planes, comm) -> dict:
     x = np.asarray(x, dtype=float).reshape(-1, 3)
     size = comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
     worst = {}
-    for name in ("punch", "die"):
+    for name in ("punch", "die", "holder"):
+        if name == "holder" and not isinstance(tools[name], HolderFace):
+            continue
         tool, largest = tools[name], 0.0
         g = tool.gap(x, 0.0, 0.0)[0]
         for m in planes:
@@ -182,6 +207,9 @@ def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
         if deepest < -tolerance:
             raise InputError(f"tools.{name}_translation", f"the {name} overlaps the blank at the start: a node "
                              f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
+    if isinstance(tools["holder"], HolderFace):  # a binder face of any shape, held at a gap
+        _check_face_start(tools["holder"], x, half, comm, tolerance)
+        return
     under = np.isfinite(tools["holder"].gap(x, 0.0, 0.0)[0])
     if comm.allreduce(int(under.sum()), op=MPI.SUM) == 0:
         raise InputError("geometry", "the blank does not reach the blank holder: no node of it lies over the die's "
@@ -195,6 +223,26 @@ def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
     if off > tolerance:
         raise InputError("tools.die_translation", f"the die's flat top under the holder lies {off:.4g} mm off the "
                          "sheet's lower surface z = -t/2: the holder pinches the flange onto it")
+
+
+def _check_face_start(face, x, half, comm, tolerance: float) -> None:
+    """A holder's face from a file, resting on the sheet at the start: its normals point to the
+    sheet (tools.holder_normals), it overlaps no node (tools.holder_translation) and it rests on
+    the blank: some node lies within `tolerance` of it (tools.holder_translation)."""
+    from mpi4py import MPI
+
+    g, _ = face.gap(x, half, 0.0)
+    highest = comm.allreduce(float(g.max(initial=-np.inf)), op=MPI.MAX)
+    deepest = comm.allreduce(float(g.min(initial=np.inf)), op=MPI.MIN)
+    if highest < -tolerance:
+        raise InputError("tools.holder_normals", "the holder's faces' normals point away from the sheet: every node "
+                         "of the blank lies behind its surface (turn them with holder_normals)")
+    if deepest < -tolerance:
+        raise InputError("tools.holder_translation", f"the holder's face overlaps the blank at the start: a node "
+                         f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
+    if deepest > tolerance:
+        raise InputError("tools.holder_translation", f"the holder's face does not rest on the blank: the nearest node "
+                         f"lies {deepest:.4g} mm from it (place it on the sheet's upper surface; holder_gap lifts it)")
 
 
 tools = cad_cup_tools
@@ -213,14 +261,17 @@ def check(s) -> BinderPlan:
     surface_tool.py, mesh_tool.py), their placements, the punch's travel and the holder's inner
     edge; returns where the die's flat top begins (holder_half_width)."""
     t = s.tools
-    for name in ("punch_file", "die_file"):
+    for name in ("punch_file", "die_file", "holder_file"):
         v = getattr(t, name)
+        if name == "holder_file" and not v:
+            continue
         require(bool(v), f"tools.{name}",
                 "shape = 'cad' needs the tool's STEP, IGES or BREP file (or .stl, .msh surface mesh)")
         require(Path(v).is_file(), f"tools.{name}", f"no such file: {v}")
     for name, what in (("punch_translation", "[x, y, z] (mm)"), ("die_translation", "[x, y, z] (mm)"),
-                       ("punch_rotation", "angles about x, y, z (degrees)"),
-                       ("die_rotation", "angles about x, y, z (degrees)"), ("punch_direction", "[x, y, z]")):
+                       ("holder_translation", "[x, y, z] (mm)"), ("punch_rotation", "angles about x, y, z (degrees)"),
+                       ("die_rotation", "angles about x, y, z (degrees)"),
+                       ("holder_rotation", "angles about x, y, z (degrees)"), ("punch_direction", "[x, y, z]")):
         v = getattr(t, name)
         require(len(v) == 3 and all(isinstance(c, (int, float)) and math.isfinite(c) for c in v), f"tools.{name}",
                 f"must be three finite numbers {what}, got {v}")
@@ -228,9 +279,12 @@ def check(s) -> BinderPlan:
     require(np.linalg.norm(d) > 0, "tools.punch_direction", "must be a non-zero vector, the way the punch travels")
     require(d[2] < 0, "tools.punch_direction", f"must point down into the die (a negative z component): the punch "
                                                f"draws the sheet into the die below it, got {t.punch_direction}")
-    for name in ("punch_normals", "die_normals"):
+    for name in ("punch_normals", "die_normals", "holder_normals"):
         require(getattr(t, name) in NORMALS, f"tools.{name}",
                 f"must be one of {NORMALS}, got {getattr(t, name)!r}")
+    require(not t.holder_file or t.holder == "gap", "tools.holder_file",
+            "a holder's face from a file is held at a gap (tools.holder = 'gap'): the force-controlled holder pinches "
+            "the flange with the flat analytic face")
     require(math.isfinite(t.holder_half_width) and t.holder_half_width >= 0, "tools.holder_half_width",
             f"must be >= 0: the holder's inner edge (where the die's flat top begins), 0 for the die's own, got "
             f"{t.holder_half_width}")
