@@ -75,3 +75,39 @@ def test_a_holders_face_from_a_file_is_checked(tmp_path, changes, field):
         s = _scene(**{"tools.holder_file": str(plate), **changes})
         DrawingProblem.from_scene(s, verbose=False)
     assert err.value.field == field
+
+
+CURVED = ROOT / "demos" / "square_cup_curved_binder.toml"
+
+
+def test_the_holder_closes_the_blank_onto_a_cylindrical_binder_from_cad_files():
+    """demos/square_cup_curved_binder.toml (die and holder faces: cylinders of R 500 and
+    500 + t about the x axis, from STEP files) on n 6, the ram at binder_rise (6 mm): the
+    holder has stopped 0.8 mm over the die, and the flange beyond the die's opening lies on the
+    cylinder: its mid-surface within the holder's clearance (0.02 mm) and the contact's
+    tolerance of the radius R + t/2, its ends 5.6 mm below the crown."""
+    import numpy as np
+
+    s = scene.load(CURVED).changed({"mesh.n": 6})
+    p = DrawingProblem.from_scene(s, verbose=False)
+    d = p.driver
+    d.run(s.tools.binder_rise / s.tools.stroke)
+    t, rm = s.material.thickness, 500.0 + s.material.thickness / 2
+    X, x = d.model.mesh.geometry.x[: d.n_owned], d.positions()
+    off = np.hypot(x[:, 1], x[:, 2] + rm) - rm
+    flange = (np.abs(X[:, 0]) > 50.0) | (np.abs(X[:, 1]) > 50.0)
+    assert flange.sum() > 10
+    assert np.all(off[flange] > -0.01 * t - 1e-9) and np.all(off[flange] < (0.8 - t) + 0.01 * t)
+    assert np.all(x[flange & (X[:, 1] > 74.0), 2] < -5.5)
+    assert d.paths[2].at(d.lam) == -6.0 and d.paths[2].at(1.0) == -6.0  # the holder stopped
+
+
+@pytest.mark.parametrize("changes, field", [
+    ({"tools.binder_rise": 3.0}, "tools.binder_rise"),  # the face would cut the flat blank's ends
+    ({"tools.holder_file": ""}, "tools.binder_rise"),  # a rise without a face from a file
+    ({"tools.stroke": 5.0}, "tools.stroke"),  # not beyond the rise
+])
+def test_a_curved_binders_rise_is_checked(changes, field):
+    with pytest.raises(InputError) as err:
+        DrawingProblem.from_scene(scene.load(CURVED).changed({"mesh.n": 4, **changes}), verbose=False)
+    assert err.value.field == field

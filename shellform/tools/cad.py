@@ -18,6 +18,7 @@ from shellform.tools.mesh_tool import MESH_SUFFIXES, MeshTool
 from shellform.tools.placement import UP, Placed, rotation
 from shellform.tools.protocol import BinderPlan, ram_travel
 from shellform.tools.surface_tool import SurfaceTool
+from shellform.tools.travel import Capped
 
 NAME = "cad"
 
@@ -37,6 +38,8 @@ FIELDS = (
     ("holder_translation", [0.0, 0.0, 0.0], "mm"),
     ("holder_rotation", [0.0, 0.0, 0.0], "degrees"),
     ("holder_normals", "outward", "as punch_normals"),
+    ("binder_rise", 0.0, "how far the holder comes down with the ram before it stops at its gap (the binder "
+     "wrap)"),
     ("holder_half_width", 0.0, "the holder's inner edge, a rounded square (where the die's flat top begins; "
      "0: the die's own)"),
     ("holder_corner_radius", 0.0, "its corner radius"),
@@ -81,7 +84,7 @@ def cad_cup_tools(spec, thickness: float) -> dict:
     if spec.holder_file:
         face = placed("holder")
         return dict(punch=placed("punch", -np.asarray(spec.punch_direction, dtype=float)), die=die,
-                    holder=HolderFace(face.tool, face.R, face.translation))
+                    holder=HolderFace(face.tool, face.R, face.translation, rise=spec.binder_rise))
     if spec.holder_half_width > 0:
         edge = RoundedSquareEdge(spec.holder_half_width, spec.holder_corner_radius)
     else:
@@ -94,13 +97,21 @@ def cad_cup_tools(spec, thickness: float) -> dict:
 
 
 class HolderFace(Placed):
-    """The holder's face from a file (a CAD model or a surface mesh), placed resting on the
-    sheet's upper surface; ``at_gap(gap, t)`` raises it by gap - t along z, its face then `gap`
-    over the die's binder face under it (tools.holder = "gap": a third rigid tool). A binder of
-    any shape: the force-controlled holder needs the flat analytic face (holder.py)."""
+    """The holder's face from a file (a CAD model or a surface mesh), placed (`translation`)
+    resting on the sheet's upper surface where it closes: on the flat blank, or on the blank
+    wrapped onto a curved binder, in which case it starts `rise` higher (binder_rise: it comes
+    down with the ram and stops, travel.Capped). ``at_gap(gap, t)`` raises it by gap - t along
+    z, its face then `gap` over the die's binder face under it (tools.holder = "gap": a third
+    rigid tool). A binder of any shape: the force-controlled holder needs the flat analytic face
+    (holder.py)."""
+
+    def __init__(self, tool, rotation, translation, axis=UP, rise: float = 0.0):
+        self.rise = float(rise)
+        super().__init__(tool, rotation, np.asarray(translation, dtype=float) + self.rise * UP, axis)
 
     def at_gap(self, gap: float, thickness: float) -> "HolderFace":
-        return HolderFace(self.tool, self.R, self.translation + (gap - thickness) * UP, self.axis)
+        return HolderFace(self.tool, self.R, self.translation - self.rise * UP + (gap - thickness) * UP, self.axis,
+                          self.rise)
 
 
 def die_opening(die: Placed) -> OutlineEdge:
@@ -226,9 +237,10 @@ def check_start(tools: dict, x, half, comm, tolerance: float) -> None:
 
 
 def _check_face_start(face, x, half, comm, tolerance: float) -> None:
-    """A holder's face from a file, resting on the sheet at the start: its normals point to the
-    sheet (tools.holder_normals), it overlaps no node (tools.holder_translation) and it rests on
-    the blank: some node lies within `tolerance` of it (tools.holder_translation)."""
+    """A holder's face from a file at the start: its normals point to the sheet
+    (tools.holder_normals), it overlaps no node (tools.holder_translation; tools.binder_rise
+    where it starts raised) and, where it closes on the flat blank (no rise), it rests on it:
+    some node lies within `tolerance` of it (tools.holder_translation)."""
     from mpi4py import MPI
 
     g, _ = face.gap(x, half, 0.0)
@@ -238,15 +250,26 @@ def _check_face_start(face, x, half, comm, tolerance: float) -> None:
         raise InputError("tools.holder_normals", "the holder's faces' normals point away from the sheet: every node "
                          "of the blank lies behind its surface (turn them with holder_normals)")
     if deepest < -tolerance:
-        raise InputError("tools.holder_translation", f"the holder's face overlaps the blank at the start: a node "
-                         f"penetrates it by {-deepest:.4g} mm (more than {tolerance:g} mm)")
-    if deepest > tolerance:
+        field = "tools.binder_rise" if face.rise > 0 else "tools.holder_translation"
+        raise InputError(field, f"the holder's face overlaps the blank at the start: a node penetrates it by "
+                         f"{-deepest:.4g} mm (more than {tolerance:g} mm)" + (
+                             f"; binder_rise ({face.rise:g} mm) must lift it clear of the flat blank" if face.rise > 0
+                             else ""))
+    if face.rise == 0 and deepest > tolerance:
         raise InputError("tools.holder_translation", f"the holder's face does not rest on the blank: the nearest node "
                          f"lies {deepest:.4g} mm from it (place it on the sheet's upper surface; holder_gap lifts it)")
 
 
 tools = cad_cup_tools
-travel = ram_travel
+
+
+def travel(spec) -> dict:
+    """The punch travels the stroke (protocol.ram_travel); a holder's face from a file that
+    starts raised comes down with it by binder_rise and stops (travel.Capped)."""
+    paths = ram_travel(spec)
+    if spec.binder_rise > 0:
+        paths["holder"] = Capped(-spec.stroke, -spec.binder_rise)
+    return paths
 
 
 def check_placement(tools: dict, x, half, planes, comm, tolerance: float) -> None:
@@ -282,6 +305,12 @@ def check(s) -> BinderPlan:
     for name in ("punch_normals", "die_normals", "holder_normals"):
         require(getattr(t, name) in NORMALS, f"tools.{name}",
                 f"must be one of {NORMALS}, got {getattr(t, name)!r}")
+    require(math.isfinite(t.binder_rise) and t.binder_rise >= 0, "tools.binder_rise",
+            f"must be >= 0, got {t.binder_rise}")
+    require(t.binder_rise == 0 or t.holder_file, "tools.binder_rise",
+            "a holder that comes down onto a curved binder takes its face from a file (holder_file)")
+    require(t.stroke > t.binder_rise, "tools.stroke",
+            f"must exceed binder_rise ({t.binder_rise}): the ram closes the holder first, got {t.stroke}")
     require(not t.holder_file or t.holder == "gap", "tools.holder_file",
             "a holder's face from a file is held at a gap (tools.holder = 'gap'): the force-controlled holder pinches "
             "the flange with the flat analytic face")
