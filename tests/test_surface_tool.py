@@ -341,6 +341,85 @@ def test_a_sphere_s_poles_do_not_stop_the_search():
     np.testing.assert_allclose(n, x / r[:, None], atol=1e-9)  # the outward normal, inside too
 
 
+PLATE = dict(half=25.0, corner=10.0, outer=60.0, height=10.0)  # a plate with a rounded-square hole
+
+
+def _plate(gmsh):
+    """A plate |x|, |y| <= outer, 0 <= z <= height, through it a hole of half-width `half` and
+    plan corner radius `corner`: its rims are sharp edges, four straight and four arcs at top
+    and bottom (the arcs' parameter ranges quarter turns, not all of them holding 0)."""
+    occ, a, h, out = gmsh.model.occ, PLATE["half"], PLATE["height"], PLATE["outer"]
+    plate = occ.addBox(-out, -out, 0.0, 2 * out, 2 * out, h)
+    hole = occ.addBox(-a, -a, -1.0, 2 * a, 2 * a, h + 2.0)
+    occ.synchronize()
+    boxes = {t: np.reshape(gmsh.model.getBoundingBox(1, t), (2, 3)) for _, t in gmsh.model.getEntities(1)}
+    vertical = [t for t, (lo, hi) in boxes.items() if np.all(hi[:2] - lo[:2] < 1e-6) and abs(abs(lo[0]) - a) < 1e-6]
+    occ.fillet([hole], vertical, [PLATE["corner"]])
+    occ.synchronize()
+    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != plate]
+    occ.cut([(3, plate)], [(3, hole)])
+    occ.synchronize()
+
+
+def _plate_distance(x):
+    """The plate's signed distance (> 0 outside), its gradient (the outward normal) and the hole's
+    plan tangent at the nearest rim point, in closed form, for points nearer the hole than the
+    plate's outer sides: the hole's rounded square's plan distance s (> 0 in the hole), the plate
+    its extrusion over 0 <= z <= height."""
+    a, r, h = PLATE["half"], PLATE["corner"], PLATE["height"]
+    q = np.abs(x[:, :2]) - (a - r)
+    corner = np.all(q > 0, axis=1)
+    side = np.argmax(q, axis=1)
+    qq = np.maximum(q, 0)
+    g2 = np.where(corner[:, None], qq / np.maximum(np.linalg.norm(qq, axis=1), 1e-300)[:, None],
+                  np.eye(2)[side]) * np.sign(x[:, :2])  # the gradient of the hole's plan distance, outward
+    s = -(np.linalg.norm(np.maximum(q, 0), axis=1) + np.minimum(q.max(axis=1), 0) - r)  # > 0 in the hole
+    wz = np.abs(x[:, 2] - h / 2) - h / 2
+    out = np.hypot(np.maximum(s, 0), np.maximum(wz, 0))
+    d = np.where((s > 0) | (wz > 0), out, np.maximum(s, wz))
+    grad = np.zeros_like(x)
+    rim = (s > 0) & (wz > 0)  # nearest a sharp rim edge
+    grad[:, :2] = -g2 * np.where(rim, s / np.maximum(out, 1e-300), (s >= wz))[:, None]
+    grad[:, 2] = np.sign(x[:, 2] - h / 2) * np.where(rim, wz / np.maximum(out, 1e-300), (wz > s))
+    tangent = np.c_[-g2[:, 1], g2[:, 0], np.zeros(len(x))]
+    return d, grad, tangent, rim, corner
+
+
+def test_points_nearest_a_sharp_edge_get_its_distance(tmp_path):
+    """A plate with a rounded-square hole, read from STEP: its rims are sharp edges, straight
+    lines and quarter arcs. At points around the rims, outside the plate (the point nearest on
+    an edge: the search's candidates) and inside it, from a new tool and moved a little on the
+    same one: the gap and the normal are the closed form's, H on a rim (I - n n^T - e e^T)/d,
+    and mirrored points get the same gap. Before, gmsh's parameter of an edge's projection (0
+    wherever OCC's projection succeeds) was clamped to the edge's range: the foot point on the
+    bottom rim y = 45 of a hole of half-width 45 (22.04, 44.14, -0.405) was answered 47.05 mm
+    off, by the far end of the segment."""
+    path = tmp_path / "plate.step"
+    _script().write_step(_plate, path)
+    a, h = PLATE["half"], PLATE["height"]
+    rng = np.random.default_rng(4)
+    x = rng.uniform([-a - 4, -a - 4, -3.0], [a + 4, a + 4, h + 3.0], (20000, 3))
+    d, _, _, rim, _ = _plate_distance(x)
+    near = (np.abs(d) < 3.0) & ((np.abs(x[:, 2]) < 3.0) | (np.abs(x[:, 2] - h) < 3.0))
+    x = np.vstack([x[near & ~rim][:200], x[near & rim][:200]])  # inside and outside, beside the rims
+    x = np.vstack([x, [[a - 3.0, a - 0.86, -0.405], [0.0, a - 0.86, -0.405], [a - 0.86, 0.0, h + 0.3]]])
+    d, grad, tangent, rim, corner = _plate_distance(x)
+    assert (rim & corner).sum() > 20 and (rim & ~corner).sum() > 20  # arcs and lines
+    mirrored = []
+    for y in (x, x * [-1.0, 1.0, 1.0], x * [1.0, -1.0, 1.0], x[:, [1, 0, 2]]):
+        tool = SurfaceTool.from_file(path)
+        g, n = tool.gap(y)
+        dy, grad, tangent, rim, _ = _plate_distance(y)
+        np.testing.assert_allclose(g, dy, atol=1e-9)
+        np.testing.assert_allclose(n, grad, atol=1e-7)
+        P = np.eye(3) - n[rim, :, None] * n[rim, None, :] - tangent[rim, :, None] * tangent[rim, None, :]
+        np.testing.assert_allclose(tool.shape(y)[rim], P / g[rim, None, None], atol=1e-7)
+        mirrored.append(g)
+        moved = y + rng.normal(scale=0.05, size=y.shape)
+        np.testing.assert_allclose(tool.gap(moved)[0], _plate_distance(moved)[0], atol=1e-9)
+    assert np.abs(np.array(mirrored) - mirrored[0]).max() < 1e-12
+
+
 def test_bad_files_are_named(tmp_path):
     """A missing file, a file that is no CAD file by its name, a file OCC cannot read and a
     file with no surface: each an InputError naming the field given."""

@@ -80,7 +80,7 @@ class CadModel:
         lo, hi = self._box[:, 0].min(axis=0), self._box[:, 1].max(axis=0)
         self.size = float(np.linalg.norm(hi - lo))
         self._box += np.array([-1.0, 1.0])[None, :, None] * 1e-9 * self.size
-        self._bounds, self._filled, self._trims, self._flat, self._orient = {}, {}, {}, set(), {}
+        self._bounds, self._filled, self._trims, self._flat, self._orient, self._ends = {}, {}, {}, set(), {}, {}
         # the faces evaluated in numpy that fill their rectangle: the first three in closed form,
         # also on their boundary; the surfaces of revolution of a curve only inside
         self._kinds = [Planes(self.size), Cylinders(self.size), Revolutions(self.size),
@@ -112,6 +112,7 @@ class CadModel:
             else:
                 uv = np.c_[b0[0] + s * (b1[0] - b0[0]), np.zeros(SAMPLES)]
                 xyz = np.asarray(m.getValue(1, t, uv[:, 0])).reshape(-1, 3)
+                self._ends[t] = xyz[[0, -1]]  # the edge's ends, at b0 and b1
             points.append(xyz)
             owner.append(np.full(len(xyz), k))
             params.append(uv)

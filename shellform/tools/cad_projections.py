@@ -179,13 +179,32 @@ class CadProjections(CadExact):
         Jo[rows], So[rows], has[rows] = J[newton], S[newton], True
         return sure
 
+    def _edge_nearest(self, m, e, y):
+        """The nearest points of edge e (a tag) to points y, their parameters and distances: the
+        nearer of OCC's projection onto the edge and the edge's ends (getClosestPoint: the
+        curve's extremum of least distance within the edge's range, where it has one; an arc's
+        farthest point where only that lies in the range). gmsh's parametric coordinate of an
+        edge's projection is not used: gmsh 4.15 returns 0 for it wherever OCC's projection
+        succeeds (its point is right), so clamping it moved a segment's foot point to an end of
+        the segment. The parameter is that of the projected point (getParametrization of a
+        point on the curve: exact), clamped to the edge's range and evaluated there."""
+        b0, b1 = self._bounds[(1, e)]
+        c = np.asarray(m.getClosestPoint(1, e, y.ravel())[0], dtype=float).reshape(-1, 3)
+        t = np.clip(np.asarray(m.getParametrization(1, e, c.ravel()), dtype=float), b0[0], b1[0])
+        c = np.asarray(m.getValue(1, e, t)).reshape(-1, 3)
+        X = np.concatenate([c[:, None], np.broadcast_to(self._ends[e], (len(y), 2, 3))], axis=1)
+        T = np.c_[t, np.full(len(y), b0[0]), np.full(len(y), b1[0])]
+        D = np.linalg.norm(y[:, None] - X, axis=2)
+        j, r = np.argmin(D, axis=1), np.arange(len(y))  # a tie: the projection
+        return X[r, j], T[r, j], D[r, j]
+
     def _candidates(self, m, y, upper, lower, seed, bound):
         """The nearest of every entity's projection whose bounding box lies within `upper`, and
         of the seed (c, dist, entity, parameters: the local projection's point, entity -1 where
-        there is none). Raises `bound` to each projection's distance (onto the untrimmed
-        surface, the edge's curve unclamped, a straight edge's clamped: lower bounds of the
-        distance to the entity), and a face's whose projection falls outside it to the least of
-        its edges' bounds."""
+        there is none). Raises `bound` to each projection's distance (a face's onto its
+        untrimmed surface; an edge's nearest point, _edge_nearest: lower bounds of the distance
+        to the entity), and a face's whose projection falls outside it to the least of its
+        edges' bounds."""
         npts = len(y)
         cand = lower <= upper[:, None]
         nent = len(self._ents)
@@ -201,19 +220,13 @@ class CadProjections(CadExact):
             d, t = self._ents[k]
             idx = np.flatnonzero(cand[:, k])
             b0, b1 = self._bounds[(d, t)]
-            c, p = m.getClosestPoint(d, t, y[idx].ravel())
-            c = np.asarray(c).reshape(-1, 3)
-            bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
-            if d == 1:
-                p = np.asarray(p, dtype=float)
-                q = np.clip(p, b0[0], b1[0])
-                moved = q != p
-                if moved.any():
-                    c[moved] = np.asarray(m.getValue(1, t, q[moved])).reshape(-1, 3)
-                P[idx, k, 0] = q
-                if (d, t) in self._flat:  # a segment's nearest point: the line's, clamped
-                    bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
+            if d == 1:  # the edge's nearest point: its distance is the edge's
+                c, P[idx, k, 0], dist = self._edge_nearest(m, t, y[idx])
+                bound[idx, k] = np.maximum(bound[idx, k], dist)
             else:
+                c, p = m.getClosestPoint(d, t, y[idx].ravel())
+                c = np.asarray(c).reshape(-1, 3)
+                bound[idx, k] = np.maximum(bound[idx, k], np.linalg.norm(y[idx] - c, axis=1))
                 p = np.asarray(p, dtype=float).reshape(-1, 2)
                 P[idx, k] = p
                 tol = 1e-9 * (b1 - b0 + 1.0)

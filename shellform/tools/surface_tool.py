@@ -35,9 +35,10 @@ and where not, in two steps with gmsh:
                 projection onto its underlying surface (getClosestPoint, OCC's global one), kept
                 where it lies inside the trimmed face (its parametric bounds for a face that
                 fills them; for a trimmed one the inner side of its sampled boundary, isInside
-                within the sampling's margin); an edge's projection with its parameter clamped
-                to its range (the nearest point of a face whose projection falls outside it
-                lies on its boundary).
+                within the sampling's margin); an edge's nearest point, the nearer of OCC's
+                projection onto it and its two ends, its parameter that of the point, not
+                gmsh's (which reads 0 where OCC's projection succeeds). The nearest point of a
+                face whose projection falls outside it lies on its boundary: an edge's.
 
 A second, non-global minimum of the distance inside one face is not found by the gmsh steps
 (the closed forms are global on their face).
