@@ -38,7 +38,8 @@ STUDIES = {
     "strip": "finite-strain plasticity: a strip pulled to a stretch of 1.5 against closed forms",
     "ironing": "a strip squeezed between faces and drawn through a gap against plane-strain closed forms",
     "binder-wrap": "a strip wrapped onto a cylindrical binder, its springback against the closed form of a bend",
-    "channel-binder": "a channel over a curved binder: the binder wrap, then the draw, with friction per tool",
+    "curved-binder": "a channel and a square cup over cylindrical binders: the binder wrap, then the draw; friction "
+                     "per tool",
     "assembly": "assembly benchmark",
     "newton": "one Newton iteration of the plastic sheet, benchmark",
     "cup-hard": "the square cup's five hard cases",

@@ -45,6 +45,7 @@ def _drawn(s):
             "iterations": sum(h.iterations for h in p.driver.history), "increments": len(p.driver.history)}
 
 
+@pytest.mark.filterwarnings("error::shellform.tools.cad.ToolSymmetryWarning")  # the plate is symmetric
 def test_a_flat_binder_from_a_cad_file_draws_the_analytic_holders_cup(tmp_path):
     """The aluminium cup's CAD tools (n 8, 3 mm), the holder 0.85 mm over the die's top: its
     face the flat analytic one, or a CAD plate with the same opening placed on the sheet
@@ -80,6 +81,7 @@ def test_a_holders_face_from_a_file_is_checked(tmp_path, changes, field):
 CURVED = ROOT / "demos" / "square_cup_curved_binder.toml"
 
 
+@pytest.mark.filterwarnings("error::shellform.tools.cad.ToolSymmetryWarning")  # the binder is symmetric
 def test_the_holder_closes_the_blank_onto_a_cylindrical_binder_from_cad_files():
     """demos/square_cup_curved_binder.toml (die and holder faces: cylinders of R 500 and
     500 + t about the x axis, from STEP files) on n 6, the ram at binder_rise (6 mm): the

@@ -165,15 +165,15 @@ def test_the_holder_closes_the_blank_onto_the_curved_binder():
 
 
 def test_the_studys_channels_wrap_onto_the_binder_and_order_by_the_punchs_friction():
-    """docs/results/channel_binder (shellform study channel-binder): on n 16 and 24 the flange
+    """docs/results/curved_binder (shellform study curved-binder): on n 16 and 24 the flange
     closed onto the binder lies within the holder's clearance and the contact's tolerance of the
     wrapped radius; with the die and holder at 0.12, the punch's coefficient 0.02 < 0.12 < 0.3
     orders the draw-in and the peak punch force upward and the peak thinning's magnitude
     downward (docs/tools.md: the direction and the literature)."""
     import csv
 
-    rows = list(csv.DictReader(open(Path(__file__).resolve().parents[1] / "docs" / "results" / "channel_binder"
-                                    / "channel_binder.csv")))
+    rows = list(csv.DictReader(open(Path(__file__).resolve().parents[1] / "docs" / "results" / "curved_binder"
+                                    / "channel.csv")))
     curved = [r for r in rows if float(r["binder_radius_mm"]) > 0]
     assert len(curved) == 4
     for r in curved:
