@@ -414,3 +414,17 @@ class ContactSet(Part):
 
     def report(self) -> dict:
         return {"frozen": self.frozen, "in_contact": self.count()}
+
+    def derivatives(self) -> str | None:
+        """The set held, a node on a tool has a known normal row and no force on its free rows
+        beyond the sheet's (the tools' curvature term is in K); the ironing's bound is refused
+        by its own part. None."""
+        return None
+
+    def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
+        """A node on a tool lies its half thickness h_i from the tool's surface along the normal
+        (its frame's third row): d(d(x))/dp = h_i' on that known row (SheetNodes'
+        half_thickness_derivative), the tool not moving with p."""
+        on = np.flatnonzero(self.tool != FREE)
+        if on.size:
+            delta[on, 2] += self.nodes.half_thickness_derivative(de33)[on]

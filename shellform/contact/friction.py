@@ -108,6 +108,10 @@ class CoulombFriction(Part):
     def active(self) -> bool:
         return float(np.max(self.mu)) > 0
 
+    def derivatives(self) -> str | None:
+        """Frictionless, it adds nothing; its trial force's history is not differentiated yet."""
+        return "friction has no derivatives yet (its committed forces are history)" if self.active else None
+
     def per_tool(self) -> np.ndarray:
         """mu per tool of the contact set (its order, the holder's last): the scene's one
         coefficient for each, or its own."""

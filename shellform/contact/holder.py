@@ -340,3 +340,7 @@ class PinchingHolder(Part):
 
     def report(self) -> dict:
         return {"holder_closed": bool(self.closed), "holder_lift": float(self.lift)}
+
+    def derivatives(self) -> str | None:
+        """With no force there is no holder; its split of F and its lift are not differentiated yet."""
+        return "the blank holder's force has no derivatives yet" if self.force > 0 else None

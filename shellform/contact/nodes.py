@@ -157,6 +157,19 @@ class SheetNodes(Part):
         self.half_thickness = half
         self.surface_slopes = self.gradient(half, w)
 
+    def derivatives(self) -> str | None:
+        """The nodes' positions and thicknesses are read, not solved for: nothing to add (a node
+        held flat by the holder follows a moved surface at commit: the holder is refused)."""
+        return None
+
+    def half_thickness_derivative(self, de33: np.ndarray) -> np.ndarray:
+        """(n_owned,): d/dp of the half thickness of the committed state, given de33 = d/dp of
+        the cells' thickness strains: h = t/2 exp(recover(e33)) and recover is linear, so
+        h' = h recover(e33') with the same weights (0 for an elastic sheet, whose h is t/2)."""
+        if not self.model.plastic:
+            return np.zeros(self.n_owned)
+        return self.half_thickness * self.recover(de33, self._weights())
+
     def recover(self, values: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
         """(n_owned,): a per-cell field at the nodes, exact for a linear field: at each node the
         value at the node of the plane fitted by weighted least squares to the cells' values at

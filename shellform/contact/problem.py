@@ -77,13 +77,20 @@ class DrawingProblem(SheetFields):
     def stroke(self) -> float:
         return self.driver.lam * self.scene.tools.stroke
 
-    def tool_force(self, tool: int) -> np.ndarray:
+    def tool_force(self, tool: int, residual: np.ndarray | None = None) -> np.ndarray:
         """Force of a tool on the sheet (x, y, z), whole blank: contact reactions of its nodes
         rotated back from their frames, plus their friction forces. On the die this includes
         the nodes the closed holder pinches (their net force, die minus holder, and the
-        friction of both faces); the open holder's are its own (HOLDER)."""
+        friction of both faces); the open holder's are its own (HOLDER). With `residual` (owned
+        rows, the nodes' frames: a Sensitivity's dR/dp) its reactions instead: the force's
+        sensitivity (friction and the ironing's face then left out: they have none yet)."""
         d = self.driver
         on = d.contact.on(tool)
+        if residual is not None:
+            r = np.asarray(residual)[: d.n_owned * BS].reshape(-1, BS)[on, :3]
+            r = np.where(d.nodes.held[on, :3], 0.0, r)
+            f = np.einsum("nji,nj->ni", d.frames[: d.n_owned][on], r)
+            return self.symmetry * d.model.mesh.comm.allreduce(f.sum(axis=0), op=MPI.SUM)
         r = d.reactions()[on]
         r = np.where(d.nodes.held[on, :3], 0.0, r)  # the symmetry planes' reactions are not the tool's
         F = d.frames[: d.n_owned][on]
@@ -93,11 +100,11 @@ class DrawingProblem(SheetFields):
             total = total + d.ironing.face_force(tool)
         return self.symmetry * total
 
-    def punch_force(self) -> float:
+    def punch_force(self, residual: np.ndarray | None = None) -> float:
         """The force the punch pushes with along its travel (N, > 0 when drawing), whole blank:
         the sheet's force from it along its axis, negated (the punch travels down its axis,
-        +z for the analytic punch)."""
-        return -float(self.tool_force(PUNCH) @ self.driver.tools[PUNCH].axis)
+        +z for the analytic punch); with `residual`, its sensitivity (tool_force)."""
+        return -float(self.tool_force(PUNCH, residual) @ self.driver.tools[PUNCH].axis)
 
     def holder_force(self) -> float:
         """The sum of the holder's nodal forces on the sheet (N, pressing down), whole blank: the

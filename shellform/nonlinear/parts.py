@@ -21,6 +21,11 @@ forces relaxed) and the passes repeat until no part changes. A part owns its sta
 an increment from its committed state (``start``), commits it with a converged increment
 (``commit``), writes it into a checkpoint and reads it back (``checkpoint``, ``restore``) and
 says what it is doing (``report``). Every method has a default that contributes nothing.
+
+Sensitivities (sensitivity.py) differentiate the converged increment with the parts' sets
+held: a part says whether it can (``derivatives``: None, or why not) and gives the derivatives
+of its known rows (``known_derivatives``: a node on a tool lies its half thickness from it,
+which moves with the thickness strain).
 """
 
 from dataclasses import dataclass
@@ -151,3 +156,14 @@ class Part:
     def report(self) -> dict:
         """What the part is doing, for the increment's record."""
         return {}
+
+    def derivatives(self) -> str | None:
+        """None where this part's equations are differentiated by known_derivatives alone (its
+        forces on the free rows independent of the parameters at fixed q, its set held), else
+        why not, in words (the sensitivities are then refused)."""
+        return f"the part {type(self).__name__} has no derivatives yet"
+
+    def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
+        """delta ((n_owned, BS), the solve's frames) += d/dp of this part's known values, given
+        de33 = d/dp of the committed thickness strain per owned cell (the state the increment
+        started from)."""

@@ -30,15 +30,29 @@ between p - eps and p + eps, the central difference is the mean of the one-sided
 such layers are counted per increment (`switches`), so that a jump in a sensitivity can be
 traced to the increments where the plastic zone moved across a quadrature point.
 
+With tools (a driver with parts: the semi-inverse contact), the increment is differentiated with
+the parts' sets held as converged (the nodes on each tool, the stick and slip states): the
+derivative of the fixed-set problem. The known rows are then not all fixed in p: a node on a
+tool lies its half thickness h_i from the tool's surface, and h_i = t/2 exp(e33) follows the
+committed thickness strain, so the node's normal row takes q' = h_i' = h_i recover(e33'_n) (the
+parts' known_derivatives; the driver's lifted solve carries it into the free rows). The tools'
+curvature term of the tangent is in K. A part whose forces on the free rows depend on p
+(friction's committed forces, the holder's split of its force, the ironing's penalty, the
+drawbeads) says so (Part.derivatives) and the sensitivities are refused, as is a tool scene
+without finite strains or one whose parameter moves the tools (the thickness: the tools are
+placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
+jumps and the derivative of the fixed set does not: the comparison holds on a path whose set
+does not change within the difference (docs/sensitivity.md).
+
 The sensitivity is a Record of the driver (driver.records): `converged` runs with each
 converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through
-a resume. It sees the sheet and its supports only; the tools' parts (contact, friction, the
-holder) have no derivatives of their own yet, and a driver with parts is refused.
+a resume.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
+from dolfinx import fem
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
@@ -117,11 +131,18 @@ class Sensitivity(Record):
     with driver.records.append."""
 
     def __init__(self, driver, parameters):
-        if driver.parts:
-            raise InputError("output.sensitivities", "sensitivities are computed for a sheet and its supports "
-                                                     "only; a scene with tools has none yet")
         self.driver, self.model = driver, driver.model
         self.parameters = list(parameters)
+        if driver.parts:
+            why = next((w for w in (part.derivatives() for part in driver.parts) if w), None)
+            if why is None and not self.model.finite:
+                why = "a tool scene's sensitivities need the effect 'finite_strain' (the nodes' thickness)"
+            if why is None and any(isinstance(p, ThicknessParameter) for p in self.parameters):
+                why = "material.thickness places the tools around the sheet: not differentiated with tools yet"
+            if why is not None:
+                raise InputError("output.sensitivities", f"{why}; a tool scene's sensitivities need rigid tools "
+                                 "without friction, holder force, ironing or drawbeads")
+        self._known = fem.Function(self.model.V)  # the known rows' derivatives, shared with the ghosts
         zeros = lambda a: np.zeros_like(a)  # noqa: E731
         start = self.model.history()
         self.dq = {p.name: zeros(driver.q.x.array) for p in self.parameters}
@@ -150,8 +171,16 @@ class Sensitivity(Record):
             if load is not None:
                 rhs[: load.size] += load
             rhs[~free] = 0.0
+            delta = np.zeros_like(q)  # the known rows' derivatives (solve coordinates, ghosts from their owners)
+            if driver.parts:
+                de33 = (dh["stretch"] / h_n["stretch"]).mean(axis=1)  # d/dp of ln(t/t0) per cell, committed
+                self._known.x.array[:] = 0.0
+                for part in driver.parts:
+                    part.known_derivatives(self._known.x.array[:owned].reshape(-1, BS), de33)
+                self._known.x.scatter_forward()
+                delta = self._known.x.array.copy()
             out = driver.dq  # the step's work array, free after convergence
-            if not driver.solve_lifted(np.zeros_like(q), out, extra=-rhs):
+            if not driver.solve_lifted(delta, out, extra=-rhs):
                 raise RuntimeError(f"the sensitivity solve for {par.name} failed at load factor {lam:.6g}")
             dq = driver.to_xyz(out.x.array)
             ends = [model.respond(q + s * eps * dq, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))

@@ -197,15 +197,16 @@ def _validate_material(s) -> None:
 
 
 def _validate_sensitivities(s) -> None:
-    """[output] sensitivities: a nonlinear sheet scene's (the tools' parts have no derivatives
-    yet), each a number the sheet depends on; scatter: one standard deviation >= 0 each."""
+    """[output] sensitivities: a nonlinear sheet scene's (a tool scene's rigid tools have
+    derivatives, reached from a script: docs/sensitivity.md), each a number the sheet depends
+    on; scatter: one standard deviation >= 0 each."""
     names, scatter = s.output.sensitivities, s.output.scatter
     if not names:
         require(not scatter, "output.scatter", "needs output.sensitivities (a standard deviation per parameter)")
         return
     require(s.nonlinear and s.tools is None, "output.sensitivities",
-            "sensitivities are computed for a nonlinear sheet scene without tools (the contact's parts have no "
-            "derivatives yet)")
+            "a scene reports sensitivities for a nonlinear sheet without tools (a tool scene's rigid punch and die "
+            "have derivatives, reached from a script so far: docs/sensitivity.md, Tool scenes)")
     numbers = {f.name for f in fields(s.material) if f.type is float and f.name != "thickness"}
     base = s.hill79().pack()
     require(len(set(names)) == len(names), "output.sensitivities", "names a parameter twice")

@@ -30,6 +30,7 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from shellform.assembly.sheet_element import BS
 from shellform.material import Hill79Material, flow_stress
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.loads import SheetLoads
@@ -197,6 +198,60 @@ def cantilever(folder: Path) -> tuple[list[dict], dict]:
     return rows, {"case": "cantilever (scene)", "with_s": with_s, "without_s": without, "parameters": len(CANTILEVER)}
 
 
+CUP_STEP = 1e-5  # the drawn cup's differences: at 1e-4 layers yield between p - h and p + h (docs/sensitivity.md)
+CUP_PARAMETERS = ("K", "n")
+
+
+def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0):
+    """demos/round_cup.toml without friction, holder force and ironing (rigid punch and die only:
+    the parts that have derivatives), n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10, with
+    `changes` {material key: value}: (problem, Sensitivity or None)."""
+    from shellform import demos, scene
+    from shellform.contact.problem import DrawingProblem
+
+    base = scene.load(demos.path("round_cup.toml"))
+    s = base.changed({"mesh.n": n, "tools.stroke": stroke, "tools.friction": 0.0, "tools.blank_holder_force": 0.0,
+                      "effects": [e for e in base.effects if e not in ("friction", "ironing")],
+                      "process.report": [], "process.initial_step_mm": 0.1, "process.max_step_mm": 0.1,
+                      "process.min_step_mm": 0.001, "process.rtol": 1e-10,
+                      **{f"material.{k}": v for k, v in (changes or {}).items()}})
+    p = DrawingProblem.from_scene(s, verbose=False)
+    sens = None
+    if sensitivities:
+        sens = Sensitivity(p.driver, [MaterialParameter(k, float(getattr(s.material, k)),
+                                                        lambda v, k=k: s.with_material(k, v).hill79().pack())
+                                      for k in sensitivities])
+        p.driver.records.append(sens)
+    p.driver.run(1.0)
+    return p, sens
+
+
+def rim_node(p) -> int:
+    """The owned node of the blank's edge on y = 0 (its radial draw-in: -dx)."""
+    X = p.driver.model.mesh.geometry.x[: p.driver.n_owned]
+    return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
+
+
+def cup() -> tuple[list[dict], dict]:
+    """The frictionless round cup drawn 3 mm (drawn_cup): the punch force and the rim's draw-in
+    on y = 0, d/dK and d/dn against central differences of two runs at p (1 +- CUP_STEP)."""
+    (p, s), with_s, without = _costs(lambda: drawn_cup(), lambda: drawn_cup(sensitivities=CUP_PARAMETERS))
+    i = rim_node(p)
+    rows = []
+    for k in CUP_PARAMETERS:
+        value = float(getattr(p.scene.material, k))
+        h = CUP_STEP * value
+        plus, minus = drawn_cup({k: value + h})[0], drawn_cup({k: value - h})[0]
+        fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)
+        fd_draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
+        rows.append(_row("round cup, frictionless", "punch force", k, p.punch_force(residual=s.residual(k)),
+                         fd_force, "central differences", abs(p.punch_force() / value)))
+        rows.append(_row("round cup, frictionless", "rim draw-in (y = 0)", k,
+                         -float(s.carrier(k).reshape(-1, BS)[i, 0]), fd_draw, "central differences"))
+    return rows, {"case": "round cup, frictionless", "with_s": with_s, "without_s": without,
+                  "parameters": len(CUP_PARAMETERS)}
+
+
 def plates() -> tuple[list[dict], dict]:
     E, P = 70e3, 5.0
     effects = ("bending", "membrane", "geometric_nonlinearity")
@@ -238,7 +293,7 @@ def run(outdir) -> list[dict]:
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     rows, times = [], []
-    for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates):
+    for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup):
         r, t = case()
         rows += r
         times.append(t)
