@@ -42,19 +42,34 @@ def punch(gmsh, half_width, corner_radius, profile_radius, z_face=0.0, height=60
     occ.synchronize()
 
 
+def vertical_edges_of(gmsh, volume):
+    """The vertical edges of one volume of the current model."""
+    faces = gmsh.model.getBoundary([(3, volume)], oriented=False)
+    edges = {abs(t) for _, t in gmsh.model.getBoundary(faces, combined=False, oriented=False)}
+    return [t for t in edges if _vertical(*gmsh.model.getBoundingBox(1, t))]
+
+
+def cut_opening(gmsh, solid, half_width, corner_radius, z0, z1):
+    """Cut from the volume `solid` the rounded-square opening of half-width half_width (plan
+    corner radius corner_radius > 0) between z0 and z1; returns the volume left."""
+    occ, a = gmsh.model.occ, half_width
+    hole = occ.addBox(-a, -a, z0, 2 * a, 2 * a, z1 - z0)
+    occ.synchronize()
+    occ.fillet([hole], vertical_edges_of(gmsh, hole), [corner_radius])
+    occ.synchronize()
+    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != solid]
+    occ.cut([(3, solid)], [(3, hole)])
+    occ.synchronize()
+    (_, vol), = gmsh.model.getEntities(3)
+    return vol
+
+
 def die(gmsh, half_width, corner_radius, profile_radius, z_top=0.0, outer=100.0, depth=60.0):
     """The die in the current gmsh model: flat top at z_top over |x|, |y| <= outer, the opening
     of half-width half_width (plan corner radius corner_radius > 0) through its depth."""
-    occ, a = gmsh.model.occ, half_width
+    occ = gmsh.model.occ
     plate = occ.addBox(-outer, -outer, z_top - depth, 2 * outer, 2 * outer, depth)
-    hole = occ.addBox(-a, -a, z_top - depth - 1.0, 2 * a, 2 * a, depth + 2.0)
-    occ.synchronize()
-    occ.fillet([hole], _edges(gmsh, _vertical), [corner_radius])
-    occ.synchronize()
-    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != plate]
-    occ.cut([(3, plate)], [(3, hole)])
-    occ.synchronize()
-    (_, vol), = gmsh.model.getEntities(3)
+    vol = cut_opening(gmsh, plate, half_width, corner_radius, z_top - depth - 1.0, z_top + 1.0)
     rim = _edges(gmsh, lambda x0, y0, z0, x1, y1, z1: z0 > z_top - 1e-6 and max(x1, y1) < outer - 1e-6)
     occ.fillet([vol], rim, [profile_radius])
     occ.synchronize()
@@ -65,15 +80,8 @@ def holder(gmsh, half_width, corner_radius, z_face=0.0, outer=100.0, height=20.0
     z_face over |x|, |y| <= outer, with the opening of half-width half_width (plan corner radius
     corner_radius > 0) through it; its face's inner edge is sharp, as the analytic holder's
     (shellform/tools/analytic.py, BlankHolder) ends there."""
-    occ, a = gmsh.model.occ, half_width
-    plate = occ.addBox(-outer, -outer, z_face, 2 * outer, 2 * outer, height)
-    hole = occ.addBox(-a, -a, z_face - 1.0, 2 * a, 2 * a, height + 2.0)
-    occ.synchronize()
-    occ.fillet([hole], _edges(gmsh, _vertical), [corner_radius])
-    occ.synchronize()
-    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != plate]
-    occ.cut([(3, plate)], [(3, hole)])
-    occ.synchronize()
+    plate = gmsh.model.occ.addBox(-outer, -outer, z_face, 2 * outer, 2 * outer, height)
+    cut_opening(gmsh, plate, half_width, corner_radius, z_face - 1.0, z_face + height + 1.0)
 
 
 def write_step(build, path, *args, prepare=None):

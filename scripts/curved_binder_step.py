@@ -21,38 +21,22 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cup_tools_step import _edges, _vertical, write_step  # noqa: E402
+from cup_tools_step import _edges, _vertical, cut_opening, write_step  # noqa: E402
 
 
-def _vertical_edges_of(gmsh, volume):
-    """The vertical edges of one volume."""
-    faces = gmsh.model.getBoundary([(3, volume)], oriented=False)
-    edges = {abs(t) for _, t in gmsh.model.getBoundary(faces, combined=False, oriented=False)}
-    return [t for t in edges if _vertical(*gmsh.model.getBoundingBox(1, t))]
-
-
-def _cylinder_block(gmsh, radius, outer, bottom, top):
-    """The solid under (or over) the cylinder of `radius` about the x axis through z = -radius,
-    over |x|, |y| <= outer, between z = bottom and z = top: the box cut by the cylinder."""
-    occ = gmsh.model.occ
-    box = occ.addBox(-outer, -outer, bottom, 2 * outer, 2 * outer, top - bottom)
-    cyl = occ.addCylinder(-outer - 1.0, 0.0, -radius, 2 * outer + 2.0, 0.0, 0.0, radius)
-    return box, cyl
+def _cylinder(gmsh, axis_depth, radius, outer):
+    """The cylinder of `radius` about the x axis through z = -axis_depth, longer than the tools."""
+    return gmsh.model.occ.addCylinder(-outer - 1.0, 0.0, -axis_depth, 2 * outer + 2.0, 0.0, 0.0, radius)
 
 
 def die(gmsh, radius, half_width, corner_radius, profile_radius, outer=100.0, depth=60.0):
+    """A block under the cylinder of `radius` (over |x|, |y| <= outer, from z = -depth), the
+    opening cut through it, its rim on the cylinder rounded with profile_radius."""
     occ = gmsh.model.occ
-    box, cyl = _cylinder_block(gmsh, radius, outer, -depth, 10.0)
-    (block,), _ = occ.intersect([(3, box)], [(3, cyl)])
+    box = occ.addBox(-outer, -outer, -depth, 2 * outer, 2 * outer, depth + 10.0)
+    (block,), _ = occ.intersect([(3, box)], [(3, _cylinder(gmsh, radius, radius, outer))])
     occ.synchronize()
-    hole = occ.addBox(-half_width, -half_width, -depth - 1.0, 2 * half_width, 2 * half_width, depth + 12.0)
-    occ.synchronize()
-    occ.fillet([hole], _vertical_edges_of(gmsh, hole), [corner_radius])
-    occ.synchronize()
-    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != block[1]]
-    occ.cut([block], [(3, hole)])
-    occ.synchronize()
-    (_, vol), = gmsh.model.getEntities(3)
+    vol = cut_opening(gmsh, block[1], half_width, corner_radius, -depth - 1.0, 11.0)
     rim = _edges(gmsh, lambda x0, y0, z0, x1, y1, z1: z1 > -12.0 and z0 > -12.0 and max(x1, y1) < outer - 1e-6
                  and not _vertical(x0, y0, z0, x1, y1, z1))
     occ.fillet([vol], rim, [profile_radius])
@@ -60,19 +44,12 @@ def die(gmsh, radius, half_width, corner_radius, profile_radius, outer=100.0, de
 
 
 def holder(gmsh, radius, thickness, half_width, corner_radius, outer=100.0, height=20.0):
+    """A plate over the cylinder of radius + thickness (its face), the opening cut through it."""
     occ = gmsh.model.occ
-    face = radius + thickness
     box = occ.addBox(-outer, -outer, -30.0, 2 * outer, 2 * outer, 30.0 + height)
-    cyl = occ.addCylinder(-outer - 1.0, 0.0, -radius, 2 * outer + 2.0, 0.0, 0.0, face)
-    (plate,), _ = occ.cut([(3, box)], [(3, cyl)])
+    (plate,), _ = occ.cut([(3, box)], [(3, _cylinder(gmsh, radius, radius + thickness, outer))])
     occ.synchronize()
-    hole = occ.addBox(-half_width, -half_width, -40.0, 2 * half_width, 2 * half_width, 40.0 + height + 2.0)
-    occ.synchronize()
-    occ.fillet([hole], _vertical_edges_of(gmsh, hole), [corner_radius])
-    occ.synchronize()
-    (_, hole), = [e for e in gmsh.model.getEntities(3) if e[1] != plate[1]]
-    occ.cut([plate], [(3, hole)])
-    occ.synchronize()
+    cut_opening(gmsh, plate[1], half_width, corner_radius, -40.0, height + 2.0)
 
 
 if __name__ == "__main__":
