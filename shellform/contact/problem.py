@@ -228,6 +228,12 @@ class DrawingProblem(SheetFields):
         e33 = np.log(2 * d.nodes.half_thickness / self.model.thickness)
         return d.nodes.X[: d.n_owned, :2], d.positions(), e33
 
+    def nodal_thickness_strain_derivative(self, de33: np.ndarray) -> np.ndarray:
+        """Owned nodes: d/dp of nodal_values()'s e33 = ln(2 h_i / t), h_i'/h_i, from the cells'
+        d e33/dp (a Sensitivity's thickness_strain; SheetNodes.half_thickness_derivative)."""
+        nodes = self.driver.nodes
+        return nodes.half_thickness_derivative(de33) / nodes.half_thickness
+
     def rim(self) -> np.ndarray:
         """Owned nodes on the blank's outer edge: those of the boundary groups the scene leaves
         free (the tools hold the blank there; a quarter's symmetry lines are not its edge), as a

@@ -55,6 +55,10 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              increment), the cell's initial x y and thickness strain there; null
                              without a neck. With [process] stop_at_neck the stroke ends at that
                              increment; without, the run goes on and only reports it
+    sensitivities.csv, tornado.png   ([output] sensitivities: rigid tools alone) the answers'
+                             derivatives at every report (results/drawing.py CupSensitivities;
+                             summary.json "sensitivities" per report, "sensitivity_checks",
+                             "uncertainty" with a scatter; docs/sensitivity.md)
     springback.csv, .png     ([process] springback) the profiles along y = 0 and x = y before and
                              after the tools withdraw (contact/springback.py releases them,
                              results/springback.py writes; the picture: after minus before);
@@ -91,6 +95,7 @@ from shellform.nonlinear.interrupt import Interrupted
 from shellform.results import run_folder
 from shellform.results import springback as sprung_back
 from shellform.results.disk import DiskFull
+from shellform.nonlinear.sensitivity import Sensitivity, scene_parameters
 from shellform.results.drawing import CupListeners
 from shellform.results.listeners import EndOfStroke, Run
 from shellform.results.log import Progress, say
@@ -157,7 +162,10 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
     p = DrawingProblem.from_scene(s, comm, checkpoint_dir=outdir, trace=trace)
     d = p.driver
     d.fingerprint = run_folder.fingerprint(s, checkpoint.mesh_hash(p.model.V))
-    cup = CupListeners.of(s, p.model.plastic, outdir, comm, listeners)
+    sens = Sensitivity(d, scene_parameters(s)) if s.output.sensitivities else None
+    if sens is not None:
+        d.records.append(sens)  # the derivatives carried along the stroke, in its checkpoints
+    cup = CupListeners.of(s, p.model.plastic, outdir, comm, listeners, sens)
     if cup.limits is not None:
         d.records += cup.limits.records()  # what the run records along the stroke, in its checkpoints
     told = cup.all()
@@ -271,6 +279,7 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         "wall_time_s": {"total": time.perf_counter() - t0, "setup": setup_s, **d.times},
         "cpu_time_s": comm.allreduce(time.process_time() - c0, op=MPI.SUM),
         "over_the_stroke": cup.table.over_the_stroke(),
+        **(cup.sensitivities.summary(r) if cup.sensitivities is not None else {}),
     }, outdir)
     summary.write(comm)
     return summary

@@ -29,6 +29,7 @@ import numpy as np
 from dolfinx import fem, io
 from mpi4py import MPI
 
+from shellform.assembly.sheet_element import BS
 from shellform.results import fields
 from shellform.results.fields import offscreen_backend
 from shellform.results.tables import write_figure, write_screenshot
@@ -56,6 +57,25 @@ def draw_in(p) -> dict:
     if p.tools_kind.RIM:
         out.update(rim_draw_in(rim(p)))
     return out
+
+
+def derivatives(p, sens, name: str) -> dict:
+    """d/d(name) of the report's answers (state()) from the Sensitivity `sens`: DX, DY and DD
+    at draw_in's nodes (-dx, -dy, and the corner's -x . dx / |x| in plan), the punch force (kN,
+    its reactions' dR/dp) and min_thickness_strain at the node where it is least (the nodes'
+    e33 = ln(2 h_i / t): h_i' / h_i)."""
+    X, x, e33 = p.nodal_values()
+    dx = sens.carrier(name).reshape(-1, BS)[: len(X), :3]
+    de33 = p.nodal_thickness_strain_derivative(sens.thickness_strain(name))
+    X, x, dx, e33, de33 = _gather(p.comm, X, x, dx, e33, de33)
+    _, hx, _, hy = p.blank_bounds()
+    i0 = int(np.argmin(np.hypot(X[:, 0] - hx, X[:, 1])))
+    i1 = int(np.argmin(np.hypot(X[:, 0], X[:, 1] - hy)))
+    c = int(np.argmax(X[:, 0] + X[:, 1]))
+    plan = x[c, :2]
+    return {"DX": -float(dx[i0, 0]), "DY": -float(dx[i1, 1]), "DD": -float(plan @ dx[c, :2] / np.hypot(*plan)),
+            "punch_force_kN": p.punch_force(residual=sens.residual(name)) / 1e3,
+            "min_thickness_strain": float(de33[int(np.argmin(e33))])}
 
 
 RIM_ANGLES = (0.0, 45.0, 90.0)  # the round cup's draw-in in summary.json: rim_0deg, rim_45deg, rim_90deg

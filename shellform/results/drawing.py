@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from shellform.errors import InputError
-from shellform.results import cup, fld, neck
+from shellform.results import cup, fld, neck, sensitivity
 from shellform.results.listeners import Listener, Listeners, Run
 from shellform.results.tables import write_csv, write_json
 
@@ -217,6 +217,28 @@ class DrawnCup(Listener):
             cup.picture(outdir / "cup.png", p, f"{title}: stroke {p.stroke:.1f} mm")
 
 
+class CupSensitivities(Listener):
+    """The answers' derivatives in `[output] sensitivities` (a Sensitivity, a record of the
+    driver: nonlinear/sensitivity.py), added to each report of `reports` (cup.derivatives);
+    sensitivities.csv and tornado.png at the end (results/sensitivity.py)."""
+
+    def __init__(self, sens, reports: Reports):
+        self.sens, self.reports = sens, reports
+
+    def on_report(self, run: Run) -> None:
+        row = self.reports.rows[-1]
+        row["sensitivities"] = {par.name: cup.derivatives(run.sheet, self.sens, par.name)
+                                for par in self.sens.parameters}
+
+    def on_end(self, run: Run) -> None:
+        s = run.scene
+        sensitivity.write(run.outdir, self.reports.rows, self.sens.parameters, s.output.scatter, s.title,
+                          picture=s.output.png, at="stroke_mm")
+
+    def summary(self, run: Run) -> dict:
+        return sensitivity.summary(self.sens, self.reports.rows, run.scene.output.scatter)
+
+
 @dataclass
 class CupListeners:
     """The listeners a cup run composes, by name (None: not this scene's), and the caller's."""
@@ -227,23 +249,27 @@ class CupListeners:
     necking: neck.Necking | None
     series: Series | None
     reports: Reports
+    sensitivities: CupSensitivities | None = None
     extra: tuple = ()
 
     @classmethod
-    def of(cls, scene, plastic: bool, outdir: Path, comm, extra=()) -> "CupListeners":
+    def of(cls, scene, plastic: bool, outdir: Path, comm, extra=(), sens=None) -> "CupListeners":
         """The scene's listeners: the forming-limit records where the sheet is plastic and the
         view or the stop at the forming limit is asked for, the neck's watch where it is plastic,
-        the series where VTX or VTU is; `extra`, the caller's, told after them."""
+        the series where VTX or VTU is, the sensitivities' answers where `sens` (the run's
+        Sensitivity record) is given; `extra`, the caller's, told after them."""
         o, pr = scene.output, scene.process
         limits = FormingLimits(scene, comm, o.fld, pr.stop_at_forming_limit) \
             if plastic and (o.fld or pr.stop_at_forming_limit) else None
         series = Series(o.vtx, o.vtu, o.fld and plastic) if o.vtx or o.vtu else None
         necking = neck.Necking.stroke(comm, pr.stop_at_neck, scene.tools.stroke, scene.largest_r()) if plastic else None
-        return cls(DrawnCup(o.png), ForceStroke(outdir), limits, necking, series, Reports(outdir), tuple(extra))
+        reports = Reports(outdir)
+        return cls(DrawnCup(o.png), ForceStroke(outdir), limits, necking, series, reports,
+                   CupSensitivities(sens, reports) if sens is not None else None, tuple(extra))
 
     def all(self) -> Listeners:
         """In the order they are told: the drawn cup's pictures first at the end, the forming
         limit's end of the stroke before the neck's, the series' collective writes before the
-        reports' own."""
-        own = (self.drawn, self.table, self.limits, self.necking, self.series, self.reports)
+        reports' own, the report's derivatives after the report."""
+        own = (self.drawn, self.table, self.limits, self.necking, self.series, self.reports, self.sensitivities)
         return Listeners([x for x in own if x is not None] + list(self.extra))

@@ -26,6 +26,11 @@ Written into the output folder:
                         beside the largest of its units, a zero displacement's, is left out)
 summary.json: "sensitivities" in each report, {parameter: {answer: da/dp}}; "uncertainty" (with
 a scatter) at the last report, {answer: {"sd", "shares": {parameter: share}}}.
+
+A drawn cup's answers (a tool scene whose parts have derivatives: docs/sensitivity.md, Tool
+scenes) are its report's: DX, DY, DD, the punch force (kN) and the peak thinning
+min_thickness_strain at its node (results/cup.py, derivatives); the CSV's first column is then
+stroke_mm.
 """
 
 import math
@@ -93,18 +98,34 @@ def uncertainty(derivatives: dict, scatter: dict) -> dict:
     return out
 
 
-def write(outdir: Path, reports: list[dict], parameters, scatter, title: str, picture: bool = True) -> None:
+def summary(sens, rows: list[dict], scatter) -> dict:
+    """summary.json's "sensitivity_checks" (where the derivatives are one-sided means, and the
+    free rows' check) and, with a scatter, "uncertainty" at the last report (`rows`: the
+    reports, their "sensitivities")."""
+    out = {"sensitivity_checks": {
+        "increments_with_switching_layers": [i + 1 for i, k in enumerate(sens.switches) if k],
+        "largest_free_residual": max(sens.free_residual, default=0.0)}}
+    if scatter and rows and "sensitivities" in rows[-1]:
+        out["uncertainty"] = uncertainty(rows[-1]["sensitivities"], changes(sens.parameters, scatter))
+    return out
+
+
+def write(outdir: Path, reports: list[dict], parameters, scatter, title: str, picture: bool = True,
+          at: str = "load_factor") -> None:
     """sensitivities.csv and (with `picture`) tornado.png from the reports' "sensitivities"
-    (rank 0 writes)."""
+    (rank 0 writes); `at`: the reports' key of where they were taken (a cup's "stroke_mm"), the
+    CSV's first column."""
     stated = changes(parameters, scatter)
     values = {par.name: par.value for par in parameters}
-    rows = [{"load_factor": r["load_factor"], "answer": answer, "parameter": name, "value": values[name],
+    rows = [{at: r[at], "answer": answer, "parameter": name, "value": values[name],
              "derivative": d, "change": stated[name], "answer_change": d * stated[name]}
             for r in reports if "sensitivities" in r
             for name, ds in r["sensitivities"].items() for answer, d in ds.items()]
-    write_csv(Path(outdir) / "sensitivities.csv", rows, COLUMNS)
+    write_csv(Path(outdir) / "sensitivities.csv", rows, [at] + COLUMNS[1:])
     if picture and MPI.COMM_WORLD.rank == 0 and rows:
-        _tornado(Path(outdir) / "tornado.png", reports[-1], stated, title)
+        where = "load factor" if at == "load_factor" else at.replace("_mm", " (mm)")
+        _tornado(Path(outdir) / "tornado.png", reports[-1], stated, f"{title}: sensitivities at {where} "
+                 f"{reports[-1][at]:.4g}")
 
 
 def _tornado(path: Path, report: dict, stated: dict, title: str) -> None:
@@ -128,7 +149,7 @@ def _tornado(path: Path, report: dict, stated: dict, title: str) -> None:
         ax.set_title(answer, fontsize=9, loc="left")
         ax.tick_params(labelsize=8)
     axes[-1, 0].set_xlabel("change of the answer for the stated change of each parameter")
-    fig.suptitle(f"{title}: sensitivities at load factor {report['load_factor']:.4g}", fontsize=10)
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     write_figure(path, fig)
     plt.close(fig)

@@ -131,16 +131,8 @@ class SheetSensitivities(Listener):
                           picture=s.output.png)
 
     def summary(self, run: Run) -> dict:
-        """summary.json's "sensitivity_checks" (where the derivatives are one-sided means, and
-        the free rows' check) and, with a scatter, "uncertainty" at the last report."""
-        out = {"sensitivity_checks": {
-            "increments_with_switching_layers": [i + 1 for i, k in enumerate(self.sens.switches) if k],
-            "largest_free_residual": max(self.sens.free_residual, default=0.0)}}
-        rows, scatter = self.reports.rows, run.scene.output.scatter
-        if scatter and rows and "sensitivities" in rows[-1]:
-            out["uncertainty"] = sensitivity.uncertainty(rows[-1]["sensitivities"],
-                                                         sensitivity.changes(self.sens.parameters, scatter))
-        return out
+        """summary.json's "sensitivity_checks" and "uncertainty" (results/sensitivity.py)."""
+        return sensitivity.summary(self.sens, self.reports.rows, run.scene.output.scatter)
 
 
 class SheetListeners:

@@ -197,16 +197,16 @@ def _validate_material(s) -> None:
 
 
 def _validate_sensitivities(s) -> None:
-    """[output] sensitivities: a nonlinear sheet scene's (a tool scene's rigid tools have
-    derivatives, reached from a script: docs/sensitivity.md), each a number the sheet depends
-    on; scatter: one standard deviation >= 0 each."""
+    """[output] sensitivities: a nonlinear scene's, each a number the sheet depends on (a tool
+    scene's: of its rigid tools alone, whose parts have derivatives: docs/sensitivity.md, Tool
+    scenes); scatter: one standard deviation >= 0 each."""
     names, scatter = s.output.sensitivities, s.output.scatter
     if not names:
         require(not scatter, "output.scatter", "needs output.sensitivities (a standard deviation per parameter)")
         return
-    require(s.nonlinear and s.tools is None, "output.sensitivities",
-            "a scene reports sensitivities for a nonlinear sheet without tools (a tool scene's rigid punch and die "
-            "have derivatives, reached from a script so far: docs/sensitivity.md, Tool scenes)")
+    require(s.nonlinear, "output.sensitivities", "a scene reports sensitivities of a nonlinear sheet")
+    if s.tools is not None:
+        _validate_tool_sensitivities(s)
     numbers = {f.name for f in fields(s.material) if f.type is float and f.name != "thickness"}
     base = s.hill79().pack()
     require(len(set(names)) == len(names), "output.sensitivities", "names a parameter twice")
@@ -226,6 +226,22 @@ def _validate_sensitivities(s) -> None:
             f"needs one standard deviation per parameter of output.sensitivities ({len(names)}), got {len(scatter)}")
     for i, sd in enumerate(scatter):
         require(math.isfinite(sd) and sd >= 0, f"output.scatter[{i}]", f"must be finite and >= 0, got {sd}")
+
+
+def _validate_tool_sensitivities(s) -> None:
+    """A tool scene's sensitivities: its rigid tools alone have derivatives (no friction, holder
+    force, ironing or drawbeads), with finite strains (the nodes' thickness), and no parameter
+    that moves the tools."""
+    for effect in ("friction", "ironing", "drawbeads"):
+        require(effect not in s.effects, "effects", f"the effect {effect!r} has no derivatives yet: a tool scene's "
+                "output.sensitivities are its rigid tools' alone (docs/sensitivity.md, Tool scenes)")
+    require("finite_strain" in s.effects, "effects",
+            "a tool scene's output.sensitivities need the effect 'finite_strain' (the nodes' thickness)")
+    require(s.tools.blank_holder_force == 0, "tools.blank_holder_force",
+            "the holder's force has no derivatives yet: a tool scene's output.sensitivities need it 0")
+    for name in s.output.sensitivities:
+        require(name not in ("material.thickness", "loads.pressure"), f"output.sensitivities ({name})",
+                "moves the tools or loads no tool scene: a tool scene takes material.<number>")
 
 
 def _validate_probes(s) -> None:

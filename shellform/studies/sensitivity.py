@@ -202,10 +202,11 @@ CUP_STEP = 1e-5  # the drawn cup's differences: at 1e-4 layers yield between p -
 CUP_PARAMETERS = ("K", "n")
 
 
-def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0):
+def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False):
     """demos/round_cup.toml without friction, holder force and ironing (rigid punch and die only:
     the parts that have derivatives), n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10, with
-    `changes` {material key: value}: (problem, Sensitivity or None)."""
+    `changes` {material key: value}: (problem, Sensitivity or None); with scene_only, (the
+    scene, None), not run."""
     from shellform import demos, scene
     from shellform.contact.problem import DrawingProblem
 
@@ -215,6 +216,8 @@ def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke:
                       "process.report": [], "process.initial_step_mm": 0.1, "process.max_step_mm": 0.1,
                       "process.min_step_mm": 0.001, "process.rtol": 1e-10,
                       **{f"material.{k}": v for k, v in (changes or {}).items()}})
+    if scene_only:
+        return s, None
     p = DrawingProblem.from_scene(s, verbose=False)
     sens = None
     if sensitivities:
