@@ -149,6 +149,16 @@ class ContactSet(Part):
             gaps.append(self.holder.face_gap(x, h))
         return gaps
 
+    def normals_at(self, x, lam) -> np.ndarray:
+        """(n_owned, 3): each node's tool's normal at positions x (+z off the tools)."""
+        out = np.tile([0.0, 0.0, 1.0], (x.shape[0], 1))
+        h = self.nodes.half_thickness
+        for k, (tool, path) in enumerate(zip(self.tools, self.paths)):
+            on = self.tool == k
+            if on.any():
+                out[on] = tool.gap(x[on], h[on], path.at(lam))[1]
+        return out
+
     def on(self, k: int) -> np.ndarray:
         """The owned nodes on tool k (the open holder: holder_tool)."""
         return self.tool == k

@@ -102,6 +102,8 @@ class CoulombFriction(Part):
         self.force = np.zeros((n, 3))  # of the current iterate (x, y, z)
         self.rate = np.zeros((n, 2, 2))  # -df/ds in the nodes' tangent slots
         self.slipping = np.zeros(n, dtype=bool)
+        self.forgotten = np.zeros(n, dtype=bool)
+        self.dhistory, self.dforce = {}, {}  # per parameter: d/dp of the history, of this increment's forces
         self.known_columns = None  # that tangent's terms on the known columns (lift_known)
 
     @property
@@ -109,8 +111,9 @@ class CoulombFriction(Part):
         return float(np.max(self.mu)) > 0
 
     def derivatives(self) -> str | None:
-        """Frictionless, it adds nothing; its trial force's history is not differentiated yet."""
-        return "friction has no derivatives yet (its committed forces are history)" if self.active else None
+        """Friction on the tools is differentiated with the stick and slip states held
+        (pseudo_load, carry); on a pinched node it reads the holder's split, which has none."""
+        return None
 
     def per_tool(self) -> np.ndarray:
         """mu per tool of the contact set (its order, the holder's last): the scene's one
@@ -146,6 +149,7 @@ class CoulombFriction(Part):
         """An increment (or a retry of it) starts from the committed history and normal forces,
         extrapolated where the driver predicts."""
         self.history = self.committed.copy()
+        self.forgotten = np.zeros(self.history.shape[0], dtype=bool)  # nodes whose history this increment forgot
         self.normal = self.committed_normal.copy()
         self._r_prev, self._omega = None, 1.0  # Aitken's memory of the normal-force updates
         prev = self.previous
@@ -166,9 +170,13 @@ class CoulombFriction(Part):
     def forget(self, nodes: np.ndarray) -> None:
         """Nodes that switched tools start without history."""
         self.history[nodes] = 0.0
+        self.forgotten[nodes] = True
 
     def commit(self, lam: float = 0.0) -> None:
-        """The increment converged: its forces are the next one's history."""
+        """The increment converged: its forces are the next one's history (and their
+        derivatives, where carry gave them, the next one's history derivatives)."""
+        self.dhistory.update(self.dforce)
+        self.dforce = {}
         self.committed = self.force.copy()
         self.history = self.committed.copy()
         self.previous = self.last
@@ -285,6 +293,74 @@ class CoulombFriction(Part):
         dp, pn = self.update_normal(changes, weight)
         return Change(0, 0, bool(mu * dp <= self.rtol * mu * pn),
                       f"friction change |mu dp| {mu * dp:.3e} of |mu p| {mu * pn:.3e}")
+
+    # -- derivatives (nonlinear/sensitivity.py) --------------------------------------------------
+    def forces_at(self, x, x_n, normals, history, normal, coefficient) -> np.ndarray:
+        """(n_owned, 3): the return mapping's forces on this iterate's rubbing nodes with every
+        input given (positions x, x_n, their tools' normals, the history, the normal forces and
+        coefficients) and the stick and slip states held as they are (slip's formulas): the map
+        a sensitivity differentiates."""
+        idx, shift = self._rub[0], self._rub[1]
+        n = normals[idx]
+        ds = x[idx] - x_n[idx]
+        ds -= shift
+        ds -= np.sum(ds * n, axis=1)[:, None] * n
+        h = history[idx]
+        trial = h - np.sum(h * n, axis=1)[:, None] * n - self.k_stick[idx][:, None] * ds
+        size = np.linalg.norm(trial, axis=1)
+        limit = coefficient[idx] * normal[idx]
+        ratio = np.where(self.slipping[idx], limit / np.maximum(size, 1e-300), 1.0)
+        out = np.zeros_like(self.force)
+        out[idx] = ratio[:, None] * trial
+        return out
+
+    def _differences(self, key, eps, x, dx, dx_n, normals, dnormal, rates):
+        """(f(+eps) - f(-eps)) / 2 eps of forces_at along (dx, dx_n, the history's derivative,
+        dnormal, the coefficients' rates); normals: a function of the positions."""
+        dh = self.dhistory.get(key, np.zeros_like(self.history))
+        dh = np.where(self.forgotten[:, None], 0.0, dh)
+        mu_rate = np.asarray(rates, dtype=float)[self.contact.tool] if rates is not None else 0.0
+        ends = [self.forces_at(x + s * eps * dx, self.nodes.x_n + s * eps * dx_n, normals(x + s * eps * dx),
+                               self.history + s * eps * dh, self.normal + s * eps * dnormal,
+                               self.coefficient + s * eps * mu_rate) for s in (1.0, -1.0)]
+        return (ends[0] - ends[1]) / (2 * eps)
+
+    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, rates=None) -> None:
+        """rhs ((n_owned, BS), the nodes' frames: dR/dp at fixed q, the sheet's) -= the friction
+        forces' derivative at fixed q, turned into the frames: through the history's derivative,
+        the committed positions' (dx_n), the normal forces' (dp = dR0/dp on the normal rows,
+        where the tool presses) and the coefficients' (`rates` per tool, the parameter's)."""
+        if not self.active:
+            return
+        n = self.nodes.n_owned
+        x = self.nodes.positions()
+        fixed = self.frames[:n, 2]
+        dnormal = np.where((self.contact.tool != -1) & (self.normal > 0), rhs[:, 2], 0.0)
+        df = self._differences(key, eps, x, np.zeros_like(x), dx_n, lambda _: fixed, dnormal, rates)
+        rhs[:, :3] -= np.einsum("nij,nj->ni", self.frames[:n], df)
+
+    def carry(self, key: str, dx: np.ndarray, dx_n: np.ndarray, dR: np.ndarray, lam: float, eps: float,
+              rates=None) -> None:
+        """The converged forces' derivative (the next increment's history derivative, at commit):
+        forces_at along the positions' derivative dx (their tools' normals following them), the
+        committed positions' dx_n, the normal forces' total derivative (dR's normal rows)."""
+        if not self.active:
+            return
+        x = self.nodes.positions()
+        dnormal = np.where((self.contact.tool != -1) & (self.normal > 0), dR[:, 2], 0.0)
+        self.dforce[key] = self._differences(key, eps, x, dx, dx_n, lambda y: self.contact.normals_at(y, lam),
+                                             dnormal, rates)
+
+    def total_derivative(self, key: str, dR: np.ndarray) -> None:
+        if key in self.dforce:
+            n = self.nodes.n_owned
+            dR[:, :3] -= np.einsum("nij,nj->ni", self.frames[:n], self.dforce[key])
+
+    def derivative_state(self, key: str) -> dict:
+        return {"friction_dhistory": self.dhistory.get(key, np.zeros_like(self.history))}
+
+    def restore_derivative_state(self, key: str, state: dict) -> None:
+        self.dhistory[key] = state["friction_dhistory"].copy()
 
     # -- one iterate ---------------------------------------------------------------------------
     def slip(self, idx, shift, x, x_n, F, normal) -> None:

@@ -167,3 +167,25 @@ class Part:
         """delta ((n_owned, BS), the solve's frames) += d/dp of this part's known values, given
         de33 = d/dp of the committed thickness strain per owned cell (the state the increment
         started from)."""
+
+    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, rates=None) -> None:
+        """rhs ((n_owned, BS), the solve's frames: dR/dp at fixed q, the sheet's, its known rows
+        still there) += the part's own forces' dR/dp at fixed q for the parameter `key`, whose
+        central differences step by eps (dx_n: the committed positions' derivative; rates: the
+        parameter's per tool, for a part it is a coefficient of)."""
+
+    def carry(self, key: str, dx: np.ndarray, dx_n: np.ndarray, dR: np.ndarray, lam: float, eps: float,
+              rates=None) -> None:
+        """After the solve: the derivative of the part's history at this increment (dx: the
+        positions', dR: the residual's total, (n_owned, BS) in the frames), taken at commit."""
+
+    def total_derivative(self, key: str, dR: np.ndarray) -> None:
+        """dR ((n_owned, BS), the frames) += the total derivative of the part's forces (after
+        carry): the free rows' check of the sensitivities."""
+
+    def derivative_state(self, key: str) -> dict:
+        """The part's history derivative for `key`, owned nodes' arrays (a checkpoint's)."""
+        return {}
+
+    def restore_derivative_state(self, key: str, state: dict) -> None:
+        """Read back derivative_state."""

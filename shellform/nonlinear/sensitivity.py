@@ -36,9 +36,14 @@ derivative of the fixed-set problem. The known rows are then not all fixed in p:
 tool lies its half thickness h_i from the tool's surface, and h_i = t/2 exp(e33) follows the
 committed thickness strain, so the node's normal row takes q' = h_i' = h_i recover(e33'_n) (the
 parts' known_derivatives; the driver's lifted solve carries it into the free rows). The tools'
-curvature term of the tangent is in K. A part whose forces on the free rows depend on p
-(friction's committed forces, the holder's split of its force, the ironing's penalty, the
-drawbeads) says so (Part.derivatives) and the sensitivities are refused, as is a tool scene
+curvature term of the tangent is in K. Coulomb friction's forces depend on p at fixed q through its history (the committed forces),
+the committed positions, the normal forces (the reactions' pseudo-load on the normal rows) and,
+for a friction coefficient, the coefficient: the part adds that to the pseudo-load
+(Part.pseudo_load) and carries its history's derivative by central differences of its own
+return mapping with the stick and slip states held (Part.carry), as the sheet's is carried.
+A part whose forces on the free rows depend on p
+(the holder's split of its force, the ironing's penalty, the drawbeads) says so
+(Part.derivatives) and the sensitivities are refused, as is a tool scene
 without finite strains or one whose parameter moves the tools (the thickness: the tools are
 placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
 jumps and the derivative of the fixed set does not: the comparison holds on a path whose set
@@ -58,6 +63,7 @@ from mpi4py import MPI
 from shellform.assembly.sheet_element import BS
 from shellform.errors import InputError
 from shellform.results.listeners import Record
+from shellform.scene.schema import FRICTION_KEYS, FRICTION_TOOLS
 
 STEP = 1e-5  # the central differences' step, relative to the parameter
 KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
@@ -72,6 +78,7 @@ class Parameter:
 
     name: str
     value: float
+    rates = None  # d(coefficient)/dp per tool of the contact set, the holder's last (a friction parameter)
 
     def respond(self, value: float) -> dict:
         return {}
@@ -99,6 +106,15 @@ class ThicknessParameter(Parameter):
 
 
 @dataclass
+class FrictionParameter(Parameter):
+    """A Coulomb coefficient (tools.friction, tools.punch_friction, ...): the sheet does not
+    depend on it; the friction part does, on the tools it is the coefficient of (rates: 1 on
+    those, 0 on the others)."""
+
+    rates: tuple = ()
+
+
+@dataclass
 class PressureParameter(Parameter):
     """The dead pressure at load factor 1 (its value the driver's): R = f_int - lambda p f,
     so dR/dp = -lambda f_ext / p."""
@@ -110,12 +126,19 @@ class PressureParameter(Parameter):
 
 
 def scene_parameters(scene) -> list[Parameter]:
-    """The parameters a sheet scene names in `[output] sensitivities` (checked with the scene:
-    "material.<number>", "material.thickness", "loads.pressure")."""
+    """The parameters a scene names in `[output] sensitivities` (checked with the scene:
+    "material.<number>", "material.thickness", "loads.pressure"; a tool scene's "tools.friction"
+    and a tool's own "tools.punch_friction", ...: the coefficient of the tools (punch, die,
+    holder) that carry it)."""
     out = []
     for name in scene.output.sensitivities:
-        key = name.partition(".")[2]
-        if name == "material.thickness":
+        section, _, key = name.partition(".")
+        if section == "tools" and key in FRICTION_KEYS:
+            t = scene.tools
+            own = {tool: getattr(t, f"{tool}_friction") for tool in FRICTION_TOOLS}
+            carried = [own[tool] is None if key == "friction" else key == f"{tool}_friction" for tool in own]
+            out.append(FrictionParameter(name, float(getattr(t, key)), rates=tuple(float(c) for c in carried)))
+        elif name == "material.thickness":
             out.append(ThicknessParameter(name, float(scene.material.thickness)))
         elif name == "loads.pressure":
             out.append(PressureParameter(name, float(scene.loads.pressure)))
@@ -170,6 +193,9 @@ class Sensitivity(Record):
             load = par.external(driver, lam)
             if load is not None:
                 rhs[: load.size] += load
+            dx_n = self.dq[par.name].reshape(-1, BS)[: driver.n_owned, :3].copy()  # the committed positions'
+            for part in driver.parts:
+                part.pseudo_load(par.name, rhs[:owned].reshape(-1, BS), dx_n, eps, par.rates)
             rhs[~free] = 0.0
             delta = np.zeros_like(q)  # the known rows' derivatives (solve coordinates, ghosts from their owners)
             if driver.parts:
@@ -188,13 +214,19 @@ class Sensitivity(Record):
             dR = driver.assembled(ends[0][0] - ends[1][0]) / (2 * eps)
             if load is not None:
                 dR[: load.size] += load
+            for part in driver.parts:
+                part.carry(par.name, dq.reshape(-1, BS)[: driver.n_owned, :3], dx_n,
+                           dR[:owned].reshape(-1, BS), lam, eps, par.rates)
             self.dq[par.name] = dq
             self.dh[par.name] = {k: (ends[0][1][k] - ends[1][1][k]) / (2 * eps) for k in KEYS}
             self.dR[par.name] = dR[:owned]
             yielded = [e[1]["p"] > h_n["p"] for e in ends]
             switched += int(np.sum(yielded[0] != yielded[1]))
             scale = comm.allreduce(float(np.abs(rhs[:owned][free]).max(initial=0.0)), op=MPI.MAX)  # the pseudo-load
-            worst = comm.allreduce(float(np.abs(dR[:owned][free]).max(initial=0.0)), op=MPI.MAX)
+            total = dR[:owned].copy()  # with the parts' forces: about zero on the free rows
+            for part in driver.parts:
+                part.total_derivative(par.name, total.reshape(-1, BS))
+            worst = comm.allreduce(float(np.abs(total[free]).max(initial=0.0)), op=MPI.MAX)
             ratio = max(ratio, worst / scale if scale > 0 else 0.0)
         self.switches.append(comm.allreduce(switched, op=MPI.SUM))
         self.free_residual.append(ratio)
@@ -203,6 +235,8 @@ class Sensitivity(Record):
         nodes, cells = {}, {}
         for i, par in enumerate(self.parameters):
             nodes[f"sensitivity{i}_dq"] = self.dq[par.name][: self.driver.n_owned * BS].reshape(-1, BS).copy()
+            for part in self.driver.parts:
+                nodes.update({f"sensitivity{i}_{k}": v for k, v in part.derivative_state(par.name).items()})
             for k in KEYS:
                 cells[f"sensitivity{i}_{k}"] = self.dh[par.name][k]
         return {"nodes": nodes, "cells": cells}
@@ -217,6 +251,10 @@ class Sensitivity(Record):
             work.array[: self.driver.n_owned * BS] = state["nodes"][key].ravel()
             work.scatter_forward()
             self.dq[par.name] = work.array.copy()
+            for part in self.driver.parts:
+                own = {k: state["nodes"][f"sensitivity{i}_{k}"] for k in part.derivative_state(par.name)}
+                if own:
+                    part.restore_derivative_state(par.name, own)
             for k in KEYS:
                 self.dh[par.name][k][...] = state["cells"][f"sensitivity{i}_{k}"]
 

@@ -19,7 +19,7 @@ from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
-                                    DIAGONALS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE,
+                                    DIAGONALS, FRICTION_KEYS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE,
                                     STROKE_STEP_KEYS, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
                                     NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, bounds)
 
@@ -216,8 +216,16 @@ def _validate_sensitivities(s) -> None:
         if name in ("material.thickness", "loads.pressure"):
             require(name != "loads.pressure" or s.loads.pressure != 0, field_, "needs a pressure other than 0")
             continue
+        if section == "tools" and s.tools is not None and key in FRICTION_KEYS:
+            value = getattr(s.tools, key)
+            require("friction" in s.effects and value is not None and value > 0, field_,
+                    "needs the effect 'friction' and that coefficient set > 0 (a tool's own where it is given)")
+            require(key != "friction" or any(getattr(s.tools, f"{t}_friction") is None for t in FRICTION_TOOLS), field_,
+                    "every tool has its own coefficient: tools.friction is none of theirs")
+            continue
         require(section == "material" and key in numbers, field_,
-                "must be material.<a number of [material]>, material.thickness or loads.pressure")
+                "must be material.<a number of [material]>, material.thickness or loads.pressure (a tool scene: "
+                "tools.friction or a tool's own coefficient too)")
         value = getattr(s.material, key)
         require(not np.array_equal(s.with_material(key, value * (1 + 1e-3) if value else 1e-3).hill79().pack(),
                                    base), field_,
@@ -232,16 +240,17 @@ def _validate_tool_sensitivities(s) -> None:
     """A tool scene's sensitivities: its rigid tools alone have derivatives (no friction, holder
     force, ironing or drawbeads), with finite strains (the nodes' thickness), and no parameter
     that moves the tools."""
-    for effect in ("friction", "ironing", "drawbeads"):
+    for effect in ("ironing", "drawbeads"):
         require(effect not in s.effects, "effects", f"the effect {effect!r} has no derivatives yet: a tool scene's "
-                "output.sensitivities are its rigid tools' alone (docs/sensitivity.md, Tool scenes)")
+                "output.sensitivities are its rigid tools' and friction's alone (docs/sensitivity.md, Tool scenes)")
     require("finite_strain" in s.effects, "effects",
             "a tool scene's output.sensitivities need the effect 'finite_strain' (the nodes' thickness)")
     require(s.tools.blank_holder_force == 0, "tools.blank_holder_force",
             "the holder's force has no derivatives yet: a tool scene's output.sensitivities need it 0")
     for name in s.output.sensitivities:
         require(name not in ("material.thickness", "loads.pressure"), f"output.sensitivities ({name})",
-                "moves the tools or loads no tool scene: a tool scene takes material.<number>")
+                "moves the tools or loads no tool scene: a tool scene takes material.<number>, tools.friction or "
+                "a tool's own coefficient")
 
 
 def _validate_probes(s) -> None:

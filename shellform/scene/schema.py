@@ -208,6 +208,7 @@ def _complete_tools(self):
 
 
 FRICTION_TOOLS = ("punch", "die", "holder")  # each has its own key NAME_friction (unset: `friction`)
+FRICTION_KEYS = ("friction",) + tuple(f"{name}_friction" for name in FRICTION_TOOLS)  # [tools]' coefficients
 
 
 def _friction_per_tool(self) -> dict[str, float]:

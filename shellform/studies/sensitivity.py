@@ -35,7 +35,7 @@ from shellform.material import Hill79Material, flow_stress
 from shellform.nonlinear.driver import Controls
 from shellform.nonlinear.loads import SheetLoads
 from shellform.nonlinear.problem import SheetProblem
-from shellform.nonlinear.sensitivity import MaterialParameter, PressureParameter, Sensitivity
+from shellform.nonlinear.sensitivity import MaterialParameter, PressureParameter, Sensitivity, scene_parameters
 from shellform.results.log import say
 from shellform.results.tables import write_csv
 from shellform.studies import strip
@@ -199,31 +199,33 @@ def cantilever(folder: Path) -> tuple[list[dict], dict]:
 
 
 CUP_STEP = 1e-5  # the drawn cup's differences: at 1e-4 layers yield between p - h and p + h (docs/sensitivity.md)
-CUP_PARAMETERS = ("K", "n")
+CUP_PARAMETERS = ("material.K", "material.n")
+FRICTION_PARAMETERS = ("material.K", "tools.friction")
 
 
-def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False):
-    """demos/round_cup.toml without friction, holder force and ironing (rigid punch and die only:
-    the parts that have derivatives), n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10, with
-    `changes` {material key: value}: (problem, Sensitivity or None); with scene_only, (the
+def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False,
+              friction: bool = False):
+    """demos/round_cup.toml with its rigid punch and die (no holder force, no ironing) and,
+    with `friction`, its Coulomb friction (0.07), else none: the parts that have derivatives;
+    n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10, with `changes` {scene key: value}:
+    (problem, Sensitivity of the scene keys `sensitivities` or None); with scene_only, (the
     scene, None), not run."""
     from shellform import demos, scene
     from shellform.contact.problem import DrawingProblem
 
     base = scene.load(demos.path("round_cup.toml"))
-    s = base.changed({"mesh.n": n, "tools.stroke": stroke, "tools.friction": 0.0, "tools.blank_holder_force": 0.0,
-                      "effects": [e for e in base.effects if e not in ("friction", "ironing")],
+    drop = ("ironing",) if friction else ("friction", "ironing")
+    s = base.changed({"mesh.n": n, "tools.stroke": stroke, "tools.blank_holder_force": 0.0,
+                      **({} if friction else {"tools.friction": 0.0}),
+                      "effects": [e for e in base.effects if e not in drop],
                       "process.report": [], "process.initial_step_mm": 0.1, "process.max_step_mm": 0.1,
-                      "process.min_step_mm": 0.001, "process.rtol": 1e-10,
-                      **{f"material.{k}": v for k, v in (changes or {}).items()}})
+                      "process.min_step_mm": 0.001, "process.rtol": 1e-10, **(changes or {})})
     if scene_only:
         return s, None
     p = DrawingProblem.from_scene(s, verbose=False)
     sens = None
     if sensitivities:
-        sens = Sensitivity(p.driver, [MaterialParameter(k, float(getattr(s.material, k)),
-                                                        lambda v, k=k: s.with_material(k, v).hill79().pack())
-                                      for k in sensitivities])
+        sens = Sensitivity(p.driver, scene_parameters(s.changed({"output.sensitivities": list(sensitivities)})))
         p.driver.records.append(sens)
     p.driver.run(1.0)
     return p, sens
@@ -235,24 +237,32 @@ def rim_node(p) -> int:
     return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
 
 
-def cup() -> tuple[list[dict], dict]:
-    """The frictionless round cup drawn 3 mm (drawn_cup): the punch force and the rim's draw-in
-    on y = 0, d/dK and d/dn against central differences of two runs at p (1 +- CUP_STEP)."""
-    (p, s), with_s, without = _costs(lambda: drawn_cup(), lambda: drawn_cup(sensitivities=CUP_PARAMETERS))
+def _value(s, key: str) -> float:
+    section, _, name = key.partition(".")
+    return float(getattr(s.material if section == "material" else s.tools, name))
+
+
+def cup(friction: bool = False) -> tuple[list[dict], dict]:
+    """The round cup drawn 3 mm (drawn_cup), frictionless or with its friction: the punch force
+    and the rim's draw-in on y = 0, in each parameter against central differences of two runs
+    at p (1 +- CUP_STEP)."""
+    names = FRICTION_PARAMETERS if friction else CUP_PARAMETERS
+    case = "round cup, friction 0.07" if friction else "round cup, frictionless"
+    (p, s), with_s, without = _costs(lambda: drawn_cup(friction=friction),
+                                     lambda: drawn_cup(sensitivities=names, friction=friction))
     i = rim_node(p)
     rows = []
-    for k in CUP_PARAMETERS:
-        value = float(getattr(p.scene.material, k))
+    for k in names:
+        value = _value(p.scene, k)
         h = CUP_STEP * value
-        plus, minus = drawn_cup({k: value + h})[0], drawn_cup({k: value - h})[0]
+        plus, minus = (drawn_cup({k: value + sign * h}, friction=friction)[0] for sign in (1, -1))
         fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)
         fd_draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
-        rows.append(_row("round cup, frictionless", "punch force", k, p.punch_force(residual=s.residual(k)),
-                         fd_force, "central differences", abs(p.punch_force() / value)))
-        rows.append(_row("round cup, frictionless", "rim draw-in (y = 0)", k,
-                         -float(s.carrier(k).reshape(-1, BS)[i, 0]), fd_draw, "central differences"))
-    return rows, {"case": "round cup, frictionless", "with_s": with_s, "without_s": without,
-                  "parameters": len(CUP_PARAMETERS)}
+        rows.append(_row(case, "punch force", k, p.punch_force(residual=s.residual(k)), fd_force,
+                         "central differences", abs(p.punch_force() / value)))
+        rows.append(_row(case, "rim draw-in (y = 0)", k, -float(s.carrier(k).reshape(-1, BS)[i, 0]), fd_draw,
+                         "central differences"))
+    return rows, {"case": case, "with_s": with_s, "without_s": without, "parameters": len(names)}
 
 
 def plates() -> tuple[list[dict], dict]:
@@ -296,7 +306,8 @@ def run(outdir) -> list[dict]:
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     rows, times = [], []
-    for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup):
+    for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
+                 lambda: cup(friction=True)):
         r, t = case()
         rows += r
         times.append(t)
