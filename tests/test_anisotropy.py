@@ -13,6 +13,7 @@ import pytest
 
 import shellform.material
 from criterion_checks import assert_derivatives
+from material_data import AA2090, AA2090_DATA, esaform_data
 from shellform import effects, scene
 from shellform.errors import InputError
 from shellform.material import CRITERION_
@@ -26,17 +27,7 @@ EY = SY / E
 STEEL = {"r0": 1.79, "r45": 1.51, "r90": 2.27}  # NUMISHEET'93 mild steel
 ALUMINIUM = {"r0": 0.71, "r45": 0.58, "r90": 0.70}
 ANGLES = range(0, 91, 15)
-# Barlat et al. 2003, AA2090-T3: the published alpha1..alpha8 (a = 8; as JANCAE's UMMDp and
-# youngung/abaqusPy quote them) and the eight experimental data (sigma over sigma0; r_b =
-# dep22/dep11 in balanced biaxial tension) as stefanSCS/Poly6 matAA2090T3.txt and
-# yossy11/Subroutines Datas/AA2090-T3.csv tabulate them
-AA2090 = [0.4865, 1.3783, 0.7536, 1.0246, 1.0363, 0.9036, 1.2321, 1.4858]
-AA2090_DATA = {"sigma0": 1.0, "sigma45": 0.8114, "sigma90": 0.9102, "sigma_b": 1.0350,
-               "r0": 0.2115, "r45": 1.5769, "r90": 0.6923, "r_b": 0.6700}
-# Poly6 fitted to the ESAFORM 2021 AA6016-T4 data (demos/esaform2021_cup.toml)
-POLY6_DATA = {"fit_angles": [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0],
-              "fit_r": [0.526, 0.344, 0.301, 0.253, 0.294, 0.393, 0.601],
-              "fit_sigma": [1.000, 0.944, 0.913, 0.908, 0.898, 0.928, 0.983], "sigma_b": 1.0, "r_b": 1.0}
+POLY6_DATA = esaform_data()  # Poly6 fitted to the ESAFORM 2021 AA6016-T4 data (the demo's)
 
 
 def hill48_material(values, rolling_direction=0.0, hardening="swift", **curve):

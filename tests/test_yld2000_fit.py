@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from material_data import AA2090, AA2090_DATA, esaform_data
 from shellform import scene
 from shellform.errors import InputError
 from shellform.material import PAR_, yld2000, yld2000_fit
@@ -19,17 +20,11 @@ from shellform.studies import yld2000_fit as study
 ROOT = Path(__file__).resolve().parents[1]
 TABLE = ROOT / "docs" / "results" / "yld2000_fit" / "residuals.csv"
 ANGLES = [0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0]
-# Barlat et al. 2003, AA2090-T3 (as tests/test_anisotropy.py quotes them): alphas and the eight data
-AA2090 = [0.4865, 1.3783, 0.7536, 1.0246, 1.0363, 0.9036, 1.2321, 1.4858]
-AA2090_DATA = {"sigma0": 1.0, "sigma45": 0.8114, "sigma90": 0.9102, "sigma_b": 1.0350,
-               "r0": 0.2115, "r45": 1.5769, "r90": 0.6923, "r_b": 0.6700}
 SHEET = ["bending", "membrane", "geometric_nonlinearity", "plasticity", "anisotropy"]
 VOCE = {"E": 70000.0, "nu": 0.33, "thickness": 1.0, "hardening": "voce", "yield_stress": 140.2, "Q": 190.0,
         "beta": 12.4}
 # the ESAFORM 2021 AA6016-T4 data (TUAT, docs/references.md) as demos/esaform2021_cup.toml gives them
-ESAFORM = {"yield_function": "yld2000", "a": 8.0, "fit_angles": ANGLES,
-           "fit_r": [0.526, 0.344, 0.301, 0.253, 0.294, 0.393, 0.601],
-           "fit_sigma": [1.000, 0.944, 0.913, 0.908, 0.898, 0.928, 0.983], "sigma_b": 1.0, "r_b": 1.0}
+ESAFORM = {"yield_function": "yld2000", "a": 8.0, **esaform_data()}
 
 
 def lists_of(data: dict) -> dict:
