@@ -67,6 +67,7 @@ face forces.
 """
 
 import numpy as np
+from dolfinx import fem, la
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
@@ -104,6 +105,7 @@ class CoulombFriction(Part):
         self.slipping = np.zeros(n, dtype=bool)
         self.forgotten = np.zeros(n, dtype=bool)
         self.dhistory, self.dforce = {}, {}  # per parameter: d/dp of the history, of this increment's forces
+        self._ghosts = None  # a work function: the ghosts' values of the normal-force tangent
         self.known_columns = None  # that tangent's terms on the known columns (lift_known)
 
     @property
@@ -404,8 +406,13 @@ class CoulombFriction(Part):
         g[:n][on] = np.einsum("nij,nj->ni", frames[:n][on][:, :2], self.force[on]) / normal[on, None]
         c = np.zeros(n_local)
         c[:n] = coef
+        if self.comm.size > 1:  # a node's normal row gathers the cells of every rank: ghosts get the owners' c, g
+            c, g = self._to_ghosts(model, c, g)
         cells, local = np.nonzero(c[model.dofs] != 0)
         if cells.size == 0:
+            if self.comm.size > 1:  # nothing here, but lift_known's exchange is every rank's
+                self.known_columns = (np.zeros((0, 2), dtype=np.int64), np.zeros((0, 2)), np.zeros((0, 1)),
+                                      np.zeros((0, 1), dtype=np.int64))
             return
         b = model.dofs[cells, local]
         rows = BS * b[:, None] + np.arange(2)  # (pairs, 2): the node's tangent slots in this cell
@@ -421,11 +428,30 @@ class CoulombFriction(Part):
         K.setValuesLocalRCV(rows.astype(np.int32), columns.astype(np.int32),
                             values.reshape(len(b), -1), addv=True)
 
+    def _to_ghosts(self, model, c: np.ndarray, g: np.ndarray):
+        """(c, g) with the ghost nodes' values their owners' (the owned ones as given)."""
+        if self._ghosts is None:
+            self._ghosts = fem.Function(model.V)
+        arr = self._ghosts.x.array.reshape(-1, BS)
+        arr[:] = 0.0
+        arr[:, 0], arr[:, 1:3] = c, g
+        self._ghosts.x.scatter_forward()
+        return arr[:, 0].copy(), arr[:, 1:3].copy()
+
     def lift_known(self, delta: np.ndarray, b: np.ndarray) -> None:
         """b -= the slipping force's normal-force tangent on the known columns times their
         corrections (Part.lift_known): a known correction of a node's neighbours (or of its own normal
-        row) changes its normal force, and with it the slip force mu p."""
+        row) changes its normal force, and with it the slip force mu p. A ghost node's rows (its
+        cells on this rank) go to its owner."""
         if self.known_columns is None:
             return
         rows, scale, row, columns = self.known_columns
-        np.subtract.at(b, rows, scale * np.einsum("pj,pj->p", row, delta[columns])[:, None])
+        values = scale * np.einsum("pj,pj->p", row, delta[columns])[:, None]
+        mine = rows[:, 0] < b.size
+        np.subtract.at(b, rows[mine], values[mine])
+        if self.comm.size > 1:  # collective: every rank sends its ghosts' rows, if any
+            work = self._ghosts
+            work.x.array[:] = 0.0
+            np.add.at(work.x.array, rows[~mine], values[~mine])
+            work.x.scatter_reverse(la.InsertMode.add)
+            b -= work.x.array[: b.size]
