@@ -60,6 +60,13 @@ and the passes' test weighs each node's change of p by its coefficient (|mu_i r_
 |mu_i p~_i|). With every coefficient equal, mu_i = mu exactly and each expression reduces to the one
 coefficient's, bit for bit.
 
+Sensitivities (nonlinear/sensitivity.py) differentiate the return mapping with the stick and
+slip states held (forces_at): at fixed q through the history, the committed positions, the
+normal forces and the coefficients (pseudo_load), and along the solved derivative for the next
+increment's history (carry). On several ranks the normal-force term of a node on a rank's
+boundary gathers that node's cells on every rank (the owners' coefficients and directions sent
+to the ghosts, a ghost's lift sent back to its owner).
+
 The part owns its history (committed with an increment, forgotten where a node switches tools),
 its coefficients, its normal forces and the forces, stiffness and slip state of the current
 iterate; the contact set (contact_set.py) tells it which nodes rub on which tool and with which
@@ -337,7 +344,7 @@ class CoulombFriction(Part):
         n = self.nodes.n_owned
         x = self.nodes.positions()
         fixed = self.frames[:n, 2]
-        dnormal = np.where((self.contact.tool != -1) & (self.normal > 0), rhs[:, 2], 0.0)
+        dnormal = np.where(self.contact.on_tools() & (self.normal > 0), rhs[:, 2], 0.0)
         df = self._differences(key, eps, x, np.zeros_like(x), dx_n, lambda _: fixed, dnormal, rates)
         rhs[:, :3] -= np.einsum("nij,nj->ni", self.frames[:n], df)
 
@@ -349,7 +356,7 @@ class CoulombFriction(Part):
         if not self.active:
             return
         x = self.nodes.positions()
-        dnormal = np.where((self.contact.tool != -1) & (self.normal > 0), dR[:, 2], 0.0)
+        dnormal = np.where(self.contact.on_tools() & (self.normal > 0), dR[:, 2], 0.0)
         self.dforce[key] = self._differences(key, eps, x, dx, dx_n, lambda y: self.contact.normals_at(y, lam),
                                              dnormal, rates)
 
