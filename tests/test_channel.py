@@ -107,7 +107,8 @@ def test_the_holders_path_comes_down_with_the_ram_and_stops_at_its_gap():
     assert p.between(0.3, 0.5) == pytest.approx(-(6.0 - 0.3 * 18.5))
     assert p.between(0.5, 1.0) == 0.0
     line = path(-30.0)
-    assert isinstance(line, Linear) and line.at(0.37) == 0.37 * -30.0 and line.between(0.2, 0.37) == (0.37 - 0.2) * -30.0
+    assert isinstance(line, Linear) and line.at(0.37) == 0.37 * -30.0
+    assert line.between(0.2, 0.37) == (0.37 - 0.2) * -30.0
     with pytest.raises(ValueError):
         Capped(-18.5, 6.0)
     travel = channel.travel(_spec(150.0))

@@ -310,7 +310,8 @@ def test_a_cups_sensitivities_on_two_ranks_match_serial(tmp_path):
     source = SENSITIVITIES.replace("OUT", str(tmp_path / "two"))
     parallel = on_two_ranks(tmp_path, source)
     serial = {}
-    source = SENSITIVITIES.replace("OUT", str(tmp_path / "one")).replace('print("RESULT " + json.dumps(', "RESULT.update((")
+    source = SENSITIVITIES.replace("OUT", str(tmp_path / "one"))
+    source = source.replace('print("RESULT " + json.dumps(', "RESULT.update((")
     runpy.run_path(_write(tmp_path / "serial.py", source), init_globals={"RESULT": serial})
     assert parallel["iterations"] == serial["iterations"]
     for name, answers in serial["sensitivities"].items():

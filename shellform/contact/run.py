@@ -92,10 +92,10 @@ from shellform.mesh import budget
 from shellform.nonlinear import checkpoint
 from shellform.nonlinear.driver import ConvergenceFailure
 from shellform.nonlinear.interrupt import Interrupted
+from shellform.nonlinear.sensitivity import Sensitivity, scene_parameters
 from shellform.results import run_folder
 from shellform.results import springback as sprung_back
 from shellform.results.disk import DiskFull
-from shellform.nonlinear.sensitivity import Sensitivity, scene_parameters
 from shellform.results.drawing import CupListeners
 from shellform.results.listeners import EndOfStroke, Run
 from shellform.results.log import Progress, say

@@ -40,9 +40,10 @@ class SemiInverseDriver(Driver):
 
     tools: rigid tools with ``gap(x, offset, dz) -> (gap, normal)`` and ``shape(x, offset, dz)``
     in contact order (e.g. punch, die); ``travel[k]`` is tool k's travel along its axis at
-    lambda = 1 (punch: -stroke), or its path (shellform.tools.travel); holder: a BlankHolder tool (or None) with its force, pinching the flange onto tool
-    `die` (default: the last tool); friction: mu, one coefficient for every tool or one per tool
-    in contact order then the holder's (friction.py: CoulombFriction); drawbeads: DrawbeadLine's (drawbead.py);
+    lambda = 1 (punch: -stroke), or its path (shellform.tools.travel); holder: a BlankHolder
+    tool (or None) with its force, pinching the flange onto tool `die` (default: the last tool);
+    friction: mu, one coefficient for every tool or one per tool in contact order then the
+    holder's (friction.py: CoulombFriction); drawbeads: DrawbeadLine's (drawbead.py);
     holder_edge: the pinch's EdgeLoad (pinch_edge.py; None: the rigid pinch's own edge);
     ironing: the tools' faces bound the sheet's thickness where two face each other (ironing.py);
     pressure: a dead pressure along +z at lambda = 1 (Driver's).

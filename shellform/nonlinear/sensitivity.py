@@ -36,18 +36,18 @@ derivative of the fixed-set problem. The known rows are then not all fixed in p:
 tool lies its half thickness h_i from the tool's surface, and h_i = t/2 exp(e33) follows the
 committed thickness strain, so the node's normal row takes q' = h_i' = h_i recover(e33'_n) (the
 parts' known_derivatives; the driver's lifted solve carries it into the free rows). The tools'
-curvature term of the tangent is in K. Coulomb friction's forces depend on p at fixed q through its history (the committed forces),
-the committed positions, the normal forces (the reactions' pseudo-load on the normal rows) and,
-for a friction coefficient, the coefficient: the part adds that to the pseudo-load
-(Part.pseudo_load) and carries its history's derivative by central differences of its own
-return mapping with the stick and slip states held (Part.carry), as the sheet's is carried.
-A part whose forces on the free rows depend on p
-(the holder's split of its force, the ironing's penalty, the drawbeads) says so
-(Part.derivatives) and the sensitivities are refused, as is a tool scene
-without finite strains or one whose parameter moves the tools (the thickness: the tools are
-placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
-jumps and the derivative of the fixed set does not: the comparison holds on a path whose set
-does not change within the difference (docs/sensitivity.md).
+curvature term of the tangent is in K. Coulomb friction's forces depend on p at fixed q through
+its history (the committed forces), the committed positions, the normal forces (the reactions'
+pseudo-load on the normal rows) and, for a friction coefficient, the coefficient: the part adds
+that to the pseudo-load (Part.pseudo_load) and carries its history's derivative by central
+differences of its own return mapping with the stick and slip states held (Part.carry), as the
+sheet's is carried. A part whose forces on the free rows depend on p otherwise (the holder's
+split of its force, the ironing's penalty, the drawbeads) says so (Part.derivatives) and the
+sensitivities are refused, as is a tool scene without finite strains or one whose parameter
+moves the tools (the thickness: the tools are placed around the sheet). Where the set changes
+between p - dp and p + dp a finite difference jumps and the derivative of the fixed set does
+not: the comparison holds on a path whose set does not change within the difference
+(docs/sensitivity.md).
 
 The sensitivity is a Record of the driver (driver.records): `converged` runs with each
 converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through
@@ -163,8 +163,8 @@ class Sensitivity(Record):
             if why is None and any(isinstance(p, ThicknessParameter) for p in self.parameters):
                 why = "material.thickness places the tools around the sheet: not differentiated with tools yet"
             if why is not None:
-                raise InputError("output.sensitivities", f"{why}; a tool scene's sensitivities need rigid tools "
-                                 "without friction, holder force, ironing or drawbeads")
+                raise InputError("output.sensitivities", f"{why}; a tool scene's sensitivities need rigid tools, "
+                                 "with or without friction, and no holder force, ironing or drawbeads")
         self._known = fem.Function(self.model.V)  # the known rows' derivatives, shared with the ghosts
         zeros = lambda a: np.zeros_like(a)  # noqa: E731
         start = self.model.history()
@@ -199,7 +199,7 @@ class Sensitivity(Record):
             rhs[~free] = 0.0
             delta = np.zeros_like(q)  # the known rows' derivatives (solve coordinates, ghosts from their owners)
             if driver.parts:
-                de33 = (dh["stretch"] / h_n["stretch"]).mean(axis=1)  # d/dp of ln(t/t0) per cell, committed
+                de33 = self.thickness_strain(par.name)  # d/dp of ln(t/t0) per cell, committed (h_n, dh)
                 self._known.x.array[:] = 0.0
                 for part in driver.parts:
                     part.known_derivatives(self._known.x.array[:owned].reshape(-1, BS), de33)

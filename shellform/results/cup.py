@@ -40,19 +40,20 @@ def _gather(comm, *arrays):
     return [np.concatenate(comm.allgather(a)) for a in arrays]
 
 
+def _draw_in_nodes(p, X) -> tuple[int, int, int]:
+    """The nodes (rows of the gathered initial positions X) where DX, DY and DD are measured:
+    the blank's edge on the x and y axes, and its corner (x, y >= 0 quadrant)."""
+    _, hx, _, hy = p.blank_bounds()
+    at = lambda px, py: int(np.argmin(np.hypot(X[:, 0] - px, X[:, 1] - py)))  # noqa: E731
+    return at(hx, 0.0), at(0.0, hy), int(np.argmax(X[:, 0] + X[:, 1]))
+
+
 def draw_in(p) -> dict:
     """DX, DY, DD (mm) at the blank's edge on the axes and the diagonal (x, y >= 0 quadrant)."""
     X, x, _ = p.nodal_values()
     X, x = _gather(p.comm, X, x)
-    _, hx, _, hy = p.blank_bounds()
-
-    def at(px, py):
-        i = int(np.argmin(np.hypot(X[:, 0] - px, X[:, 1] - py)))
-        return X[i], x[i]
-
-    (X0, x0), (X1, x1) = at(hx, 0.0), at(0.0, hy)
-    corner = int(np.argmax(X[:, 0] + X[:, 1]))
-    out = {"DX": float(X0[0] - x0[0]), "DY": float(X1[1] - x1[1]),
+    i0, i1, corner = _draw_in_nodes(p, X)
+    out = {"DX": float(X[i0, 0] - x[i0, 0]), "DY": float(X[i1, 1] - x[i1, 1]),
            "DD": float(np.hypot(*X[corner, :2]) - np.hypot(*x[corner, :2]))}
     if p.tools_kind.RIM:
         out.update(rim_draw_in(rim(p)))
@@ -68,10 +69,7 @@ def derivatives(p, sens, name: str) -> dict:
     dx = sens.carrier(name).reshape(-1, BS)[: len(X), :3]
     de33 = p.nodal_thickness_strain_derivative(sens.thickness_strain(name))
     X, x, dx, e33, de33 = _gather(p.comm, X, x, dx, e33, de33)
-    _, hx, _, hy = p.blank_bounds()
-    i0 = int(np.argmin(np.hypot(X[:, 0] - hx, X[:, 1])))
-    i1 = int(np.argmin(np.hypot(X[:, 0], X[:, 1] - hy)))
-    c = int(np.argmax(X[:, 0] + X[:, 1]))
+    i0, i1, c = _draw_in_nodes(p, X)
     plan = x[c, :2]
     return {"DX": -float(dx[i0, 0]), "DY": -float(dx[i1, 1]), "DD": -float(plan @ dx[c, :2] / np.hypot(*plan)),
             "punch_force_kN": p.punch_force(residual=sens.residual(name)) / 1e3,

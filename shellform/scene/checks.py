@@ -19,9 +19,9 @@ from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
-                                    DIAGONALS, FRICTION_KEYS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS, MAY_BE_INFINITE,
-                                    STROKE_STEP_KEYS, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS, MIRROR_SUPPORTS,
-                                    NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, bounds)
+                                    DIAGONALS, FRICTION_KEYS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS,
+                                    MAY_BE_INFINITE, STROKE_STEP_KEYS, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS,
+                                    MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, bounds)
 
 
 MAX_THICKNESS_POINTS = 1000  # process.thickness_points: numpy's Gauss rule of n points takes O(n^3)
@@ -220,7 +220,8 @@ def _validate_sensitivities(s) -> None:
             value = getattr(s.tools, key)
             require("friction" in s.effects and value is not None and value > 0, field_,
                     "needs the effect 'friction' and that coefficient set > 0 (a tool's own where it is given)")
-            require(key != "friction" or any(getattr(s.tools, f"{t}_friction") is None for t in FRICTION_TOOLS), field_,
+            own = [getattr(s.tools, f"{t}_friction") for t in FRICTION_TOOLS]
+            require(key != "friction" or None in own, field_,
                     "every tool has its own coefficient: tools.friction is none of theirs")
             continue
         require(section == "material" and key in numbers, field_,
@@ -237,7 +238,7 @@ def _validate_sensitivities(s) -> None:
 
 
 def _validate_tool_sensitivities(s) -> None:
-    """A tool scene's sensitivities: its rigid tools alone have derivatives (no friction, holder
+    """A tool scene's sensitivities: its rigid tools and friction have derivatives (no holder
     force, ironing or drawbeads), with finite strains (the nodes' thickness), and no parameter
     that moves the tools."""
     for effect in ("ironing", "drawbeads"):

@@ -77,10 +77,10 @@ def wrap(p, radius: float, flange) -> tuple[float, float]:
     return tuple(p.comm.allreduce(float(off[m].max(initial=0.0)), op=MPI.MAX) for m in (flange(X), centre))
 
 
-def drawn(s, radius: float, flange, pictures: tuple | None = None) -> tuple[dict, object]:
+def drawn(s, radius: float, flange, pictures: Path | None = None, name: str = "") -> dict:
     """The scene s drawn: closed onto its binder (radius, over the nodes `flange` passes) where
-    it has a binder_rise, then to its stroke; with `pictures` (folder, name), name_wrap.png and
-    name.png there. Returns its measures and the problem."""
+    it has a binder_rise, then to its stroke; with `pictures` (a folder), name_wrap.png and
+    name.png there. Returns its measures."""
     t0 = time.perf_counter()
     p = DrawingProblem.from_scene(s, verbose=False)
     d = p.driver
@@ -91,11 +91,11 @@ def drawn(s, radius: float, flange, pictures: tuple | None = None) -> tuple[dict
         d.run(s.tools.binder_rise / s.tools.stroke, on_increment=record)
         flange_off, centre = wrap(p, radius, flange)
         if pictures is not None:
-            cup.picture(pictures[0] / f"{pictures[1]}_wrap.png", p,
+            cup.picture(pictures / f"{name}_wrap.png", p,
                         f"{s.title}: closed onto the binder ({p.stroke:.1f} mm)")
     d.run(1.0, on_increment=record)
     if pictures is not None:
-        cup.picture(pictures[0] / f"{pictures[1]}.png", p, f"{s.title}: drawn ({p.stroke:.1f} mm)")
+        cup.picture(pictures / f"{name}.png", p, f"{s.title}: drawn ({p.stroke:.1f} mm)")
     thin, draw_in, mu = cup.peak_thinning(p), cup.draw_in(p), s.tools.friction_per_tool()
     return {"n": s.mesh.n, "cells": p.model.mesh.topology.index_map(2).size_global,
             "mu_punch": mu["punch"], "mu_die": mu["die"], "mu_holder": mu["holder"], "stroke_mm": p.stroke,
@@ -104,7 +104,7 @@ def drawn(s, radius: float, flange, pictures: tuple | None = None) -> tuple[dict
             "peak_thinning": thin["min_thickness_strain"], "thinning_x0_mm": thin["where_initial_xy_mm"][0],
             "thinning_y0_mm": thin["where_initial_xy_mm"][1], "increments": len(d.history),
             "iterations": sum(h.iterations for h in d.history), "cutbacks": sum(h.cutbacks for h in d.history),
-            "wall_s": time.perf_counter() - t0}, p
+            "wall_s": time.perf_counter() - t0}
 
 
 def channel(name: str, changes: dict, n: int, pictures: Path | None = None) -> dict:
@@ -112,7 +112,7 @@ def channel(name: str, changes: dict, n: int, pictures: Path | None = None) -> d
     s = scene.load(SCENE).changed({"mesh.n": n, **changes})
     t = s.tools
     edge = t.die_half_width + t.die_profile_radius + 2.0
-    row, _ = drawn(s, t.binder_radius, lambda X: X[:, 0] > edge, None if pictures is None else (pictures, "channel"))
+    row = drawn(s, t.binder_radius, lambda X: X[:, 0] > edge, pictures, "channel")
     return {"case": name, "binder_radius_mm": t.binder_radius, **row}
 
 
@@ -120,15 +120,14 @@ def square_cup(n: int = CUP_LEVEL, pictures: Path | None = None) -> dict:
     """The square cup over the cylindrical binder from CAD files (module docstring)."""
     s = scene.load(CUP_SCENE).changed({"mesh.n": n})
     edge = 42.0 + 2.0  # the die's opening and shoulder (37 + 5 mm), and 2 mm
-    row, _ = drawn(s, CUP_RADIUS, lambda X: np.maximum(np.abs(X[:, 0]), np.abs(X[:, 1])) > edge,
-                   None if pictures is None else (pictures, "cup"))
-    return row
+    return drawn(s, CUP_RADIUS, lambda X: np.maximum(np.abs(X[:, 0]), np.abs(X[:, 1])) > edge, pictures, "cup")
 
 
 def markdown(rows: list[dict]) -> str:
     head = ["run", "mu punch / die / holder", "wrap: flange, centre line (mm)", "punch force end, peak (kN)",
             "DX (mm)", "peak thinning (initial x, y)", "increments, iterations, cut-backs", "wall (s)"]
-    body = [[f"{r['case']} n {r['n']} ({r['cells']} cells)", f"{r['mu_punch']:g} / {r['mu_die']:g} / {r['mu_holder']:g}",
+    body = [[f"{r['case']} n {r['n']} ({r['cells']} cells)",
+             f"{r['mu_punch']:g} / {r['mu_die']:g} / {r['mu_holder']:g}",
              "flat" if np.isnan(r["wrap_flange_mm"]) else f"{r['wrap_flange_mm']:.4f}, {r['wrap_centre_mm']:.3f}",
              f"{r['force_kN']:.2f}, {r['force_peak_kN']:.2f}", f"{r['DX_mm']:.3f}",
              f"{r['peak_thinning']:.4f} ({r['thinning_x0_mm']:.1f}, {r['thinning_y0_mm']:.1f})",

@@ -237,11 +237,6 @@ def rim_node(p) -> int:
     return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
 
 
-def _value(s, key: str) -> float:
-    section, _, name = key.partition(".")
-    return float(getattr(s.material if section == "material" else s.tools, name))
-
-
 def cup(friction: bool = False) -> tuple[list[dict], dict]:
     """The round cup drawn 3 mm (drawn_cup), frictionless or with its friction: the punch force
     and the rim's draw-in on y = 0, in each parameter against central differences of two runs
@@ -252,8 +247,8 @@ def cup(friction: bool = False) -> tuple[list[dict], dict]:
                                      lambda: drawn_cup(sensitivities=names, friction=friction))
     i = rim_node(p)
     rows = []
-    for k in names:
-        value = _value(p.scene, k)
+    for par in s.parameters:
+        k, value = par.name, par.value
         h = CUP_STEP * value
         plus, minus = (drawn_cup({k: value + sign * h}, friction=friction)[0] for sign in (1, -1))
         fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)

@@ -18,7 +18,6 @@ from shellform.tools.mesh_tool import MESH_SUFFIXES, MeshTool
 from shellform.tools.placement import UP, Placed, rotation
 from shellform.tools.protocol import BinderPlan, ram_travel
 from shellform.tools.surface_tool import SurfaceTool
-from shellform.tools.travel import Capped
 
 NAME = "cad"
 
@@ -263,13 +262,7 @@ def _check_face_start(face, x, half, comm, tolerance: float) -> None:
 tools = cad_cup_tools
 
 
-def travel(spec) -> dict:
-    """The punch travels the stroke (protocol.ram_travel); a holder's face from a file that
-    starts raised comes down with it by binder_rise and stops (travel.Capped)."""
-    paths = ram_travel(spec)
-    if spec.binder_rise > 0:
-        paths["holder"] = Capped(-spec.stroke, -spec.binder_rise)
-    return paths
+travel = ram_travel  # a holder's face from a file that starts raised comes down by binder_rise and stops
 
 
 def check_placement(tools: dict, x, half, planes, comm, tolerance: float) -> None:

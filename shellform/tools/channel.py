@@ -43,8 +43,7 @@ import math
 import numpy as np
 
 from shellform.errors import require
-from shellform.tools.protocol import BinderPlan
-from shellform.tools.travel import Capped, Linear
+from shellform.tools.protocol import BinderPlan, ram_travel
 
 NAME = "channel"
 
@@ -209,10 +208,7 @@ def tools(spec, thickness: float) -> dict:
     )
 
 
-def travel(spec) -> dict:
-    """The punch travels the stroke; the holder comes down with it by binder_rise and stops."""
-    holder = Capped(-spec.stroke, -spec.binder_rise) if spec.binder_rise > 0 else Linear(0.0)
-    return {"punch": Linear(-spec.stroke), "die": Linear(0.0), "holder": holder}
+travel = ram_travel  # the punch travels the stroke; the holder comes down with it by binder_rise and stops
 
 
 def least_rise(spec, thickness: float, gap: float, half_length: float) -> float:

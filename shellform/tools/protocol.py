@@ -33,7 +33,7 @@ from typing import NamedTuple, Protocol, runtime_checkable
 import numpy as np
 
 from shellform.tools.analytic import rounded_square_sdf
-from shellform.tools.travel import Linear
+from shellform.tools.travel import Capped, Linear
 
 
 @runtime_checkable
@@ -116,6 +116,9 @@ class BinderPlan(NamedTuple):
 
 
 def ram_travel(spec) -> dict:
-    """The tools' paths (travel.py) of a single-action draw: the punch travels the stroke down
-    its axis, the die and the holder's face stay."""
-    return {"punch": Linear(-spec.stroke), "die": Linear(0.0), "holder": Linear(0.0)}
+    """The tools' paths (travel.py): the punch travels the stroke down its axis, the die stays,
+    and the holder's face stays, or (binder_rise > 0: a curved binder's holder that starts
+    raised) comes down with the punch by binder_rise and stops there (Capped)."""
+    rise = spec.binder_rise
+    holder = Capped(-spec.stroke, -rise) if rise > 0 else Linear(0.0)
+    return {"punch": Linear(-spec.stroke), "die": Linear(0.0), "holder": holder}
