@@ -43,16 +43,13 @@ import math
 import numpy as np
 
 from shellform.errors import require
+from shellform.tools import square
 from shellform.tools.protocol import BinderPlan, ram_travel
 
 NAME = "channel"
 
-FIELDS = (
-    ("punch_half_width", 35.0, "70 mm square punch"),
-    ("punch_profile_radius", 8.0, "nose radius"),
-    ("die_half_width", 37.0, "74 mm die opening"),
-    ("die_profile_radius", 5.0, "die shoulder radius"),
-    ("punch_gap", 0.0, "initial gap between the punch face and the sheet (>= 0)"),
+SECTION_KEYS = ("punch_half_width", "punch_profile_radius", "die_half_width", "die_profile_radius", "punch_gap")
+FIELDS = tuple(f for f in square.FIELDS if f[0] in SECTION_KEYS) + (  # the section: the square tools' side
     ("binder_radius", 0.0, "channel: the die's binder face, a cylinder about the x axis of this radius "
      "(0: flat)"),
     ("binder_rise", 0.0, "channel: how far the holder comes down with the ram before it stops at its gap "
