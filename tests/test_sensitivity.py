@@ -107,7 +107,7 @@ def test_the_frictionless_cup_against_finite_differences_of_two_runs():
     draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
     assert p.punch_force(residual=s.residual("material.K")) == pytest.approx(force, rel=1e-6)
     assert -s.carrier("material.K").reshape(-1, BS)[i, 0] == pytest.approx(draw, rel=1e-6)
-    assert max(s.free_residual) < 1e-3
+    assert max(s.free_residual) < 1e-5  # the frames' turn on the curved tools included (2e-7 measured)
 
 
 @pytest.mark.slow  # five runs, about 13 s
@@ -128,11 +128,44 @@ def test_the_cup_with_friction_against_finite_differences_of_two_runs():
         draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
         assert p.punch_force(residual=s.residual(key)) == pytest.approx(force, rel=1e-4), key
         assert -s.carrier(key).reshape(-1, BS)[i, 0] == pytest.approx(draw, rel=1e-4), key
-    assert max(s.free_residual) < 1e-2
+    assert max(s.free_residual) < 1e-3
+
+
+def _holder_cup_against_differences(key, rel):
+    """d/dp of the punch force and the rim's draw-in of the round cup with its holder (10 kN)
+    and friction (n 6, 3 mm) against central differences of two runs at p (1 +- 1e-5)."""
+    p, s = drawn_cup(sensitivities=(key,), friction=True, holder=True)
+    assert p.driver.holder.closed and p.driver.holder.pinched.sum() > 10
+    i = rim_node(p)
+    value = float(s.parameters[0].value)
+    h = 1e-5 * value
+    plus, minus = (drawn_cup({key: value + sign * h}, friction=True, holder=True)[0] for sign in (1, -1))
+    force = (plus.punch_force() - minus.punch_force()) / (2 * h)
+    draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
+    assert p.punch_force(residual=s.residual(key)) == pytest.approx(force, rel=rel)
+    assert -s.carrier(key).reshape(-1, BS)[i, 0] == pytest.approx(draw, rel=rel)
+    return s
+
+
+def test_the_cup_with_a_holder_against_finite_differences_of_two_runs():
+    """d/dF (tools.blank_holder_force): F enters only through the holder's split, which friction
+    presses with on the pinched nodes; to 1e-3 (measured 8e-5 in the force, 1.3e-4 in the
+    draw-in). The friction's tangent holds the split's spread (F's share per node) and its band
+    fixed, so the solve is corrected against the total derivative: the free rows' total after
+    the corrections is below 1e-5 of the loads' (6e-6 measured; 2e-3 uncorrected)."""
+    s = _holder_cup_against_differences("tools.blank_holder_force", 1e-3)
+    assert sum(s.corrections) > 0 and max(s.free_residual) < 1e-5
+
+
+@pytest.mark.slow  # three runs each, about 25 s
+@pytest.mark.parametrize("key", ["material.K", "tools.friction"])
+def test_the_cup_with_a_holder_in_k_and_mu(key):
+    """d/dK and d/dmu with the holder: its edge load moves with K (its strip solved again), the
+    coefficient with mu; to 1e-3 (measured 4e-7 / 7e-4 in K, 7e-5 / 1.3e-4 in mu)."""
+    _holder_cup_against_differences(key, 1e-3)
 
 
 @pytest.mark.parametrize("effect, changes, why", [
-    (None, {"tools.blank_holder_force": 1000.0}, "holder"),
     ("ironing", {}, "Ironing"),
 ])
 def test_a_tool_scene_whose_parts_have_no_derivatives_is_refused(effect, changes, why):
@@ -183,7 +216,9 @@ def test_a_tool_scene_reports_its_answers_sensitivities(tmp_path):
 
 @pytest.mark.parametrize("changes, field", [
     ({"effects": "ironing"}, "effects"),
-    ({"tools.blank_holder_force": 1000.0}, "tools.blank_holder_force"),
+    ({"output.sensitivities": ["tools.blank_holder_force"]}, "output.sensitivities (tools.blank_holder_force)"),
+    ({"tools.blank_holder_force": 1000.0, "tools.holder": "gap", "tools.holder_gap": 1.04,
+      "output.sensitivities": ["tools.blank_holder_force"]}, "output.sensitivities (tools.blank_holder_force)"),
     ({"output.sensitivities": ["tools.friction"]}, "output.sensitivities (tools.friction)"),  # no friction
     ({"effects": "friction", "tools.friction": 0.1, "tools.punch_friction": 0.02,
       "output.sensitivities": ["tools.die_friction"]}, "output.sensitivities (tools.die_friction)"),  # unset

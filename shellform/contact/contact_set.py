@@ -106,6 +106,8 @@ class ContactSet(Part):
         self.slid_off = np.zeros(n, dtype=bool)  # nodes that slid off their tool's extent (this iterate)
         self.switched = np.zeros(n, dtype=bool)  # nodes that switched in the last update
         self.net = np.zeros(n)  # the net normal forces of the last refresh
+        self._frames_now = np.tile(np.eye(3), (n, 1, 1))  # the frames of the nodes on the tools (constrain)
+        self._turn = {}  # per parameter: the frames' turn along the solved derivative (carry)
         self.following = False  # the faces follow the reactions (the iterates after a pass's first)
         self.frozen = 0
         self.residual = None  # the driver's residual with its reactions (bind)
@@ -265,6 +267,7 @@ class ContactSet(Part):
                 continue
             gap, normal = gaps[k][0][on], gaps[k][1][on]
             c.frames[on] = nodal_frames(normal)
+            self._frames_now[on] = c.frames[on]
             c.known[on, 2] = -gap  # the normal correction that closes the gap
             c.flags[on, 2] = True
             if k == self.holder_tool:
@@ -430,6 +433,33 @@ class ContactSet(Part):
         beyond the sheet's (the tools' curvature term is in K); the ironing's bound is refused
         by its own part. None."""
         return None
+
+    def face_derivatives(self, parameter, dnet: np.ndarray, x: np.ndarray, dx: np.ndarray, eps: float):
+        """((dd, dh), pinched): d/dp of faces() on the nodes the closed holder pinches, its split's
+        (PinchingHolder.face_derivatives) along the net normal forces' derivative dnet and the
+        positions' dx; None where no holder presses."""
+        if self.holder is None or self.holder.force <= 0:
+            return None
+        return self.holder.face_derivatives(parameter, self.net, dnet, x, dx, eps), self.holder.pinched
+
+    def carry(self, key: str, dx: np.ndarray, dx_n: np.ndarray, dR: np.ndarray, lam: float, eps: float,
+              parameter=None) -> None:
+        """The turn of the frames of the nodes on curved tools along the positions' derivative
+        dx, for total_derivative: a tangent row t_a . R picks up (dt_a/dp) . n R0 =
+        -R0 W_ab (t_b . dx), the curvature term of the tangent (add_tangent) along dx."""
+        b = np.flatnonzero((self.tool != FREE) & (np.abs(self.curvature).max(axis=(1, 2)) > 0))
+        turn = np.zeros((self.tool.size, 2))
+        if b.size:
+            t = np.einsum("nai,ni->na", self._frames_now[b][:, :2], dx[b])
+            turn[b] = -self.net_normal_forces()[b, None] * np.einsum("nab,nb->na", self.curvature[b], t)
+            turn[self.nodes.held[:, :2]] = 0.0
+        self._turn[key] = turn
+
+    def total_derivative(self, key: str, dR: np.ndarray) -> None:
+        """dR's tangent rows += the frames' turn (carry): what the element forces' differences,
+        taken in the frames held, leave out."""
+        if key in self._turn:
+            dR[:, :2] += self._turn.pop(key)
 
     def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
         """A node on a tool lies its half thickness h_i from the tool's surface along the normal

@@ -120,8 +120,8 @@ class CoulombFriction(Part):
         return float(np.max(self.mu)) > 0
 
     def derivatives(self) -> str | None:
-        """Friction on the tools is differentiated with the stick and slip states held
-        (pseudo_load, carry); on a pinched node it reads the holder's split, which has none."""
+        """Friction is differentiated with the stick and slip states held (pseudo_load, carry);
+        on a pinched node through the holder's split (normal_rates)."""
         return None
 
     def per_tool(self) -> np.ndarray:
@@ -323,42 +323,68 @@ class CoulombFriction(Part):
         out[idx] = ratio[:, None] * trial
         return out
 
-    def _differences(self, key, eps, x, dx, dx_n, normals, dnormal, rates):
+    def _differences(self, key, eps, x, dx, dx_n, normals, dnormal, dmu):
         """(f(+eps) - f(-eps)) / 2 eps of forces_at along (dx, dx_n, the history's derivative,
-        dnormal, the coefficients' rates); normals: a function of the positions."""
+        dnormal, the coefficients' dmu); normals: a function of the positions."""
         dh = self.dhistory.get(key, np.zeros_like(self.history))
         dh = np.where(self.forgotten[:, None], 0.0, dh)
-        mu_rate = np.asarray(rates, dtype=float)[self.contact.tool] if rates is not None else 0.0
         ends = [self.forces_at(x + s * eps * dx, self.nodes.x_n + s * eps * dx_n, normals(x + s * eps * dx),
                                self.history + s * eps * dh, self.normal + s * eps * dnormal,
-                               self.coefficient + s * eps * mu_rate) for s in (1.0, -1.0)]
+                               self.coefficient + s * eps * dmu) for s in (1.0, -1.0)]
         return (ends[0] - ends[1]) / (2 * eps)
 
-    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, rates=None) -> None:
+    def normal_rates(self, parameter, dnet: np.ndarray, x: np.ndarray, dx: np.ndarray, eps: float):
+        """(dp, dmu) per owned node: d/dp of the normal forces and the coefficients friction
+        presses with, given the net normal forces' derivative dnet and the positions' dx. On a
+        tool dp = dR0/dp where it presses and dmu the parameter's rate for that tool; on a node
+        the closed holder pinches, the derivative of its split (ContactSet.face_derivatives):
+        dp = dd + dh, and mu_i = mu_tool + (mu_holder - mu_tool) h / (d + h) moves with both
+        the rates and the holder face's share."""
+        c = self.contact
+        rates = getattr(parameter, "rates", None)
+        dnormal = np.where(c.on_tools() & (self.normal > 0), dnet, 0.0)
+        dmu = np.asarray(rates, dtype=float)[c.tool] if rates is not None else np.zeros(dnet.size)
+        split = c.face_derivatives(parameter, dnet, x, dx, eps)
+        if split is not None:
+            (dd, dh), pinched = split
+            d, h = c.faces()
+            p = d + h
+            share = np.divide(h, p, out=np.zeros_like(p), where=p > 0)
+            dshare = np.divide(dh * d - h * dd, p * p, out=np.zeros_like(p), where=p > 0)
+            table = self.table
+            rate_h = float(rates[-1]) if rates is not None else 0.0
+            mu = dmu + (rate_h - dmu) * share + (table[-1] - table[c.tool]) * dshare
+            dnormal = np.where(pinched, dd + dh, dnormal)
+            dmu = np.where(pinched, mu, dmu)
+        return dnormal, dmu
+
+    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, parameter=None) -> None:
         """rhs ((n_owned, BS), the nodes' frames: dR/dp at fixed q, the sheet's) -= the friction
         forces' derivative at fixed q, turned into the frames: through the history's derivative,
-        the committed positions' (dx_n), the normal forces' (dp = dR0/dp on the normal rows,
-        where the tool presses) and the coefficients' (`rates` per tool, the parameter's)."""
+        the committed positions' (dx_n), the normal forces' (normal_rates along dR0/dp, the
+        normal rows of rhs: where the tool presses, and the holder's split) and the
+        coefficients' (the parameter's rates per tool)."""
         if not self.active:
             return
         n = self.nodes.n_owned
         x = self.nodes.positions()
         fixed = self.frames[:n, 2]
-        dnormal = np.where(self.contact.on_tools() & (self.normal > 0), rhs[:, 2], 0.0)
-        df = self._differences(key, eps, x, np.zeros_like(x), dx_n, lambda _: fixed, dnormal, rates)
+        dnormal, dmu = self.normal_rates(parameter, rhs[:, 2], x, np.zeros_like(x), eps)
+        df = self._differences(key, eps, x, np.zeros_like(x), dx_n, lambda _: fixed, dnormal, dmu)
         rhs[:, :3] -= np.einsum("nij,nj->ni", self.frames[:n], df)
 
     def carry(self, key: str, dx: np.ndarray, dx_n: np.ndarray, dR: np.ndarray, lam: float, eps: float,
-              rates=None) -> None:
+              parameter=None) -> None:
         """The converged forces' derivative (the next increment's history derivative, at commit):
         forces_at along the positions' derivative dx (their tools' normals following them), the
-        committed positions' dx_n, the normal forces' total derivative (dR's normal rows)."""
+        committed positions' dx_n, the normal forces' total derivative (normal_rates along dR's
+        normal rows and dx)."""
         if not self.active:
             return
         x = self.nodes.positions()
-        dnormal = np.where(self.contact.on_tools() & (self.normal > 0), dR[:, 2], 0.0)
+        dnormal, dmu = self.normal_rates(parameter, dR[:, 2], x, dx, eps)
         self.dforce[key] = self._differences(key, eps, x, dx, dx_n, lambda y: self.contact.normals_at(y, lam),
-                                             dnormal, rates)
+                                             dnormal, dmu)
 
     def total_derivative(self, key: str, dR: np.ndarray) -> None:
         if key in self.dforce:

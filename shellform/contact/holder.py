@@ -44,6 +44,7 @@ from shellform.contact.holder_split import HolderSplit
 from shellform.contact.lifted_face import LiftedFace
 from shellform.contact.nodes import W_SLOPES
 from shellform.contact.pinch_edge import edge_weights
+from shellform.errors import InputError
 from shellform.nonlinear.parts import Part
 from shellform.results.log import say
 
@@ -72,6 +73,7 @@ class PinchingHolder(Part):
         self.sloped = np.zeros(n, dtype=bool)  # the nodes whose slopes the faces hold
         self.view = None  # what it reads of the contact set (compose)
         self.committed = None
+        self._edge_rates = {}  # dV_e/dp per parameter (_edge_rate)
 
     def bind(self, driver) -> None:
         self.lifted_face.bind(driver.model.V)
@@ -107,7 +109,8 @@ class PinchingHolder(Part):
     def _sum(self, v) -> float:
         return self.comm.allreduce(float(np.sum(v)), op=MPI.SUM)
 
-    def edge_shares(self, x: np.ndarray, pinched: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def edge_shares(self, x: np.ndarray, pinched: np.ndarray, line_load: float | None = None) \
+            -> tuple[np.ndarray, np.ndarray]:
         """(e, band): e_i = V_e a_i j_i (2 / b_i) sin^2(pi s_i / b_i) on the pinched nodes at x
         within b_i = 2 r_i of the holder's inner edge, 0 elsewhere (pinch_edge.py): s_i their
         plan distance from it, j_i the edge's length per unit length of their offset line, and
@@ -115,13 +118,15 @@ class PinchingHolder(Part):
         (SheetNodes.spread of s: the rows' spacing however the flange has stretched, so that
         the kernel sums to 1 over them and the band's total is V_e per unit length of the
         edge). The band, the pinched nodes with s_i < b_i, includes those drawn past the edge
-        in this increment (s < 0, still pinched until the next)."""
+        in this increment (s < 0, still pinched until the next). line_load: V_e (default the
+        edge law's)."""
+        V = self.edge_load if line_load is None else line_load
         if self.edge_load <= 0.0:
             return np.zeros(pinched.size), np.zeros(pinched.size, dtype=bool)
         s, j = self.tool.edge_offset(x)
         rows = self.nodes.spread(s)
         band = pinched & (s < 2.0 * rows)
-        return np.where(pinched, self.edge_load * self.nodes.current_area() * j * edge_weights(s, rows), 0.0), band
+        return np.where(pinched, V * self.nodes.current_area() * j * edge_weights(s, rows), 0.0), band
 
     def rides(self, share: float, tolerance: float) -> bool:
         """Whether giving its edge `share` of the edge load lifts the holder by at most
@@ -341,6 +346,64 @@ class PinchingHolder(Part):
     def report(self) -> dict:
         return {"holder_closed": bool(self.closed), "holder_lift": float(self.lift)}
 
+    # -- derivatives (nonlinear/sensitivity.py) ------------------------------------------------
+    EDGE_STEP = 1e-3  # the edge load's central differences in a material parameter, relative to it
+
     def derivatives(self) -> str | None:
-        """With no force there is no holder; its split of F and its lift are not differentiated yet."""
-        return "the blank holder's force has no derivatives yet" if self.force > 0 else None
+        """The closed holder's split is differentiated (face_derivatives), its pinched nodes'
+        known slopes too (known_derivatives); the open holder's lift is not (pseudo_load refuses
+        it when the holder opens)."""
+        return None
+
+    def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
+        """The nodes the faces hold flat take the slopes of the surface a half thickness above
+        the die (constrain): their slope rows' derivative is that surface's
+        (SheetNodes.surface_slopes_derivative). Their w row is the die's (the contact set's)."""
+        if self.sloped.any():
+            delta[self.sloped, W_SLOPES] += self.nodes.surface_slopes_derivative(de33)[self.sloped]
+
+    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, parameter=None) -> None:
+        """No forces of its own (its split presses through friction: face_derivatives); the open
+        holder's lift, an unknown of its own, has no derivatives yet: refused where it is open."""
+        if self.is_open:
+            raise InputError("output.sensitivities", f"the holder opened (lift {self.lift:.3g} mm): the open "
+                             "holder's lift has no derivatives yet; the sensitivities end at the last increment "
+                             "before it opened")
+
+    def face_derivatives(self, parameter, net: np.ndarray, dnet: np.ndarray, x: np.ndarray, dx: np.ndarray,
+                         eps: float) -> tuple[np.ndarray, np.ndarray]:
+        """(dd, dh) per owned node: d/dp of the closed holder's split (d_i, h_i) on the pinched
+        nodes, 0 elsewhere, along the net normal forces' derivative dnet, the positions' dx (the
+        edge load's shares follow each node's distance from the edge and its rows' spacing; its
+        area is the iterate's), the force's (the parameter's, where it is the holder's force) and
+        the edge load's V_e (its strip's, where the parameter is the material's): central
+        differences of HolderSplit.forces with step eps, the pinched nodes and the edge's band
+        held as converged."""
+        zero = np.zeros(net.size)
+        if not self.closed or self.force <= 0:
+            return zero, zero.copy()
+        dF = self.force / parameter.value if parameter is not None and parameter.holder_force else 0.0
+        dV = self._edge_rate(parameter)
+        split = self.split
+        saved = (split.force, split.band_ratio, split.band_force)
+        ends = []
+        for sign in (1.0, -1.0):
+            y = x + sign * eps * dx
+            split.force = self.force + sign * eps * dF
+            e = self.edge_shares(y, self.pinched, self.edge_load + sign * eps * dV)[0]
+            ends.append(split.forces(self.pinched, net + sign * eps * dnet, self._tops(y), e, self.band))
+        split.force, split.band_ratio, split.band_force = saved
+        return (ends[0][0] - ends[1][0]) / (2 * eps), (ends[0][1] - ends[1][1]) / (2 * eps)
+
+    def _edge_rate(self, parameter) -> float:
+        """dV_e/dp: central differences of the edge's strip (EdgeLoad.at) at p (1 +- EDGE_STEP)
+        where the parameter is the material's, else 0; once per parameter."""
+        if self.edge_law is None or parameter is None or "material" not in parameter.respond(parameter.value):
+            return 0.0
+        rates = self._edge_rates
+        if parameter.name not in rates:
+            step = self.EDGE_STEP * abs(parameter.value)
+            ends = [self.edge_law.at(parameter.respond(parameter.value + sign * step)["material"]).line_load
+                    for sign in (1.0, -1.0)]
+            rates[parameter.name] = (ends[0] - ends[1]) / (2 * step)
+        return rates[parameter.name]

@@ -158,8 +158,8 @@ class SheetNodes(Part):
         self.surface_slopes = self.gradient(half, w)
 
     def derivatives(self) -> str | None:
-        """The nodes' positions and thicknesses are read, not solved for: nothing to add (a node
-        held flat by the holder follows a moved surface at commit: the holder is refused)."""
+        """The nodes' positions and thicknesses are read, not solved for: nothing to add (the
+        parts that hold nodes on them give those rows' derivatives: known_derivatives)."""
         return None
 
     def half_thickness_derivative(self, de33: np.ndarray) -> np.ndarray:
@@ -169,6 +169,11 @@ class SheetNodes(Part):
         if not self.model.plastic:
             return np.zeros(self.n_owned)
         return self.half_thickness * self.recover(de33, self._weights())
+
+    def surface_slopes_derivative(self, de33: np.ndarray) -> np.ndarray:
+        """(n_owned, 2): d/dp of surface_slopes of the committed state, the gradient of the half
+        thickness's derivative (half_thickness_derivative) with the same weights."""
+        return self.gradient(self.half_thickness_derivative(de33), self._weights())
 
     def recover(self, values: np.ndarray, weights: np.ndarray | None = None) -> np.ndarray:
         """(n_owned,): a per-cell field at the nodes, exact for a linear field: at each node the

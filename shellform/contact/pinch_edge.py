@@ -143,6 +143,7 @@ class EdgeLoad:
     moment: float
     thickness: float
     plate_stiffness: float
+    radius: float = math.nan  # the die shoulder's radius R_d the strip was wrapped on (at)
 
     def riding_lift(self, share: float) -> float:
         """The lift of a holder that gives the edge only `share` (0 < f <= 1) of V_e: the couple's
@@ -153,16 +154,25 @@ class EdgeLoad:
         arm = self.moment / self.line_load / max(share, 1e-300)
         return self.moment / self.plate_stiffness * arm**2 / 3.0
 
+    def at(self, material) -> "EdgeLoad":
+        """The same edge (thickness, shoulder) of another sheet (packed material): its strip
+        solved again (a sensitivity's differences in the material)."""
+        return strip_edge(material, self.thickness, self.radius)
+
 
 def edge_load(material, thickness: float, die, holder) -> EdgeLoad:
     """The EdgeLoad of the sheet (packed material: E, nu first) on this die under this holder:
     the Strip with the shoulder's radius (shoulder_curvature) and the sheet's own compliance, at
     spacing t / RESOLUTION, with no tension and no pre-squeeze (whose nanometres change nothing)."""
+    return strip_edge(material, thickness, 1.0 / shoulder_curvature(die, holder, thickness) - thickness / 2)
+
+
+def strip_edge(material, thickness: float, radius: float) -> EdgeLoad:
+    """The EdgeLoad of the sheet wrapped on a shoulder of radius R_d (edge_load's strip)."""
     E, nu = float(material[0]), float(material[1])
-    radius = 1.0 / shoulder_curvature(die, holder, thickness) - thickness / 2
     strip = Strip(material, thickness, radius, 0.0)
     r = strip.solve(thickness / RESOLUTION, 2 * strip.E_ps / thickness, 0.0)
-    return EdgeLoad(r["Vh_N_per_mm"], r["M0_Nmm_per_mm"], thickness, E / (1 - nu**2) * thickness**3 / 12)
+    return EdgeLoad(r["Vh_N_per_mm"], r["M0_Nmm_per_mm"], thickness, E / (1 - nu**2) * thickness**3 / 12, radius)
 
 
 def edge_weights(s: np.ndarray, h: np.ndarray) -> np.ndarray:

@@ -168,14 +168,15 @@ class Part:
         de33 = d/dp of the committed thickness strain per owned cell (the state the increment
         started from)."""
 
-    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, rates=None) -> None:
+    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, parameter=None) -> None:
         """rhs ((n_owned, BS), the solve's frames: dR/dp at fixed q, the sheet's, its known rows
         still there) += the part's own forces' dR/dp at fixed q for the parameter `key`, whose
-        central differences step by eps (dx_n: the committed positions' derivative; rates: the
-        parameter's per tool, for a part it is a coefficient of)."""
+        central differences step by eps (dx_n: the committed positions' derivative; parameter:
+        the Parameter (nonlinear/sensitivity.py), which says how its value enters: a friction
+        coefficient's rates per tool, the holder's force, the material)."""
 
     def carry(self, key: str, dx: np.ndarray, dx_n: np.ndarray, dR: np.ndarray, lam: float, eps: float,
-              rates=None) -> None:
+              parameter=None) -> None:
         """After the solve: the derivative of the part's history at this increment (dx: the
         positions', dR: the residual's total, (n_owned, BS) in the frames), taken at commit."""
 

@@ -66,6 +66,9 @@ from shellform.results.listeners import Record
 from shellform.scene.schema import FRICTION_KEYS, FRICTION_TOOLS
 
 STEP = 1e-5  # the central differences' step, relative to the parameter
+CORRECT_ABOVE = 1e-6  # a solve is corrected while its free rows' total passes this share of the loads' scale
+CORRECTED_BY = 0.5  # ... and each correction shrinks it at least by this factor
+MAX_CORRECTIONS = 8
 KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
 
 
@@ -79,6 +82,7 @@ class Parameter:
     name: str
     value: float
     rates = None  # d(coefficient)/dp per tool of the contact set, the holder's last (a friction parameter)
+    holder_force = False  # the holder's force is this value (over the model's symmetry)
 
     def respond(self, value: float) -> dict:
         return {}
@@ -115,6 +119,15 @@ class FrictionParameter(Parameter):
 
 
 @dataclass
+class HolderForceParameter(Parameter):
+    """The force-controlled holder's force on the whole blank (tools.blank_holder_force): the
+    sheet does not depend on it; the holder's split of it over the pinched nodes does, and
+    friction presses with that split (contact/holder.py)."""
+
+    holder_force = True
+
+
+@dataclass
 class PressureParameter(Parameter):
     """The dead pressure at load factor 1 (its value the driver's): R = f_int - lambda p f,
     so dR/dp = -lambda f_ext / p."""
@@ -129,7 +142,7 @@ def scene_parameters(scene) -> list[Parameter]:
     """The parameters a scene names in `[output] sensitivities` (checked with the scene:
     "material.<number>", "material.thickness", "loads.pressure"; a tool scene's "tools.friction"
     and a tool's own "tools.punch_friction", ...: the coefficient of the tools (punch, die,
-    holder) that carry it)."""
+    holder) that carry it; "tools.blank_holder_force")."""
     out = []
     for name in scene.output.sensitivities:
         section, _, key = name.partition(".")
@@ -138,6 +151,8 @@ def scene_parameters(scene) -> list[Parameter]:
             own = {tool: getattr(t, f"{tool}_friction") for tool in FRICTION_TOOLS}
             carried = [own[tool] is None if key == "friction" else key == f"{tool}_friction" for tool in own]
             out.append(FrictionParameter(name, float(getattr(t, key)), rates=tuple(float(c) for c in carried)))
+        elif name == "tools.blank_holder_force":
+            out.append(HolderForceParameter(name, float(scene.tools.blank_holder_force)))
         elif name == "material.thickness":
             out.append(ThicknessParameter(name, float(scene.material.thickness)))
         elif name == "loads.pressure":
@@ -164,7 +179,7 @@ class Sensitivity(Record):
                 why = "material.thickness places the tools around the sheet: not differentiated with tools yet"
             if why is not None:
                 raise InputError("output.sensitivities", f"{why}; a tool scene's sensitivities need rigid tools, "
-                                 "with or without friction, and no holder force, ironing or drawbeads")
+                                 "with or without friction and a force-controlled holder, and no ironing or drawbeads")
         self._known = fem.Function(self.model.V)  # the known rows' derivatives, shared with the ghosts
         zeros = lambda a: np.zeros_like(a)  # noqa: E731
         start = self.model.history()
@@ -172,7 +187,12 @@ class Sensitivity(Record):
         self.dh = {p.name: {k: zeros(start[k]) for k in KEYS} for p in self.parameters}
         self.dR = {p.name: zeros(driver.residual_full) for p in self.parameters}
         self.switches = []  # per increment: layers that turned elastic/plastic within +-eps, all parameters
-        self.free_residual = []  # per increment: the largest |dR/dp| on the free rows over the pseudo-load's (a check)
+        # per increment: the largest total |dR/dp| on the free rows over the scale of the loads'
+        # (the pseudo-load's and the reactions' derivatives, the larger: a check), the corrections
+        # its solves took (all parameters)
+        self.free_residual, self.corrections = [], []
+        self._step = fem.Function(self.model.V)  # a correction's solve
+        self._free_total = None  # the free rows' total of the last _total
 
     # -- the record's protocol ------------------------------------------------------------------
     def converged(self, driver, lam: float) -> None:
@@ -181,7 +201,7 @@ class Sensitivity(Record):
         h_n = model.history()
         q = driver.q.x.array.copy()
         driver.linearize(lam)  # the consistent tangent at the converged state, from h_n
-        switched, ratio = 0, 0.0
+        switched, ratio, corrections = 0, 0.0, 0
         owned = driver.n_owned * BS
         free = np.ones(owned, dtype=bool)
         free[driver.bc_dofs[driver.bc_dofs < owned]] = False
@@ -195,7 +215,7 @@ class Sensitivity(Record):
                 rhs[: load.size] += load
             dx_n = self.dq[par.name].reshape(-1, BS)[: driver.n_owned, :3].copy()  # the committed positions'
             for part in driver.parts:
-                part.pseudo_load(par.name, rhs[:owned].reshape(-1, BS), dx_n, eps, par.rates)
+                part.pseudo_load(par.name, rhs[:owned].reshape(-1, BS), dx_n, eps, par)
             rhs[~free] = 0.0
             delta = np.zeros_like(q)  # the known rows' derivatives (solve coordinates, ghosts from their owners)
             if driver.parts:
@@ -208,28 +228,56 @@ class Sensitivity(Record):
             out = driver.dq  # the step's work array, free after convergence
             if not driver.solve_lifted(delta, out, extra=-rhs):
                 raise RuntimeError(f"the sensitivity solve for {par.name} failed at load factor {lam:.6g}")
-            dq = driver.to_xyz(out.x.array)
-            ends = [model.respond(q + s * eps * dq, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))
-                    for s in (1, -1)]
-            dR = driver.assembled(ends[0][0] - ends[1][0]) / (2 * eps)
-            if load is not None:
-                dR[: load.size] += load
-            for part in driver.parts:
-                part.carry(par.name, dq.reshape(-1, BS)[: driver.n_owned, :3], dx_n,
-                           dR[:owned].reshape(-1, BS), lam, eps, par.rates)
+            pseudo = comm.allreduce(float(np.abs(rhs[:owned][free]).max(initial=0.0)), op=MPI.MAX)
+            dq, ends, dR, worst, size = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+            scale = max(pseudo, size)  # the pseudo-load's or the reactions' derivatives, the larger
+            before, previous = np.inf, None
+            for _ in range(MAX_CORRECTIONS):
+                if not worst > CORRECT_ABOVE * scale:
+                    break
+                if not worst < CORRECTED_BY * before:  # no longer converging: keep the better one
+                    if worst > before:
+                        out.x.array[:] = previous
+                        dq, ends, dR, worst, _ = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+                    break
+                corrections += 1  # K misses a part's terms: solve again for what the total leaves
+                before, previous = worst, out.x.array.copy()
+                if not driver.solve_lifted(np.zeros_like(q), self._step, extra=-self._free_total):
+                    raise RuntimeError(f"the sensitivity correction for {par.name} failed at load factor {lam:.6g}")
+                out.x.array[:] += self._step.x.array
+                dq, ends, dR, worst, _ = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
             self.dq[par.name] = dq
             self.dh[par.name] = {k: (ends[0][1][k] - ends[1][1][k]) / (2 * eps) for k in KEYS}
             self.dR[par.name] = dR[:owned]
             yielded = [e[1]["p"] > h_n["p"] for e in ends]
             switched += int(np.sum(yielded[0] != yielded[1]))
-            scale = comm.allreduce(float(np.abs(rhs[:owned][free]).max(initial=0.0)), op=MPI.MAX)  # the pseudo-load
-            total = dR[:owned].copy()  # with the parts' forces: about zero on the free rows
-            for part in driver.parts:
-                part.total_derivative(par.name, total.reshape(-1, BS))
-            worst = comm.allreduce(float(np.abs(total[free]).max(initial=0.0)), op=MPI.MAX)
             ratio = max(ratio, worst / scale if scale > 0 else 0.0)
         self.switches.append(comm.allreduce(switched, op=MPI.SUM))
         self.free_residual.append(ratio)
+        self.corrections.append(corrections)
+
+    def _total(self, par, out, q, h_n, dh, eps, dx_n, load, free, lam):
+        """The solved derivative in `out` (solve coordinates) taken through the element loop and
+        the parts: (dq, the two ends of the differences, dR/dp, the largest |total dR/dp| on the
+        free rows, on all owned rows); the free rows' total kept for a correction."""
+        driver, model, comm = self.driver, self.model, self.model.mesh.comm
+        owned = driver.n_owned * BS
+        dq = driver.to_xyz(out.x.array)
+        ends = [model.respond(q + s * eps * dq, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))
+                for s in (1, -1)]
+        dR = driver.assembled(ends[0][0] - ends[1][0]) / (2 * eps)
+        if load is not None:
+            dR[: load.size] += load
+        for part in driver.parts:
+            part.carry(par.name, dq.reshape(-1, BS)[: driver.n_owned, :3], dx_n, dR[:owned].reshape(-1, BS), lam,
+                       eps, par)
+        total = dR[:owned].copy()  # with the parts' forces: about zero on the free rows
+        for part in driver.parts:
+            part.total_derivative(par.name, total.reshape(-1, BS))
+        size = comm.allreduce(float(np.abs(total).max(initial=0.0)), op=MPI.MAX)
+        total[~free] = 0.0
+        self._free_total = total
+        return dq, ends, dR, comm.allreduce(float(np.abs(total).max(initial=0.0)), op=MPI.MAX), size
 
     def checkpoint(self) -> dict:
         nodes, cells = {}, {}

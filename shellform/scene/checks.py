@@ -216,6 +216,10 @@ def _validate_sensitivities(s) -> None:
         if name in ("material.thickness", "loads.pressure"):
             require(name != "loads.pressure" or s.loads.pressure != 0, field_, "needs a pressure other than 0")
             continue
+        if name == "tools.blank_holder_force" and s.tools is not None:
+            require(s.tools.holder != "gap" and s.tools.blank_holder_force > 0, field_,
+                    "needs a holder pressing with a force > 0 (not one held at a gap)")
+            continue
         if section == "tools" and s.tools is not None and key in FRICTION_KEYS:
             value = getattr(s.tools, key)
             require("friction" in s.effects and value is not None and value > 0, field_,
@@ -226,7 +230,7 @@ def _validate_sensitivities(s) -> None:
             continue
         require(section == "material" and key in numbers, field_,
                 "must be material.<a number of [material]>, material.thickness or loads.pressure (a tool scene: "
-                "tools.friction or a tool's own coefficient too)")
+                "tools.friction, a tool's own coefficient or tools.blank_holder_force too)")
         value = getattr(s.material, key)
         require(not np.array_equal(s.with_material(key, value * (1 + 1e-3) if value else 1e-3).hill79().pack(),
                                    base), field_,
@@ -238,20 +242,19 @@ def _validate_sensitivities(s) -> None:
 
 
 def _validate_tool_sensitivities(s) -> None:
-    """A tool scene's sensitivities: its rigid tools and friction have derivatives (no holder
-    force, ironing or drawbeads), with finite strains (the nodes' thickness), and no parameter
-    that moves the tools."""
+    """A tool scene's sensitivities: its rigid tools, its closed holder and friction have
+    derivatives (not ironing or drawbeads), with finite strains (the nodes' thickness), and no
+    parameter that moves the tools."""
     for effect in ("ironing", "drawbeads"):
         require(effect not in s.effects, "effects", f"the effect {effect!r} has no derivatives yet: a tool scene's "
-                "output.sensitivities are its rigid tools' and friction's alone (docs/sensitivity.md, Tool scenes)")
+                "output.sensitivities are its rigid tools', its holder's and friction's alone (docs/sensitivity.md, "
+                "Tool scenes)")
     require("finite_strain" in s.effects, "effects",
             "a tool scene's output.sensitivities need the effect 'finite_strain' (the nodes' thickness)")
-    require(s.tools.blank_holder_force == 0, "tools.blank_holder_force",
-            "the holder's force has no derivatives yet: a tool scene's output.sensitivities need it 0")
     for name in s.output.sensitivities:
         require(name not in ("material.thickness", "loads.pressure"), f"output.sensitivities ({name})",
-                "moves the tools or loads no tool scene: a tool scene takes material.<number>, tools.friction or "
-                "a tool's own coefficient")
+                "moves the tools or loads no tool scene: a tool scene takes material.<number>, tools.friction, "
+                "a tool's own coefficient or tools.blank_holder_force")
 
 
 def _validate_probes(s) -> None:

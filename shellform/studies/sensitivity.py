@@ -204,18 +204,19 @@ FRICTION_PARAMETERS = ("material.K", "tools.friction")
 
 
 def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False,
-              friction: bool = False):
-    """demos/round_cup.toml with its rigid punch and die (no holder force, no ironing) and,
-    with `friction`, its Coulomb friction (0.07), else none: the parts that have derivatives;
-    n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10, with `changes` {scene key: value}:
-    (problem, Sensitivity of the scene keys `sensitivities` or None); with scene_only, (the
-    scene, None), not run."""
+              friction: bool = False, holder: bool = False):
+    """demos/round_cup.toml with its rigid punch and die (no ironing), with `holder` its
+    force-controlled holder (10 kN), else none, and with `friction` its Coulomb friction (0.07),
+    else none: parts that have derivatives; n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10,
+    with `changes` {scene key: value}: (problem, Sensitivity of the scene keys `sensitivities`
+    or None); with scene_only, (the scene, None), not run."""
     from shellform import demos, scene
     from shellform.contact.problem import DrawingProblem
 
     base = scene.load(demos.path("round_cup.toml"))
     drop = ("ironing",) if friction else ("friction", "ironing")
-    s = base.changed({"mesh.n": n, "tools.stroke": stroke, "tools.blank_holder_force": 0.0,
+    s = base.changed({"mesh.n": n, "tools.stroke": stroke,
+                      **({} if holder else {"tools.blank_holder_force": 0.0}),
                       **({} if friction else {"tools.friction": 0.0}),
                       "effects": [e for e in base.effects if e not in drop],
                       "process.report": [], "process.initial_step_mm": 0.1, "process.max_step_mm": 0.1,
