@@ -58,6 +58,8 @@ STUDIES = {
                    "errors per angle",
     "esaform-cup": "the ESAFORM 2021 cup drawn through, Yld2000-2d and Hill 1948: the height profile against the measured one",
     "sensitivity": "sensitivities from one run against closed forms and finite differences of two runs",
+    "sensitivity-cup": "the aluminium cup's sensitivities (holder force, friction, K, n, r0) against differences of "
+                       "whole runs, and their cost",
 }
 
 SCENE_HELP = "the scene's TOML file (docs/scenes.md)"
