@@ -287,9 +287,8 @@ from mpi4py import MPI
 from shellform.contact.run import run
 from shellform.studies.sensitivity import drawn_cup
 
-s, _ = drawn_cup(scene_only=True, friction=True, n=8)
-s = s.changed({"output.sensitivities": ["tools.friction", "material.K"], "output.png": False, "output.vtx": False,
-               "output.fld": False})
+s, _ = drawn_cup(scene_only=True, friction=True, n=8, holder=HOLDER)
+s = s.changed({"output.sensitivities": PARAMETERS, "output.png": False, "output.vtx": False, "output.fld": False})
 summary = run(s, "OUT")
 if MPI.COMM_WORLD.rank == 0:
     print("RESULT " + json.dumps({"iterations": summary["newton_iterations"],
@@ -300,17 +299,23 @@ if MPI.COMM_WORLD.rank == 0:
 @pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(mpiexec() is None, reason="no mpiexec")
-def test_a_cups_sensitivities_on_two_ranks_match_serial(tmp_path):
-    """The round cup with friction (n 8, 3 mm) and its sensitivities in tools.friction and K on
-    two ranks: the same Newton iterations as serial (friction's normal-force tangent gathers a
-    node's cells from every rank: a ghost node's rows go to its owner) and the same derivatives
-    of every answer to 1e-6 (measured 1e-7)."""
+@pytest.mark.parametrize("holder, parameters", [
+    (False, ["tools.friction", "material.K"]),
+    (True, ["tools.blank_holder_force", "material.K"]),
+])
+def test_a_cups_sensitivities_on_two_ranks_match_serial(tmp_path, holder, parameters):
+    """The round cup with friction (n 8, 3 mm), without and with its holder (10 kN), and its
+    sensitivities on two ranks: the same Newton iterations as serial (friction's normal-force
+    tangent gathers a node's cells from every rank: a ghost node's rows go to its owner) and the
+    same derivatives of every answer to 1e-6 (measured 1e-7 without the holder)."""
     import runpy
 
-    source = SENSITIVITIES.replace("OUT", str(tmp_path / "two"))
+    source = SENSITIVITIES.replace("HOLDER", str(holder)).replace("PARAMETERS", repr(parameters))
+    source = source.replace("OUT", str(tmp_path / "two"))
     parallel = on_two_ranks(tmp_path, source)
     serial = {}
-    source = SENSITIVITIES.replace("OUT", str(tmp_path / "one"))
+    source = SENSITIVITIES.replace("HOLDER", str(holder)).replace("PARAMETERS", repr(parameters))
+    source = source.replace("OUT", str(tmp_path / "one"))
     source = source.replace('print("RESULT " + json.dumps(', "RESULT.update((")
     runpy.run_path(_write(tmp_path / "serial.py", source), init_globals={"RESULT": serial})
     assert parallel["iterations"] == serial["iterations"]

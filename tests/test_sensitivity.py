@@ -157,6 +157,15 @@ def test_the_cup_with_a_holder_against_finite_differences_of_two_runs():
     assert sum(s.corrections) > 0 and max(s.free_residual) < 1e-5
 
 
+def test_an_opening_holder_stops_the_sensitivities():
+    """A light holder (300 N) opens in the first millimetres: its lift, an unknown of its own, has
+    no derivatives yet, and the run says so, naming the field."""
+    with pytest.raises(InputError, match="holder opened") as err:
+        drawn_cup({"tools.blank_holder_force": 300.0}, sensitivities=("tools.blank_holder_force",), friction=True,
+                  holder=True)
+    assert err.value.field == "output.sensitivities"
+
+
 @pytest.mark.slow  # three runs each, about 25 s
 @pytest.mark.parametrize("key", ["material.K", "tools.friction"])
 def test_the_cup_with_a_holder_in_k_and_mu(key):

@@ -359,7 +359,7 @@ class PinchingHolder(Part):
         """The nodes the faces hold flat take the slopes of the surface a half thickness above
         the die (constrain): their slope rows' derivative is that surface's
         (SheetNodes.surface_slopes_derivative). Their w row is the die's (the contact set's)."""
-        if self.sloped.any():
+        if self.force > 0:  # every rank: the gradient gathers the cells of every rank
             delta[self.sloped, W_SLOPES] += self.nodes.surface_slopes_derivative(de33)[self.sloped]
 
     def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, parameter=None) -> None:
@@ -367,8 +367,8 @@ class PinchingHolder(Part):
         holder's lift, an unknown of its own, has no derivatives yet: refused where it is open."""
         if self.is_open:
             raise InputError("output.sensitivities", f"the holder opened (lift {self.lift:.3g} mm): the open "
-                             "holder's lift has no derivatives yet; the sensitivities end at the last increment "
-                             "before it opened")
+                             "holder's lift has no derivatives yet; run without output.sensitivities, or with a "
+                             "holder that stays closed")
 
     def face_derivatives(self, parameter, net: np.ndarray, dnet: np.ndarray, x: np.ndarray, dx: np.ndarray,
                          eps: float) -> tuple[np.ndarray, np.ndarray]:
