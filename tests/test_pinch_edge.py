@@ -99,3 +99,18 @@ def test_the_riding_lift_is_micrometres_at_full_share_and_grows_as_one_over_f_sq
     e = EdgeLoad(line_load=45.0, moment=28.6, thickness=0.81, plate_stiffness=3400.0)
     assert 1e-4 < e.riding_lift(1.0) < 3e-3
     assert e.riding_lift(0.5) == pytest.approx(4 * e.riding_lift(1.0))
+
+
+def test_an_edge_load_of_another_sheet_solves_its_strip_again():
+    """EdgeLoad.at (a sensitivity's differences in the material): the same sheet gives the same
+    edge bit for bit; K 1 % higher raises V_e by a little less than 1 % (the moment at the
+    shoulder is the plastic section's, K times its shape, less the elastic core's share)."""
+    from shellform.contact.pinch_edge import strip_edge
+    from shellform.studies.cup_hard import variant
+
+    s = variant(16, "numisheet93_aluminium.toml")
+    mat = s.hill79().pack()
+    e = strip_edge(mat, s.material.thickness, s.tools.die_profile_radius)
+    assert e.at(mat) == e
+    ratio = e.at(s.with_material("K", 1.01 * s.material.K).hill79().pack()).line_load / e.line_load
+    assert 1.005 < ratio < 1.0101

@@ -41,13 +41,29 @@ its history (the committed forces), the committed positions, the normal forces (
 pseudo-load on the normal rows) and, for a friction coefficient, the coefficient: the part adds
 that to the pseudo-load (Part.pseudo_load) and carries its history's derivative by central
 differences of its own return mapping with the stick and slip states held (Part.carry), as the
-sheet's is carried. A part whose forces on the free rows depend on p otherwise (the holder's
-split of its force, the ironing's penalty, the drawbeads) says so (Part.derivatives) and the
-sensitivities are refused, as is a tool scene without finite strains or one whose parameter
-moves the tools (the thickness: the tools are placed around the sheet). Where the set changes
-between p - dp and p + dp a finite difference jumps and the derivative of the fixed set does
-not: the comparison holds on a path whose set does not change within the difference
-(docs/sensitivity.md).
+sheet's is carried. On a node the closed holder pinches, friction presses with the holder's
+split of its force F (contact/holder_split.py), differentiated the same way in F, the net
+normal forces, the positions and the edge load (PinchingHolder.face_derivatives); the held
+slopes are known rows (Part.known_derivatives). A part whose forces on the free rows depend on
+p otherwise (the open holder's lift, the ironing's penalty, the drawbeads) says so
+(Part.derivatives, or when it opens) and the sensitivities are refused, as is a tool scene
+without finite strains or one whose parameter moves the tools (the thickness: the tools are
+placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
+jumps and the derivative of the fixed set does not: the comparison holds on a path whose set
+does not change within the difference (docs/sensitivity.md).
+
+The check and the corrections. The total derivative of the residual along (q', h'_n, 1), the
+element forces' difference, the parts' own (Part.total_derivative) and the turn of the frames of
+the nodes on curved tools (-R0 W_ab t_b . x', the tangent's curvature term along q', which the
+differences in the frames held leave out: ContactSet.carry), vanishes on the free rows where K
+is the exact Jacobian of the converged increment. Where a part's tangent leaves a term out (the
+friction's on a pinched node holds the split's spread and band fixed: each node's face follows
+its own R0, while the squeeze F - E_in - f E_e couples every pinched node), it does not: the
+solve is then corrected, K delta = -total on the free rows, q' += delta, while the total passes
+CORRECT_ABOVE of the loads' scale (the pseudo-load's and the reactions' derivatives, the
+larger) and each correction at least halves it (a defect correction with the increment's
+factors, at most MAX_CORRECTIONS; where one no longer halves it, the better of the last two is
+kept).
 
 The sensitivity is a Record of the driver (driver.records): `converged` runs with each
 converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through

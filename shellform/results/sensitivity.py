@@ -99,12 +99,14 @@ def uncertainty(derivatives: dict, scatter: dict) -> dict:
 
 
 def summary(sens, rows: list[dict], scatter) -> dict:
-    """summary.json's "sensitivity_checks" (where the derivatives are one-sided means, and the
-    free rows' check) and, with a scatter, "uncertainty" at the last report (`rows`: the
-    reports, their "sensitivities")."""
+    """summary.json's "sensitivity_checks" (where the derivatives are one-sided means, the free
+    rows' check and the corrections its solves took: nonlinear/sensitivity.py) and, with a
+    scatter, "uncertainty" at the last report (`rows`: the reports, their "sensitivities")."""
     out = {"sensitivity_checks": {
         "increments_with_switching_layers": [i + 1 for i, k in enumerate(sens.switches) if k],
-        "largest_free_residual": max(sens.free_residual, default=0.0)}}
+        "largest_free_residual": max(sens.free_residual, default=0.0),
+        "corrections": int(sum(sens.corrections)),
+        "increments_corrected": int(sum(1 for k in sens.corrections if k))}}
     if scatter and rows and "sensitivities" in rows[-1]:
         out["uncertainty"] = uncertainty(rows[-1]["sensitivities"], changes(sens.parameters, scatter))
     return out

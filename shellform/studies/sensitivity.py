@@ -201,6 +201,7 @@ def cantilever(folder: Path) -> tuple[list[dict], dict]:
 CUP_STEP = 1e-5  # the drawn cup's differences: at 1e-4 layers yield between p - h and p + h (docs/sensitivity.md)
 CUP_PARAMETERS = ("material.K", "material.n")
 FRICTION_PARAMETERS = ("material.K", "tools.friction")
+HOLDER_PARAMETERS = ("material.K", "tools.friction", "tools.blank_holder_force")
 
 
 def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False,
@@ -238,20 +239,21 @@ def rim_node(p) -> int:
     return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
 
 
-def cup(friction: bool = False) -> tuple[list[dict], dict]:
-    """The round cup drawn 3 mm (drawn_cup), frictionless or with its friction: the punch force
-    and the rim's draw-in on y = 0, in each parameter against central differences of two runs
-    at p (1 +- CUP_STEP)."""
-    names = FRICTION_PARAMETERS if friction else CUP_PARAMETERS
-    case = "round cup, friction 0.07" if friction else "round cup, frictionless"
-    (p, s), with_s, without = _costs(lambda: drawn_cup(friction=friction),
-                                     lambda: drawn_cup(sensitivities=names, friction=friction))
+def cup(friction: bool = False, holder: bool = False) -> tuple[list[dict], dict]:
+    """The round cup drawn 3 mm (drawn_cup), frictionless, with its friction, or with its
+    friction and its holder: the punch force and the rim's draw-in on y = 0, in each parameter
+    against central differences of two runs at p (1 +- CUP_STEP)."""
+    names = HOLDER_PARAMETERS if holder else FRICTION_PARAMETERS if friction else CUP_PARAMETERS
+    case = "round cup, holder 10 kN, friction 0.07" if holder else \
+        "round cup, friction 0.07" if friction else "round cup, frictionless"
+    (p, s), with_s, without = _costs(lambda: drawn_cup(friction=friction, holder=holder),
+                                     lambda: drawn_cup(sensitivities=names, friction=friction, holder=holder))
     i = rim_node(p)
     rows = []
     for par in s.parameters:
         k, value = par.name, par.value
         h = CUP_STEP * value
-        plus, minus = (drawn_cup({k: value + sign * h}, friction=friction)[0] for sign in (1, -1))
+        plus, minus = (drawn_cup({k: value + sign * h}, friction=friction, holder=holder)[0] for sign in (1, -1))
         fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)
         fd_draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
         rows.append(_row(case, "punch force", k, p.punch_force(residual=s.residual(k)), fd_force,
@@ -303,7 +305,7 @@ def run(outdir) -> list[dict]:
     out.mkdir(parents=True, exist_ok=True)
     rows, times = [], []
     for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
-                 lambda: cup(friction=True)):
+                 lambda: cup(friction=True), lambda: cup(friction=True, holder=True)):
         r, t = case()
         rows += r
         times.append(t)
