@@ -382,9 +382,13 @@ class CoulombFriction(Part):
         if not self.active:
             return
         x = self.nodes.positions()
-        dnormal, dmu = self.normal_rates(parameter, dR[:, 2], x, dx, eps)
-        self.dforce[key] = self._differences(key, eps, x, dx, dx_n, lambda y: self.contact.normals_at(y, lam),
-                                             dnormal, dmu)
+        normals = lambda y: self.contact.normals_at(y, lam)  # noqa: E731
+        # R0 = n . R_sheet and R_sheet = R0 n + f on a node on a tool: as the node moves on a
+        # curved tool its normal turns towards the friction force, R0' = n . R_sheet' + n' . f
+        # (dR's normal row is n . R_sheet', the frames held)
+        turn = np.einsum("ni,ni->n", (normals(x + eps * dx) - normals(x - eps * dx)) / (2 * eps), self.force)
+        dnormal, dmu = self.normal_rates(parameter, dR[:, 2] + turn, x, dx, eps)
+        self.dforce[key] = self._differences(key, eps, x, dx, dx_n, normals, dnormal, dmu)
 
     def total_derivative(self, key: str, dR: np.ndarray) -> None:
         if key in self.dforce:

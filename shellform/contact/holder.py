@@ -109,8 +109,8 @@ class PinchingHolder(Part):
     def _sum(self, v) -> float:
         return self.comm.allreduce(float(np.sum(v)), op=MPI.SUM)
 
-    def edge_shares(self, x: np.ndarray, pinched: np.ndarray, line_load: float | None = None) \
-            -> tuple[np.ndarray, np.ndarray]:
+    def edge_shares(self, x: np.ndarray, pinched: np.ndarray, line_load: float | None = None,
+                    area: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(e, band): e_i = V_e a_i j_i (2 / b_i) sin^2(pi s_i / b_i) on the pinched nodes at x
         within b_i = 2 r_i of the holder's inner edge, 0 elsewhere (pinch_edge.py): s_i their
         plan distance from it, j_i the edge's length per unit length of their offset line, and
@@ -119,14 +119,15 @@ class PinchingHolder(Part):
         the kernel sums to 1 over them and the band's total is V_e per unit length of the
         edge). The band, the pinched nodes with s_i < b_i, includes those drawn past the edge
         in this increment (s < 0, still pinched until the next). line_load: V_e (default the
-        edge law's)."""
+        edge law's); area: the nodes' a_i (default the iterate's, SheetNodes.current_area)."""
         V = self.edge_load if line_load is None else line_load
         if self.edge_load <= 0.0:
             return np.zeros(pinched.size), np.zeros(pinched.size, dtype=bool)
         s, j = self.tool.edge_offset(x)
         rows = self.nodes.spread(s)
         band = pinched & (s < 2.0 * rows)
-        return np.where(pinched, V * self.nodes.current_area() * j * edge_weights(s, rows), 0.0), band
+        area = self.nodes.current_area() if area is None else area
+        return np.where(pinched, V * area * j * edge_weights(s, rows), 0.0), band
 
     def rides(self, share: float, tolerance: float) -> bool:
         """Whether giving its edge `share` of the edge load lifts the holder by at most
@@ -390,7 +391,7 @@ class PinchingHolder(Part):
         for sign in (1.0, -1.0):
             y = x + sign * eps * dx
             split.force = self.force + sign * eps * dF
-            e = self.edge_shares(y, self.pinched, self.edge_load + sign * eps * dV)[0]
+            e = self.edge_shares(y, self.pinched, self.edge_load + sign * eps * dV, self.nodes.current_area(y))[0]
             ends.append(split.forces(self.pinched, net + sign * eps * dnet, self._tops(y), e, self.band))
         split.force, split.band_ratio, split.band_force = saved
         return (ends[0][0] - ends[1][0]) / (2 * eps), (ends[0][1] - ends[1][1]) / (2 * eps)

@@ -107,9 +107,13 @@ class SheetNodes(Part):
         self.flat = np.asarray(held, dtype=bool).copy()
         self.pinched = np.asarray(pinched, dtype=bool) & self.flat
 
-    def current_area(self) -> np.ndarray:
-        """(n_owned,): a third of the current plan area of each cell around each node."""
-        x = self.local_positions()[:, :2][self.model.dofs.reshape(-1, 3)]
+    def current_area(self, positions: np.ndarray | None = None) -> np.ndarray:
+        """(n_owned,): a third of the current plan area of each cell around each node (or of
+        the plan area with the owned nodes at `positions`, the ghosts at their owners')."""
+        if positions is None:
+            x = self.local_positions()[:, :2][self.model.dofs.reshape(-1, 3)]
+        else:
+            x = np.stack([self.at_vertices(positions[:, 0]), self.at_vertices(positions[:, 1])], axis=-1)
         e1, e2 = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
         a = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
         return self.cell_sums(a / 3)[:, 0]
