@@ -108,6 +108,7 @@ def test_the_frictionless_cup_against_finite_differences_of_two_runs():
     assert p.punch_force(residual=s.residual("material.K")) == pytest.approx(force, rel=1e-6)
     assert -s.carrier("material.K").reshape(-1, BS)[i, 0] == pytest.approx(draw, rel=1e-6)
     assert max(s.free_residual) < 1e-5  # the frames' turn on the curved tools included (2e-7 measured)
+    assert not s.corrected and sum(s.corrections) == 0  # every part's tangent exact: nothing corrected
 
 
 @pytest.mark.slow  # five runs, about 13 s
@@ -149,12 +150,13 @@ def _holder_cup_against_differences(key, rel):
 
 def test_the_cup_with_a_holder_against_finite_differences_of_two_runs():
     """d/dF (tools.blank_holder_force): F enters only through the holder's split, which friction
-    presses with on the pinched nodes; to 1e-3 (measured 8e-5 in the force, 1.3e-4 in the
+    presses with on the pinched nodes; to 1e-3 (measured 3e-6 in the force, 1.3e-4 in the
     draw-in). The friction's tangent holds the split's spread (F's share per node) and its band
     fixed, so the solve is corrected against the total derivative: the free rows' total after
-    the corrections is below 1e-5 of the loads' (6e-6 measured; 2e-3 uncorrected)."""
+    the corrections is below the threshold, 1e-4 of the loads' (5e-5 measured; 2e-3
+    uncorrected)."""
     s = _holder_cup_against_differences("tools.blank_holder_force", 1e-3)
-    assert sum(s.corrections) > 0 and max(s.free_residual) < 1e-5
+    assert s.corrected and sum(s.corrections) > 0 and max(s.free_residual) < 1e-4
 
 
 def test_an_opening_holder_stops_the_sensitivities():

@@ -124,6 +124,12 @@ class CoulombFriction(Part):
         on a pinched node through the holder's split (normal_rates)."""
         return None
 
+    def tangent_misses(self) -> bool:
+        """Its tangent holds the pinched nodes' split of the holder's force fixed but for each
+        node's own R0, and leaves out the turn of a curved tool's normal towards the friction
+        force (carry): a sensitivity's solve is corrected."""
+        return self.active
+
     def per_tool(self) -> np.ndarray:
         """mu per tool of the contact set (its order, the holder's last): the scene's one
         coefficient for each, or its own."""

@@ -163,6 +163,11 @@ class Part:
         why not, in words (the sensitivities are then refused)."""
         return f"the part {type(self).__name__} has no derivatives yet"
 
+    def tangent_misses(self) -> bool:
+        """Whether the part's tangent leaves out terms of its forces' derivative, so that a
+        sensitivity's solve is corrected against the total derivative (nonlinear/sensitivity.py)."""
+        return False
+
     def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
         """delta ((n_owned, BS), the solve's frames) += d/dp of this part's known values, given
         de33 = d/dp of the committed thickness strain per owned cell (the state the increment

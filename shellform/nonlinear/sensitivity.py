@@ -56,10 +56,11 @@ The check and the corrections. The total derivative of the residual along (q', h
 element forces' difference, the parts' own (Part.total_derivative) and the turn of the frames of
 the nodes on curved tools (-R0 W_ab t_b . x', the tangent's curvature term along q', which the
 differences in the frames held leave out: ContactSet.carry), vanishes on the free rows where K
-is the exact Jacobian of the converged increment. Where a part's tangent leaves a term out (the
-friction's on a pinched node holds the split's spread and band fixed: each node's face follows
-its own R0, while the squeeze F - E_in - f E_e couples every pinched node), it does not: the
-solve is then corrected, K delta = -total on the free rows, q' += delta, while the total passes
+is the exact Jacobian of the converged increment. Where a part's tangent leaves a term out
+(Part.tangent_misses: friction's on a pinched node holds the split's spread and band fixed, each
+node's face following its own R0 while the squeeze F - E_in - f E_e couples every pinched node,
+and on a curved tool it leaves out the normal's turn towards the friction force), it does not:
+the solve is then corrected, K delta = -total on the free rows, q' += delta, while the total passes
 CORRECT_ABOVE of the loads' scale (the pseudo-load's and the reactions' derivatives, the
 larger) and each correction at least halves it (a defect correction with the increment's
 factors, at most MAX_CORRECTIONS; where one no longer halves it, the better of the last two is
@@ -82,7 +83,7 @@ from shellform.results.listeners import Record
 from shellform.scene.schema import FRICTION_KEYS, FRICTION_TOOLS
 
 STEP = 1e-5  # the central differences' step, relative to the parameter
-CORRECT_ABOVE = 1e-6  # a solve is corrected while its free rows' total passes this share of the loads' scale
+CORRECT_ABOVE = 1e-4  # a solve is corrected while its free rows' total passes this share of the loads' scale
 CORRECTED_BY = 0.5  # ... and each correction shrinks it at least by this factor
 MAX_CORRECTIONS = 8
 KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
@@ -208,6 +209,7 @@ class Sensitivity(Record):
         # its solves took (all parameters)
         self.free_residual, self.corrections = [], []
         self._step = fem.Function(self.model.V)  # a correction's solve
+        self.corrected = any(part.tangent_misses() for part in driver.parts)  # the solves are corrected
         self._free_total = None  # the free rows' total of the last _total
 
     # -- the record's protocol ------------------------------------------------------------------
@@ -248,7 +250,7 @@ class Sensitivity(Record):
             dq, ends, dR, worst, size = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
             scale = max(pseudo, size)  # the pseudo-load's or the reactions' derivatives, the larger
             before, previous = np.inf, None
-            for _ in range(MAX_CORRECTIONS):
+            for _ in range(MAX_CORRECTIONS if self.corrected else 0):
                 if not worst > CORRECT_ABOVE * scale:
                     break
                 if not worst < CORRECTED_BY * before:  # no longer converging: keep the better one
