@@ -375,8 +375,8 @@ class PinchingHolder(Part):
                          eps: float) -> tuple[np.ndarray, np.ndarray]:
         """(dd, dh) per owned node: d/dp of the closed holder's split (d_i, h_i) on the pinched
         nodes, 0 elsewhere, along the net normal forces' derivative dnet, the positions' dx (the
-        edge load's shares follow each node's distance from the edge and its rows' spacing; its
-        area is the iterate's), the force's (the parameter's, where it is the holder's force) and
+        edge load's shares follow each node's distance from the edge, its rows' spacing and its
+        area), the force's (the parameter's, where it is the holder's force) and
         the edge load's V_e (its strip's, where the parameter is the material's): central
         differences of HolderSplit.forces with step eps, the pinched nodes and the edge's band
         held as converged."""

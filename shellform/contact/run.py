@@ -55,7 +55,7 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              increment), the cell's initial x y and thickness strain there; null
                              without a neck. With [process] stop_at_neck the stroke ends at that
                              increment; without, the run goes on and only reports it
-    sensitivities.csv, tornado.png   ([output] sensitivities: rigid tools alone) the answers'
+    sensitivities.csv, tornado.png   ([output] sensitivities; parts with derivatives) the answers'
                              derivatives at every report (results/drawing.py CupSensitivities;
                              summary.json "sensitivities" per report, "sensitivity_checks",
                              "uncertainty" with a scatter; docs/sensitivity.md)

@@ -198,8 +198,8 @@ def _validate_material(s) -> None:
 
 def _validate_sensitivities(s) -> None:
     """[output] sensitivities: a nonlinear scene's, each a number the sheet depends on (a tool
-    scene's: of its rigid tools alone, whose parts have derivatives: docs/sensitivity.md, Tool
-    scenes); scatter: one standard deviation >= 0 each."""
+    scene's: of its parts that have derivatives, rigid tools, friction and a force-controlled
+    holder: docs/sensitivity.md, Tool scenes); scatter: one standard deviation >= 0 each."""
     names, scatter = s.output.sensitivities, s.output.scatter
     if not names:
         require(not scatter, "output.scatter", "needs output.sensitivities (a standard deviation per parameter)")
