@@ -82,8 +82,10 @@ class DrawingProblem(SheetFields):
         rotated back from their frames, plus their friction forces. On the die this includes
         the nodes the closed holder pinches (their net force, die minus holder, and the
         friction of both faces); the open holder's are its own (HOLDER). With `residual` (owned
-        rows, the nodes' frames: a Sensitivity's dR/dp) its reactions instead: the force's
-        sensitivity (friction and the ironing's face then left out: they have none yet)."""
+        rows, the nodes' frames: a Sensitivity's dR/dp of the sheet's forces, which on a tool's
+        node are its reaction and the friction they balance, R0 n + f) the force's sensitivity:
+        those rows turned back with the frames held, d(F^T R) = F^T dR exactly, the frames'
+        own turn cancelling (the ironing's face left out: it has no derivatives)."""
         d = self.driver
         on = d.contact.on(tool)
         if residual is not None:
