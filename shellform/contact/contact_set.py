@@ -106,7 +106,7 @@ class ContactSet(Part):
         self.slid_off = np.zeros(n, dtype=bool)  # nodes that slid off their tool's extent (this iterate)
         self.switched = np.zeros(n, dtype=bool)  # nodes that switched in the last update
         self.net = np.zeros(n)  # the net normal forces of the last refresh
-        self._frames_now = np.tile(np.eye(3), (n, 1, 1))  # the frames of the nodes on the tools (constrain)
+        self.frames = None  # the iterate's nodal frames (follow)
         self._turn = {}  # per parameter: the frames' turn along the solved derivative (carry)
         self.following = False  # the faces follow the reactions (the iterates after a pass's first)
         self.frozen = 0
@@ -267,7 +267,6 @@ class ContactSet(Part):
                 continue
             gap, normal = gaps[k][0][on], gaps[k][1][on]
             c.frames[on] = nodal_frames(normal)
-            self._frames_now[on] = c.frames[on]
             c.known[on, 2] = -gap  # the normal correction that closes the gap
             c.flags[on, 2] = True
             if k == self.holder_tool:
@@ -276,6 +275,10 @@ class ContactSet(Part):
             t = c.frames[on][:, :2]
             self.curvature[on] = np.einsum("nai,nij,nbj->nab", t, H, t)  # W_ab = t_a . H t_b
             self.shift[on] = self.paths[k].between(self.lam_n, lam) * self.axes[k]
+
+    def follow(self, frames: np.ndarray, lam: float) -> None:
+        """The iterate's nodal frames (owned and ghost nodes), which carry reads."""
+        self.frames = frames
 
     def add_tangent(self, K, R, fixed) -> None:
         """K_ab += -R0 W_ab on the tangent slots of the nodes on curved tools (module
@@ -450,7 +453,7 @@ class ContactSet(Part):
         b = np.flatnonzero((self.tool != FREE) & (np.abs(self.curvature).max(axis=(1, 2)) > 0))
         turn = np.zeros((self.tool.size, 2))
         if b.size:
-            t = np.einsum("nai,ni->na", self._frames_now[b][:, :2], dx[b])
+            t = np.einsum("nai,ni->na", self.frames[b][:, :2], dx[b])
             turn[b] = -self.net_normal_forces()[b, None] * np.einsum("nab,nb->na", self.curvature[b], t)
             turn[self.nodes.held[:, :2]] = 0.0
         self._turn[key] = turn

@@ -316,13 +316,7 @@ class CoulombFriction(Part):
         coefficients) and the stick and slip states held as they are (slip's formulas): the map
         a sensitivity differentiates."""
         idx, shift = self._rub[0], self._rub[1]
-        n = normals[idx]
-        ds = x[idx] - x_n[idx]
-        ds -= shift
-        ds -= np.sum(ds * n, axis=1)[:, None] * n
-        h = history[idx]
-        trial = h - np.sum(h * n, axis=1)[:, None] * n - self.k_stick[idx][:, None] * ds
-        size = np.linalg.norm(trial, axis=1)
+        trial, size = self._trial(idx, shift, x, x_n, normals[idx], history)
         limit = coefficient[idx] * normal[idx]
         ratio = np.where(self.slipping[idx], limit / np.maximum(size, 1e-300), 1.0)
         out = np.zeros_like(self.force)
@@ -408,6 +402,18 @@ class CoulombFriction(Part):
         self.dhistory[key] = state["friction_dhistory"].copy()
 
     # -- one iterate ---------------------------------------------------------------------------
+    def _trial(self, idx, shift, x, x_n, n, history):
+        """The elastic trial force f_n - k_t ds of the rubbing nodes idx (normals n) and its size:
+        the history f_n and the slip increment ds = x - x_n - shift, both turned into the tangent
+        plane."""
+        ds = x[idx] - x_n[idx]
+        ds -= shift
+        ds -= np.sum(ds * n, axis=1)[:, None] * n  # tangential slip increment
+        h = history[idx]
+        f_old = h - np.sum(h * n, axis=1)[:, None] * n
+        trial = f_old - self.k_stick[idx][:, None] * ds
+        return trial, np.linalg.norm(trial, axis=1)
+
     def slip(self, idx, shift, x, x_n, F, normal) -> None:
         """The return mapping on the rubbing nodes idx at positions x (x_n: at the start of the
         increment; shift: their tool's travel in it, (m, 3); F: their frames, normal F[:, 2]) with the
@@ -418,15 +424,8 @@ class CoulombFriction(Part):
         self.slipping[:] = False
         if not self.active:
             return
-        n = F[:, 2]
-        ds = x[idx] - x_n[idx]
-        ds -= shift
-        ds -= np.sum(ds * n, axis=1)[:, None] * n  # tangential slip increment
-        h = self.history[idx]
-        f_old = h - np.sum(h * n, axis=1)[:, None] * n
         k = self.k_stick[idx]
-        trial = f_old - k[:, None] * ds
-        size = np.linalg.norm(trial, axis=1)
+        trial, size = self._trial(idx, shift, x, x_n, F[:, 2], self.history)
         limit = self.coefficient[idx] * normal[idx]
         slip = size > (1 - 1e-6) * limit  # on the cone (a node that slipped): keeps slipping, slip tangent
         ratio = np.where(slip, limit / np.maximum(size, 1e-300), 1.0)

@@ -378,22 +378,19 @@ class PinchingHolder(Part):
         edge load's shares follow each node's distance from the edge, its rows' spacing and its
         area), the force's (the parameter's, where it is the holder's force) and
         the edge load's V_e (its strip's, where the parameter is the material's): central
-        differences of HolderSplit.forces with step eps, the pinched nodes and the edge's band
+        differences of HolderSplit.split_of with step eps, the pinched nodes and the edge's band
         held as converged."""
         zero = np.zeros(net.size)
         if not self.closed or self.force <= 0:
             return zero, zero.copy()
         dF = self.force / parameter.value if parameter is not None and parameter.holder_force else 0.0
         dV = self._edge_rate(parameter)
-        split = self.split
-        saved = (split.force, split.band_ratio, split.band_force)
         ends = []
         for sign in (1.0, -1.0):
             y = x + sign * eps * dx
-            split.force = self.force + sign * eps * dF
             e = self.edge_shares(y, self.pinched, self.edge_load + sign * eps * dV, self.nodes.current_area(y))[0]
-            ends.append(split.forces(self.pinched, net + sign * eps * dnet, self._tops(y), e, self.band))
-        split.force, split.band_ratio, split.band_force = saved
+            ends.append(self.split.split_of(self.force + sign * eps * dF, self.pinched, net + sign * eps * dnet,
+                                            self._tops(y), e, self.band))
         return (ends[0][0] - ends[1][0]) / (2 * eps), (ends[0][1] - ends[1][1]) / (2 * eps)
 
     def _edge_rate(self, parameter) -> float:

@@ -93,9 +93,10 @@ class HolderSplit:
         both = self.comm.allreduce(np.array([np.maximum(-net[inner], 0.0).sum(), edge.sum()]), op=MPI.SUM)
         return float(both[0]), float(both[1])
 
-    def edge_share(self, inner: float, total_edge: float) -> float:
-        """f: the share of its edge load E_e the holder gives after the holding-down E_in."""
-        left = max(self.force - inner, 0.0)
+    def edge_share(self, inner: float, total_edge: float, force: float | None = None) -> float:
+        """f: the share of its edge load E_e the holder gives after the holding-down E_in (of a
+        force F, default its own)."""
+        left = max((self.force if force is None else force) - inner, 0.0)
         return 1.0 if total_edge <= left else left / total_edge
 
     def held_down(self, pinched: np.ndarray, net: np.ndarray, edge: np.ndarray, band: np.ndarray):
@@ -109,18 +110,24 @@ class HolderSplit:
     def forces(self, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray, band: np.ndarray):
         """(die face d, holder face h) forces on the pinched nodes (zero elsewhere), from their net
         normal forces R0, their tops z + t/2 (the "rigid" spread) and the edge load's shares e_i on
-        its band (module docstring)."""
+        its band (module docstring); the split's band totals are kept (face_slopes)."""
+        d, h, self.band_ratio, self.band_force = self.split_of(self.force, pinched, net, tops, edge, band)
+        return d, h
+
+    def split_of(self, force: float, pinched: np.ndarray, net: np.ndarray, tops: np.ndarray, edge: np.ndarray,
+              band: np.ndarray):
+        """forces' split of a force F, nothing kept: (d, h, the die's force on the band over the
+        holder's D / H, the holder's H) (a sensitivity's differences)."""
         inner, total_edge = self.demands(pinched, net, edge, band)
-        f = self.edge_share(inner, total_edge)
-        S = max(self.force - inner, 0.0) - f * total_edge
+        f = self.edge_share(inner, total_edge, force)
+        S = max(force - inner, 0.0) - f * total_edge
         s = SPREAD_RULES[self.spread](S, pinched, self.area, self.k, tops, self.comm)
         h = np.where(pinched, s + np.where(band, f * edge, np.maximum(-net, 0.0)), 0.0)
         on_band = pinched & band
         H, R = self._sum(h[on_band]), self._sum(net[on_band])
-        self.band_ratio = max(H + R, 0.0) / H if H > 0 else 0.0
-        self.band_force = H
-        d = np.where(pinched, np.where(band, self.band_ratio * h, s + np.maximum(net, 0.0)), 0.0)
-        return d, h
+        ratio = max(H + R, 0.0) / H if H > 0 else 0.0
+        d = np.where(pinched, np.where(band, ratio * h, s + np.maximum(net, 0.0)), 0.0)
+        return d, h, ratio, H
 
     def face_slopes(self, net: np.ndarray, face: np.ndarray, band: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(dd_i/dR0_i, dh_i/dR0_i) of the pinched nodes at the last split, whose holder faces were

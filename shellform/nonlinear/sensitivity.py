@@ -72,6 +72,7 @@ a resume.
 """
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from dolfinx import fem
@@ -210,7 +211,6 @@ class Sensitivity(Record):
         self.free_residual, self.corrections = [], []
         self._step = fem.Function(self.model.V)  # a correction's solve
         self.corrected = any(part.tangent_misses() for part in driver.parts)  # the solves are corrected
-        self._free_total = None  # the free rows' total of the last _total
 
     # -- the record's protocol ------------------------------------------------------------------
     def converged(self, driver, lam: float) -> None:
@@ -247,37 +247,37 @@ class Sensitivity(Record):
             if not driver.solve_lifted(delta, out, extra=-rhs):
                 raise RuntimeError(f"the sensitivity solve for {par.name} failed at load factor {lam:.6g}")
             pseudo = comm.allreduce(float(np.abs(rhs[:owned][free]).max(initial=0.0)), op=MPI.MAX)
-            dq, ends, dR, worst, size = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
-            scale = max(pseudo, size)  # the pseudo-load's or the reactions' derivatives, the larger
+            taken = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+            scale = max(pseudo, taken.size)  # the pseudo-load's or the reactions' derivatives, the larger
             before, previous = np.inf, None
             for _ in range(MAX_CORRECTIONS if self.corrected else 0):
-                if not worst > CORRECT_ABOVE * scale:
+                if not taken.worst > CORRECT_ABOVE * scale:
                     break
-                if not worst < CORRECTED_BY * before:  # no longer converging: keep the better one
-                    if worst > before:
+                if not taken.worst < CORRECTED_BY * before:  # no longer converging: keep the better one
+                    if taken.worst > before:
                         out.x.array[:] = previous
-                        dq, ends, dR, worst, _ = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+                        taken = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
                     break
                 corrections += 1  # K misses a part's terms: solve again for what the total leaves
-                before, previous = worst, out.x.array.copy()
-                if not driver.solve_lifted(np.zeros_like(q), self._step, extra=-self._free_total):
+                before, previous = taken.worst, out.x.array.copy()
+                if not driver.solve_lifted(np.zeros_like(q), self._step, extra=-taken.free_total):
                     raise RuntimeError(f"the sensitivity correction for {par.name} failed at load factor {lam:.6g}")
                 out.x.array[:] += self._step.x.array
-                dq, ends, dR, worst, _ = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
-            self.dq[par.name] = dq
+                taken = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+            ends = taken.ends
+            self.dq[par.name] = taken.dq
             self.dh[par.name] = {k: (ends[0][1][k] - ends[1][1][k]) / (2 * eps) for k in KEYS}
-            self.dR[par.name] = dR[:owned]
+            self.dR[par.name] = taken.dR[:owned]
             yielded = [e[1]["p"] > h_n["p"] for e in ends]
             switched += int(np.sum(yielded[0] != yielded[1]))
-            ratio = max(ratio, worst / scale if scale > 0 else 0.0)
+            ratio = max(ratio, taken.worst / scale if scale > 0 else 0.0)
         self.switches.append(comm.allreduce(switched, op=MPI.SUM))
         self.free_residual.append(ratio)
         self.corrections.append(corrections)
 
-    def _total(self, par, out, q, h_n, dh, eps, dx_n, load, free, lam):
+    def _total(self, par, out, q, h_n, dh, eps, dx_n, load, free, lam) -> "_Taken":
         """The solved derivative in `out` (solve coordinates) taken through the element loop and
-        the parts: (dq, the two ends of the differences, dR/dp, the largest |total dR/dp| on the
-        free rows, on all owned rows); the free rows' total kept for a correction."""
+        the parts (_Taken)."""
         driver, model, comm = self.driver, self.model, self.model.mesh.comm
         owned = driver.n_owned * BS
         dq = driver.to_xyz(out.x.array)
@@ -294,8 +294,7 @@ class Sensitivity(Record):
             part.total_derivative(par.name, total.reshape(-1, BS))
         size = comm.allreduce(float(np.abs(total).max(initial=0.0)), op=MPI.MAX)
         total[~free] = 0.0
-        self._free_total = total
-        return dq, ends, dR, comm.allreduce(float(np.abs(total).max(initial=0.0)), op=MPI.MAX), size
+        return _Taken(dq, ends, dR, total, comm.allreduce(float(np.abs(total).max(initial=0.0)), op=MPI.MAX), size)
 
     def checkpoint(self) -> dict:
         nodes, cells = {}, {}
@@ -344,6 +343,20 @@ class Sensitivity(Record):
         if not self.model.finite:
             raise InputError(f"output.sensitivities ({name})", "the thickness strain's sensitivity needs finite_strain")
         return (self.dh[name]["stretch"] / self.model.history()["stretch"]).mean(axis=1)
+
+
+class _Taken(NamedTuple):
+    """A solved derivative taken through the element loop and the parts: dq (x, y, z), the two
+    ends of the differences (SheetModel.respond's), dR/dp (the sheet's, every row), the total
+    dR/dp on the free rows (0 on the known ones: what a correction solves for), its largest
+    entry, and the largest total on all owned rows (the reactions' derivatives among them)."""
+
+    dq: np.ndarray
+    ends: list
+    dR: np.ndarray
+    free_total: np.ndarray
+    worst: float
+    size: float
 
 
 def _along(h: dict, dh: dict, step: float) -> dict:
