@@ -108,9 +108,8 @@ def level(out: Path, n: int, stroke: float = STROKE) -> tuple[list[dict], dict]:
     say(f"sensitivity-cup: n {n}, the run with the sensitivities and the one without, alone")
     with_s = _run(base / "one_run", settings(n, stroke, sensitivities=True))
     without = _run(base / "plain", settings(n, stroke))
-    jobs = {}
-    for name in PARAMETERS:
-        value = _value(name)
+    jobs, values = {}, {name: _value(name) for name in PARAMETERS}
+    for name, value in values.items():
         for h in STEPS:
             for sign in (1, -1):
                 jobs[(name, h, sign)] = (base / f"{name}_{h:g}_{'+' if sign > 0 else '-'}",
@@ -122,8 +121,7 @@ def level(out: Path, n: int, stroke: float = STROKE) -> tuple[list[dict], dict]:
     rows = []
     for i, report in enumerate(one):
         at = float(report["stroke_mm"])
-        for name in PARAMETERS:
-            value = _value(name)
+        for name, value in values.items():
             fd = {}
             for h in STEPS:
                 plus, minus = (_reports(jobs[(name, h, s)][0])[i] for s in (1, -1))
