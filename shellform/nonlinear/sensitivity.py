@@ -72,6 +72,7 @@ a resume.
 """
 
 from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -232,6 +233,7 @@ class Sensitivity(Record):
             if load is not None:
                 rhs[: load.size] += load
             dx_n = self.dq[par.name].reshape(-1, BS)[: driver.n_owned, :3].copy()  # the committed positions'
+            sheet = rhs[:owned].copy()  # the sheet's and the loads' dR/dp at fixed q (the linear total's start)
             for part in driver.parts:
                 part.pseudo_load(par.name, rhs[:owned].reshape(-1, BS), dx_n, eps, par)
             rhs[~free] = 0.0
@@ -247,23 +249,15 @@ class Sensitivity(Record):
             if not driver.solve_lifted(delta, out, extra=-rhs):
                 raise RuntimeError(f"the sensitivity solve for {par.name} failed at load factor {lam:.6g}")
             pseudo = comm.allreduce(float(np.abs(rhs[:owned][free]).max(initial=0.0)), op=MPI.MAX)
-            taken = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+            real = partial(self._total, par, out, q, h_n, dh, eps, dx_n, load, free, lam)
+            if self.corrected:  # first on the sheet's linear share, then on the element loop's
+                linear = partial(self._linear_total, out, dx_n, sheet, free, lam, eps, par)
+                corrections += self._correct(par, out, q, lam, linear(), pseudo, linear)[1]
+                taken, taken_corrections = self._correct(par, out, q, lam, real(), pseudo, real)
+                corrections += taken_corrections
+            else:
+                taken = real()
             scale = max(pseudo, taken.size)  # the pseudo-load's or the reactions' derivatives, the larger
-            before, previous = np.inf, None
-            for _ in range(MAX_CORRECTIONS if self.corrected else 0):
-                if not taken.worst > CORRECT_ABOVE * scale:
-                    break
-                if not taken.worst < CORRECTED_BY * before:  # no longer converging: keep the better one
-                    if taken.worst > before:
-                        out.x.array[:] = previous
-                        taken = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
-                    break
-                corrections += 1  # K misses a part's terms: solve again for what the total leaves
-                before, previous = taken.worst, out.x.array.copy()
-                if not driver.solve_lifted(np.zeros_like(q), self._step, extra=-taken.free_total):
-                    raise RuntimeError(f"the sensitivity correction for {par.name} failed at load factor {lam:.6g}")
-                out.x.array[:] += self._step.x.array
-                taken = self._total(par, out, q, h_n, dh, eps, dx_n, load, free, lam)
             ends = taken.ends
             self.dq[par.name] = taken.dq
             self.dh[par.name] = {k: (ends[0][1][k] - ends[1][1][k]) / (2 * eps) for k in KEYS}
@@ -274,6 +268,35 @@ class Sensitivity(Record):
         self.switches.append(comm.allreduce(switched, op=MPI.SUM))
         self.free_residual.append(ratio)
         self.corrections.append(corrections)
+
+    def _correct(self, par, out, q, lam, taken, pseudo, measure) -> tuple["_Taken", int]:
+        """Defect corrections of the solved derivative in `out` (module docstring), `taken`
+        (_Taken) its total as measure() takes it: (the last total, the corrections taken)."""
+        scale = max(pseudo, taken.size)
+        before, previous, corrections = np.inf, None, 0
+        for _ in range(MAX_CORRECTIONS):
+            if not taken.worst > CORRECT_ABOVE * scale:
+                break
+            if not taken.worst < CORRECTED_BY * before:  # no longer converging: keep the better one
+                if taken.worst > before:
+                    out.x.array[:] = previous
+                    taken = measure()
+                break
+            corrections += 1  # K misses a part's terms: solve again for what the total leaves
+            before, previous = taken.worst, out.x.array.copy()
+            if not self.driver.solve_lifted(np.zeros_like(q), self._step, extra=-taken.free_total):
+                raise RuntimeError(f"the sensitivity correction for {par.name} failed at load factor {lam:.6g}")
+            out.x.array[:] += self._step.x.array
+            taken = measure()
+        return taken, corrections
+
+    def _linear_total(self, out, dx_n, sheet, free, lam, eps, par) -> "_Taken":
+        """The total dR/dp along the solved derivative in `out` with the sheet's share linear in
+        q', sheet + K q' (K the element tangents of the converged increment, the sheet's own
+        Jacobian): the corrections' first estimate, with no element loop (ends None)."""
+        driver = self.driver
+        dR = sheet + driver.apply_tangent(out.x.array)[: sheet.size]
+        return self._with_parts(par, driver.to_xyz(out.x.array), None, dR, dx_n, free, lam, eps)
 
     def _total(self, par, out, q, h_n, dh, eps, dx_n, load, free, lam) -> "_Taken":
         """The solved derivative in `out` (solve coordinates) taken through the element loop and
@@ -286,6 +309,12 @@ class Sensitivity(Record):
         dR = driver.assembled(ends[0][0] - ends[1][0]) / (2 * eps)
         if load is not None:
             dR[: load.size] += load
+        return self._with_parts(par, dq, ends, dR, dx_n, free, lam, eps)
+
+    def _with_parts(self, par, dq, ends, dR, dx_n, free, lam, eps) -> "_Taken":
+        """The sheet's dR/dp (every owned row) with the parts' forces' derivatives (_Taken)."""
+        driver, comm = self.driver, self.model.mesh.comm
+        owned = driver.n_owned * BS
         for part in driver.parts:
             part.carry(par.name, dq.reshape(-1, BS)[: driver.n_owned, :3], dx_n, dR[:owned].reshape(-1, BS), lam,
                        eps, par)
