@@ -219,12 +219,14 @@ def run(s: Scene, outdir: Path, comm=MPI.COMM_WORLD, trace=False, resume=False, 
         if d.verbose:
             say("shellform: springback: the tools withdraw")
         try:
-            released = springback.release(d)
+            released = springback.release(d, sensitivity=sens)
         except (ConvergenceFailure, Interrupted) as err:  # the drawn state is kept and reported
             if isinstance(err, Interrupted):
                 r.stopped, signum = f"{err} during springback (the drawn cup is complete)", err.signal
             return {"stopped": str(err)}
-        return sprung_back.write(outdir, p, s.title, before, released)
+        derivatives = None if sens is None else sprung_back.derivatives(
+            p.initial_positions(), d.displacements(), released.displacements(), sens, released.sensitivity, comm)
+        return sprung_back.write(outdir, p, s.title, before, released, derivatives)
 
     full = None  # the DiskFull that stopped the run
     try:

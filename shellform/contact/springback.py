@@ -48,6 +48,7 @@ class SpringbackDriver(Driver):
         f = self.residual_full[:n].copy()  # f_int(q): the tools' forces
         f[self.bc_dofs[self.bc_dofs < n]] = 0.0
         self.nodal = ReleasedForces(f, model.mesh.comm)
+        self.sensitivity = None  # release(..., sensitivity=): the derivatives carried through the springback
 
     def _set_dirichlet(self, lam, dofs=None):
         d = self.support_dofs if dofs is None else dofs
@@ -55,9 +56,11 @@ class SpringbackDriver(Driver):
         return self._largest(self.g[d] - self.q.x.array[d])
 
 
-def release(contact_driver, controls: Controls | None = None, verbose=False) -> SpringbackDriver:
+def release(contact_driver, controls: Controls | None = None, verbose=False, sensitivity=None) -> SpringbackDriver:
     """Spring the drawn sheet of `contact_driver` back; returns the springback driver, whose
-    history counts the plastic layers of every unloading increment."""
+    history counts the plastic layers of every unloading increment. With the drawing's
+    `sensitivity` (nonlinear/sensitivity.py), the springback carries it on (Sensitivity.released):
+    the driver's `sensitivity` then holds the sprung-back sheet's derivatives."""
     from dolfinx import fem
 
     cd = contact_driver
@@ -68,5 +71,8 @@ def release(contact_driver, controls: Controls | None = None, verbose=False) -> 
     held = fem.dirichletbc(np.float64(0), (BS * centre + W).astype(np.int32), V.sub(W))
     sb = SpringbackDriver(model, cd.support_bcs, [held], cd.q.x.array, controls=controls or Controls(
         initial_step=0.25, max_step=0.5, min_step=1e-3), verbose=verbose)
+    if sensitivity is not None:
+        sb.sensitivity = sensitivity.released(sb)
+        sb.records.append(sb.sensitivity)
     sb.run(0.0)
     return sb

@@ -273,13 +273,17 @@ class SheetModel:
         that grow as the mesh is refined on the faces that hold the sheet (docs/contact.md, "The
         taper of the held flange"). The taper is part of the committed state: a section that
         leaves the faces keeps it, as the solid keeps its shape."""
-        strain = self.strain
-        if q is not None:
-            strain = np.zeros_like(self.strain)
-            self.kernels.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q.x.array, self.P,
-                                     self.consts, self.beta, self.tying, np.zeros_like(self.z), strain)
+        strain = self.strain if q is None else self._strains_at(q.x.array)
         self.taper[cells] = strain[cells, :, 3:]
         self.state_version += 1
+
+    def _strains_at(self, q: np.ndarray) -> np.ndarray:
+        """The section strains (E, K) at the points of every owned cell at the carrier array q
+        (ghosts included), on arrays of their own: the strain loop alone."""
+        strain = np.zeros_like(self.strain)
+        self.kernels.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q, self.P, self.consts,
+                                 self.beta, self.tying, np.zeros_like(self.z), strain)
+        return strain
 
     def checkpoint(self) -> dict:
         """The committed material state; the next increment's lever arm is its stretch."""
@@ -334,6 +338,13 @@ class SheetModel:
         major, minor = _surface_strains(self.strain)
         return {"equivalent_plastic_strain": self.plastic_strain(), "thickness_strain": self.thickness_strain(),
                 "major_strain": major, "minor_strain": minor}
+
+    def surface_strain_rates(self, q: np.ndarray, dq: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """Per owned cell d/dp of cell_fields' major and minor strains along a derivative dq of
+        the carrier array q (both with ghosts): central differences of the strain loop at
+        q +- step dq (the principal strains are smooth but where they are equal)."""
+        ends = [_surface_strains(self._strains_at(q + sign * step * dq)) for sign in (1.0, -1.0)]
+        return tuple((ends[0][i] - ends[1][i]) / (2.0 * step) for i in range(2))
 
     def plastic_strain(self) -> np.ndarray:
         """Per owned cell: the equivalent plastic strain, the largest over the layers, averaged

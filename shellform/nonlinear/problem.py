@@ -56,6 +56,11 @@ class SheetFields:
         """Per owned cell: equivalent plastic strain, thickness, major and minor strains (SheetModel)."""
         return self.model.cell_fields()
 
+    def surface_strain_rates(self, dq: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """Per owned cell d/dp of the major and minor strains along the carrier's derivative dq
+        (SheetModel.surface_strain_rates at the driver's carrier)."""
+        return self.model.surface_strain_rates(self.driver.q.x.array, dq, step)
+
     def cell_centres(self) -> np.ndarray:
         """(owned cells, 2) the cells' initial centres."""
         return self.model.cell_centres()

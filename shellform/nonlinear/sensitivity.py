@@ -147,6 +147,23 @@ class HolderForceParameter(Parameter):
 
 
 @dataclass
+class ReleasedParameter(Parameter):
+    """A parameter of a drawn sheet whose tools withdraw (contact/springback.py): the sheet
+    depends on it as in the drawing (`of`'s respond), and the released forces, R -= lambda f,
+    move with it: dR/dp = -lambda f', f' (`dforce`, owned rows, x, y, z) the drawn state's
+    internal forces' derivative (Sensitivity.released)."""
+
+    of: Parameter = None
+    dforce: np.ndarray = None
+
+    def respond(self, value: float) -> dict:
+        return self.of.respond(value)
+
+    def external(self, driver, lam: float):
+        return -lam * self.dforce
+
+
+@dataclass
 class PressureParameter(Parameter):
     """The dead pressure at load factor 1 (its value the driver's): R = f_int - lambda p f,
     so dR/dp = -lambda f_ext / p."""
@@ -225,7 +242,7 @@ class Sensitivity(Record):
         free = np.ones(owned, dtype=bool)
         free[driver.bc_dofs[driver.bc_dofs < owned]] = False
         for par in self.parameters:
-            eps = STEP * abs(par.value) if par.value else STEP
+            eps = self.step(par.name)
             dh = self.dh[par.name]
             f = [model.respond(q, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))[0] for s in (1, -1)]
             rhs = driver.assembled(f[0] - f[1]) / (2 * eps)
@@ -238,6 +255,8 @@ class Sensitivity(Record):
                 part.pseudo_load(par.name, rhs[:owned].reshape(-1, BS), dx_n, eps, par)
             rhs[~free] = 0.0
             delta = np.zeros_like(q)  # the known rows' derivatives (solve coordinates, ghosts from their owners)
+            # the supports keep theirs: 0 where their values do not depend on p, a springback's held node its drawn one
+            delta[driver.bc_dofs] = self.dq[par.name][driver.bc_dofs]
             if driver.parts:
                 de33 = self.thickness_strain(par.name)  # d/dp of ln(t/t0) per cell, committed (h_n, dh)
                 self._known.x.array[:] = 0.0
@@ -352,7 +371,33 @@ class Sensitivity(Record):
             for k in KEYS:
                 self.dh[par.name][k][...] = state["cells"][f"sensitivity{i}_{k}"]
 
+    def released(self, driver) -> "Sensitivity":
+        """The sensitivities carried on through the springback `driver` (the drawn sheet of this
+        one's driver, the tools' forces f released as a nodal load: contact/springback.py), from
+        where the drawing left them: q' and h' of the drawn state, and f' its element forces'
+        dR/dp (residual(): the derivative of f_int at the converged drawn state, every row; on
+        the tools' rows the reactions') turned from the nodes' frames, held, into x, y, z, 0 on
+        the springback's supports as f is. (The springback's f is f_int at the drawn state from
+        its committed material state, whose lever arm is the last increment's stretch; f' leaves
+        out the derivative of that lever's change: docs/sensitivity.md measures it.)"""
+        owned = driver.n_owned * BS
+        parameters = []
+        for par in self.parameters:
+            dforce = self.driver.to_xyz(self.dR[par.name][:owned])
+            dforce[driver.bc_dofs[driver.bc_dofs < owned]] = 0.0
+            parameters.append(ReleasedParameter(par.name, par.value, of=par, dforce=dforce))
+        out = Sensitivity(driver, parameters)
+        for par in self.parameters:
+            out.dq[par.name][:] = self.dq[par.name]
+            out.dh[par.name] = {k: v.copy() for k, v in self.dh[par.name].items()}
+        return out
+
     # -- what a run reads -----------------------------------------------------------------------
+    def step(self, name: str) -> float:
+        """The central differences' step of the parameter `name`: STEP of its value (STEP where it is 0)."""
+        value = next(par.value for par in self.parameters if par.name == name)
+        return STEP * abs(value) if value else STEP
+
     def carrier(self, name: str) -> np.ndarray:
         """dq/dp (x, y, z; the local array, ghosts included) at the last converged increment."""
         return self.dq[name]

@@ -5,7 +5,8 @@ The drawn sheet `p` is read through its public measurements only, the names that
 shellform.contact.problem.DrawingProblem publishes for the results: comm, mesh, stroke,
 symmetry, num_cells, tools_kind (its LINES and RIM), material; nodal_values(),
 displacements(), cell_fields(), cell_centres(), input_order(), contact_nodes(),
-tool_placements(), blank_bounds(), blank_size(), picture_depth(), rim() (and, for
+tool_placements(), blank_bounds(), blank_size(), picture_depth(), rim(),
+surface_strain_rates() (and, for
 results/springback.py and results/drawing.py, initial_positions(), resultants(), the forces
 and checks of the force-stroke table, membrane_stability(), cell_thickness_strain() and
 volume_change()). Nothing here reaches into the sheet's model, driver or scene.
@@ -32,6 +33,7 @@ from mpi4py import MPI
 from shellform.assembly.sheet_element import BS
 from shellform.results import fields
 from shellform.results.fields import offscreen_backend
+from shellform.results.sensitivity import at_extreme
 from shellform.results.tables import write_figure, write_screenshot
 from shellform.tools.protocol import surface_mesh
 
@@ -74,6 +76,23 @@ def derivatives(p, sens, name: str) -> dict:
     return {"DX": -float(dx[i0, 0]), "DY": -float(dx[i1, 1]), "DD": -float(plan @ dx[c, :2] / np.hypot(*plan)),
             "punch_force_kN": p.punch_force(residual=sens.residual(name)) / 1e3,
             "min_thickness_strain": float(de33[int(np.argmin(e33))])}
+
+
+def margin_derivative(p, dq: np.ndarray, value: float, step: float, curve_of) -> float:
+    """d/dp of the smallest margin to the forming-limit curve (results/fld.py: FLC(minor) - major
+    per cell) at the cell where it is least, over all ranks, p at `value`: central differences
+    with `step` of the margin along the major and minor strains' derivatives
+    (p.surface_strain_rates along the carrier's derivative dq) and the curve's own, curve_of(p)
+    (the curve at a parameter's value: Keeler-Brazier's moves with n). Where two cells' margins
+    cross, the place jumps and so does the derivative, as the peak thinning's does."""
+    from shellform.results import fld
+
+    f = p.cell_fields()
+    major, minor = f["major_strain"], f["minor_strain"]
+    dmajor, dminor = p.surface_strain_rates(dq, step)
+    ends = [fld.margins(major + s * step * dmajor, minor + s * step * dminor, curve_of(value + s * step))
+            for s in (1.0, -1.0)]
+    return at_extreme(p.comm, -fld.margins(major, minor, curve_of(value)), (ends[0] - ends[1]) / (2.0 * step))
 
 
 RIM_ANGLES = (0.0, 45.0, 90.0)  # the round cup's draw-in in summary.json: rim_0deg, rim_45deg, rim_90deg

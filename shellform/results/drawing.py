@@ -20,6 +20,7 @@ the forming limit are in the checkpoint itself (the driver's records).
 import csv
 import json
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from shellform.errors import InputError
@@ -219,16 +220,23 @@ class DrawnCup(Listener):
 
 class CupSensitivities(Listener):
     """The answers' derivatives in `[output] sensitivities` (a Sensitivity, a record of the
-    driver: nonlinear/sensitivity.py), added to each report of `reports` (cup.derivatives);
+    driver: nonlinear/sensitivity.py), added to each report of `reports` (cup.derivatives; with
+    `margin`, the forming-limit view's, the smallest margin's: cup.margin_derivative);
     sensitivities.csv and tornado.png at the end (results/sensitivity.py)."""
 
-    def __init__(self, sens, reports: Reports):
-        self.sens, self.reports = sens, reports
+    def __init__(self, sens, reports: Reports, margin: bool = False):
+        self.sens, self.reports, self.margin = sens, reports, margin
 
     def on_report(self, run: Run) -> None:
         row = self.reports.rows[-1]
-        row["sensitivities"] = {par.name: cup.derivatives(run.sheet, self.sens, par.name)
-                                for par in self.sens.parameters}
+        row["sensitivities"] = {par.name: self._answers(run, par) for par in self.sens.parameters}
+
+    def _answers(self, run: Run, par) -> dict:
+        out = cup.derivatives(run.sheet, self.sens, par.name)
+        if self.margin:
+            out["min_margin"] = cup.margin_derivative(run.sheet, self.sens.carrier(par.name), par.value,
+                                                      self.sens.step(par.name), partial(fld.curve_of, run.scene, par.name))
+        return out
 
     def on_end(self, run: Run) -> None:
         s = run.scene
@@ -265,7 +273,8 @@ class CupListeners:
         necking = neck.Necking.stroke(comm, pr.stop_at_neck, scene.tools.stroke, scene.largest_r()) if plastic else None
         reports = Reports(outdir)
         return cls(DrawnCup(o.png), ForceStroke(outdir), limits, necking, series, reports,
-                   CupSensitivities(sens, reports) if sens is not None else None, tuple(extra))
+                   CupSensitivities(sens, reports, o.fld and limits is not None) if sens is not None else None,
+                   tuple(extra))
 
     def all(self) -> Listeners:
         """In the order they are told: the drawn cup's pictures first at the end, the forming

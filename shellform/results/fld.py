@@ -100,6 +100,14 @@ def curves(material):
     return kb, None
 
 
+def curve_of(scene, name: str, value: float):
+    """The margin's curve (curves()) with the scene's number `name` at `value` (a sensitivity's
+    parameter moved): Keeler-Brazier moves with material.n; a measured curve, and the tools'
+    numbers, leave it as it is."""
+    section, _, key = name.partition(".")
+    return curves(scene.with_material(key, value).material if section == "material" else scene.material)[0][0]
+
+
 def hardening_exponent(material) -> float:
     """n of the Hollomon-type law: the Swift n; 1/N for the power law eps ~ sigma^N."""
     if material.hardening == "swift":

@@ -29,8 +29,9 @@ a scatter) at the last report, {answer: {"sd", "shares": {parameter: share}}}.
 
 A drawn cup's answers (a tool scene whose parts have derivatives: docs/sensitivity.md, Tool
 scenes) are its report's: DX, DY, DD, the punch force (kN) and the peak thinning
-min_thickness_strain at its node (results/cup.py, derivatives); the CSV's first column is then
-stroke_mm.
+min_thickness_strain at its node (results/cup.py, derivatives), and with the forming-limit view
+the smallest margin to its curve, min_margin, at its cell (cup.margin_derivative); the CSV's first
+column is then stroke_mm.
 """
 
 import math
@@ -59,10 +60,10 @@ def answers(p, sens, record: dict, probes) -> dict:
             d.update({f"{probe.name}.{k}": p.value(k, probe.x, probe.y, of=f) for k in ("u", "v", "w")})
         for k, extreme in record["extremes"].items():
             d[f"extreme_{k}"] = p.value(k, *extreme["at_initial_xy"], of=f)
-        d["max_equivalent_plastic_strain"] = _at_extreme(comm, *_peak_plastic_strain(p.model, sens.state(par.name)["p"]))
+        d["max_equivalent_plastic_strain"] = at_extreme(comm, *_peak_plastic_strain(p.model, sens.state(par.name)["p"]))
         if p.model.finite:
             e33 = p.model.thickness_strain()
-            d["min_thickness_strain"] = _at_extreme(comm, -e33, sens.thickness_strain(par.name))
+            d["min_thickness_strain"] = at_extreme(comm, -e33, sens.thickness_strain(par.name))
         out[par.name] = d
     return out
 
@@ -75,7 +76,7 @@ def _peak_plastic_strain(model, dp):
     return p.max(axis=2).mean(axis=1), np.take_along_axis(dp, k, axis=2)[..., 0].mean(axis=1)
 
 
-def _at_extreme(comm, values, derivatives) -> float:
+def at_extreme(comm, values, derivatives) -> float:
     """The derivative at the cell where `values` is largest, over all ranks."""
     i = int(np.argmax(values)) if values.size else -1
     mine = (float(values[i]), float(derivatives[i])) if i >= 0 else (-math.inf, 0.0)

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from shellform.assembly.sheet_element import BS
 from shellform.results.tables import write_csv, write_figure
 from shellform.tools import square
 
@@ -51,33 +52,61 @@ def profiles(X, u, comm) -> dict:
     return {k: profile(X, u, comm, diagonal=v) for k, v in SPRINGBACK_LINES.items()}
 
 
-def write(outdir: Path, p, title: str, before: dict, released) -> dict:
+def changes(before: dict, after: dict) -> dict:
+    """What springback changed (profiles() before and after): the wall's angle along the
+    transverse line before and after, and per line the flange edge's move (its last node's) in
+    z and in the distance from the centre."""
+    depth = float(-before["transverse"][:, 2].min())
+    edge = {k: (before[k][-1], after[k][-1]) for k in SPRINGBACK_LINES}
+    return {"wall_angle_deg": {"before": wall_angle(before["transverse"], depth),
+                               "after": wall_angle(after["transverse"], depth)},
+            "flange_edge_dz_mm": {k: float(a[2] - b[2]) for k, (b, a) in edge.items()},
+            "flange_edge_dr_mm": {k: float(a[1] - b[1]) for k, (b, a) in edge.items()}}
+
+
+def derivatives(X, drawn_u, sprung_u, drawn, sprung, comm) -> dict:
+    """{parameter: d/dp of changes()' numbers}, with the drawing's and the springback's
+    Sensitivity (`drawn`, `sprung`: nonlinear/sensitivity.py) at the displacements drawn_u and
+    sprung_u of the owned nodes (initial positions X): central differences of changes() with the
+    sensitivities' step along the displacements' derivatives before and after. The wall's angle
+    is a line fitted to the points within a band of depth, and the flange edge a node: where a
+    point enters or leaves the band, the angle's derivative is the mean of the two sides'."""
+    n = len(drawn_u)
+    out = {}
+    for par in drawn.parameters:
+        step = drawn.step(par.name)
+        du = [s.carrier(par.name).reshape(-1, BS)[:n, :3] for s in (drawn, sprung)]
+        ends = [changes(profiles(X, drawn_u + sign * step * du[0], comm), profiles(X, sprung_u + sign * step * du[1], comm))
+                for sign in (1.0, -1.0)]
+        out[par.name] = {key: {k: (ends[0][key][k] - ends[1][key][k]) / (2.0 * step) for k in ends[0][key]}
+                         for key in ends[0]}
+    return out
+
+
+def write(outdir: Path, p, title: str, before: dict, released, sensitivities: dict | None = None) -> dict:
     """What springback changed (shellform.contact.springback released the tools' forces into
-    `released`): wall angle and flange edge along the transverse line, the diagonal's corner,
-    the unloading's plastic layers, the residual resultants; springback.csv (both profiles) and
+    `released`): wall angle and flange edge along the transverse line, the diagonal's corner (changes()),
+    the unloading's plastic layers, the residual resultants, and their `sensitivities` where
+    given (derivatives()); springback.csv (both profiles) and
     springback.png (the change along each line: sprung back minus drawn, in z and in the distance
     from the centre, against the node's initial distance from the centre, which runs along the
     wall where the drawn distance folds back on itself)."""
     lines = SPRINGBACK_LINES
     after = profiles(p.initial_positions(), released.displacements(), p.comm)
-    depth = float(-before["transverse"][:, 2].min())
     rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
              "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]
     write_csv(outdir / "springback.csv", rows, list(rows[0]))
     resultants = p.resultants()
     N, M = resultants[..., :3], resultants[..., 3:]
     comm = p.comm
-    edge = {k: (before[k][-1], after[k][-1]) for k in lines}
     out = {
         "stopped": None,
-        "wall_angle_deg": {"before": wall_angle(before["transverse"], depth),
-                           "after": wall_angle(after["transverse"], depth)},
-        "flange_edge_dz_mm": {k: float(a[2] - b[2]) for k, (b, a) in edge.items()},
-        "flange_edge_dr_mm": {k: float(a[1] - b[1]) for k, (b, a) in edge.items()},
+        **changes(before, after),
         "unloading_increments": len(released.history),
         "plastic_layers_on_unloading": int(sum(h.plastic_layers for h in released.history)),
         "residual_max_N_per_mm": comm.allreduce(float(np.abs(N[..., :2]).max(initial=0.0)), op=MPI.MAX),
         "residual_max_M_N": comm.allreduce(float(np.abs(M[..., :2]).max(initial=0.0)), op=MPI.MAX),
+        **({"sensitivities": sensitivities} if sensitivities is not None else {}),
     }
     if comm.rank == 0:
         import matplotlib

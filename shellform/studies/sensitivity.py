@@ -14,7 +14,11 @@ Cases (each sensitivity from the one run that also gives the answer):
   largest w (the tip's) and the peak equivalent plastic strain in K, E, the pressure and the
   thickness, against central differences of two runs;
 - plate: the simply supported elastic plate in large deflection, whose w(E, P) = W(P / E):
-  E dw/dE + P dw/dP = 0 (error: that sum over |w|), and the linear plate's dw/dE = -w / E.
+  E dw/dE + P dw/dP = 0 (error: that sum over |w|), and the linear plate's dw/dE = -w / E;
+- round cup (demos/round_cup.toml, n 6, 3 mm): frictionless, with friction, with friction and
+  its holder, the punch force and the rim's draw-in (cup); as a scene with the forming-limit
+  view and springback, the smallest margin and the flange edge's springback (cup_scene); against
+  central differences of two runs at p (1 +- 1e-5).
 
 Writes sensitivity.csv (case, answer, parameter, the one run's derivative, the reference, the
 reference's kind, the relative error against max(|reference|, the answer's scale / |p|)) and
@@ -263,6 +267,42 @@ def cup(friction: bool = False, holder: bool = False) -> tuple[list[dict], dict]
     return rows, {"case": case, "with_s": with_s, "without_s": without, "parameters": len(names)}
 
 
+SCENE_PARAMETERS = ("material.K", "material.n", "material.r")
+SCENE_HOLDER_PARAMETERS = ("material.r", "tools.friction")
+SPRINGBACK_ANSWERS = ("flange_edge_dz_mm", "flange_edge_dr_mm")
+
+
+def cup_scene(folder: Path, holder: bool = False) -> tuple[list[dict], dict]:
+    """The round cup of drawn_cup as a scene with its forming-limit view and springback,
+    frictionless or with its friction and holder: the smallest margin to the forming-limit curve
+    at the end of the stroke and the flange edge's springback on the transverse line (its move
+    in z and in the distance from the centre), in each parameter against central differences of
+    two whole runs at p (1 +- CUP_STEP)."""
+    from shellform.contact.run import run as run_scene
+
+    names = SCENE_HOLDER_PARAMETERS if holder else SCENE_PARAMETERS
+    case = "round cup scene, holder 10 kN, friction 0.07" if holder else "round cup scene, frictionless"
+    scene_, _ = drawn_cup(scene_only=True, friction=holder, holder=holder)
+    base = scene_.changed({"process.springback": True, "output.png": False, "output.vtx": False, "output.fld": True})
+    plain = run_scene(base, folder / "plain")
+    one = run_scene(base.changed({"output.sensitivities": list(names)}), folder / "one_run")
+    derivatives, sprung = one["reports"][-1]["sensitivities"], one["springback"]["sensitivities"]
+    rows = []
+    for name in names:
+        section, _, key = name.partition(".")
+        value = float(getattr(getattr(base, section), key))
+        h = CUP_STEP * value
+        ends = [run_scene(base.changed({name: value + sign * h}), folder / f"{key}_{sign:+d}") for sign in (1, -1)]
+        rows.append(_row(case, "smallest FLD margin", name, derivatives[name]["min_margin"],
+                         (ends[0]["min_margin"] - ends[1]["min_margin"]) / (2 * h), "central differences"))
+        for answer in SPRINGBACK_ANSWERS:
+            fd = (ends[0]["springback"][answer]["transverse"] - ends[1]["springback"][answer]["transverse"]) / (2 * h)
+            rows.append(_row(case, f"springback {answer} (transverse)", name, sprung[name][answer]["transverse"], fd,
+                             "central differences"))
+    return rows, {"case": case, "with_s": one["wall_time_s"]["total"], "without_s": plain["wall_time_s"]["total"],
+                  "parameters": len(names)}
+
+
 def plates() -> tuple[list[dict], dict]:
     E, P = 70e3, 5.0
     effects = ("bending", "membrane", "geometric_nonlinearity")
@@ -305,7 +345,8 @@ def run(outdir) -> list[dict]:
     out.mkdir(parents=True, exist_ok=True)
     rows, times = [], []
     for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
-                 lambda: cup(friction=True), lambda: cup(friction=True, holder=True)):
+                 lambda: cup(friction=True), lambda: cup(friction=True, holder=True),
+                 lambda: cup_scene(out / "runs" / "cup"), lambda: cup_scene(out / "runs" / "cup_holder", holder=True)):
         r, t = case()
         rows += r
         times.append(t)
