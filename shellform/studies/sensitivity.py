@@ -283,7 +283,8 @@ def cup_scene(folder: Path, holder: bool = False) -> tuple[list[dict], dict]:
     names = SCENE_HOLDER_PARAMETERS if holder else SCENE_PARAMETERS
     case = "round cup scene, holder 10 kN, friction 0.07" if holder else "round cup scene, frictionless"
     scene_, _ = drawn_cup(scene_only=True, friction=holder, holder=holder)
-    base = scene_.changed({"process.springback": True, "output.png": False, "output.vtx": False, "output.fld": True})
+    base = scene_.changed({"process.springback": True, "output.png": False, "output.vtx": False, "output.vtu": False,
+                           "output.fld": True})
     plain = run_scene(base, folder / "plain")
     one = run_scene(base.changed({"output.sensitivities": list(names)}), folder / "one_run")
     derivatives, sprung = one["reports"][-1]["sensitivities"], one["springback"]["sensitivities"]
