@@ -132,15 +132,17 @@ def test_the_cup_with_friction_against_finite_differences_of_two_runs():
     assert max(s.free_residual) < 1e-3
 
 
-def _holder_cup_against_differences(key, rel):
+def _holder_cup_against_differences(key, rel, changes=None):
     """d/dp of the punch force and the rim's draw-in of the round cup with its holder (10 kN)
-    and friction (n 6, 3 mm) against central differences of two runs at p (1 +- 1e-5)."""
-    p, s = drawn_cup(sensitivities=(key,), friction=True, holder=True)
+    and friction (n 6, 3 mm; with `changes` to its scene) against central differences of two
+    runs at p (1 +- 1e-5)."""
+    p, s = drawn_cup(changes, sensitivities=(key,), friction=True, holder=True)
     assert p.driver.holder.closed and p.driver.holder.pinched.sum() > 10
     i = rim_node(p)
     value = float(s.parameters[0].value)
     h = 1e-5 * value
-    plus, minus = (drawn_cup({key: value + sign * h}, friction=True, holder=True)[0] for sign in (1, -1))
+    plus, minus = (drawn_cup({**(changes or {}), key: value + sign * h}, friction=True, holder=True)[0]
+                   for sign in (1, -1))
     force = (plus.punch_force() - minus.punch_force()) / (2 * h)
     draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
     assert p.punch_force(residual=s.residual(key)) == pytest.approx(force, rel=rel)
@@ -174,6 +176,35 @@ def test_the_cup_with_a_holder_in_k_and_mu(key):
     """d/dK and d/dmu with the holder: its edge load moves with K (its strip solved again), the
     coefficient with mu; to 1e-3 (measured 4e-7 / 7e-4 in K, 7e-5 / 1.3e-4 in mu)."""
     _holder_cup_against_differences(key, 1e-3)
+
+
+def _bead():
+    """A drawbead on the round cup's flange: a quarter circle of radius 47 mm (7 points), 30 N/mm
+    restraint, 5 N/mm uplift."""
+    from shellform import demos, scene
+
+    effects = [e for e in scene.load(demos.path("round_cup.toml")).effects if e != "ironing"] + ["drawbeads"]
+    angles = np.linspace(0.0, np.pi / 2, 7)
+    return {"effects": effects, "tools.drawbead": [{"points": [[47 * np.cos(a), 47 * np.sin(a)] for a in angles],
+                                                    "restraint": 30.0, "uplift": 5.0}]}
+
+
+def test_the_cup_with_a_drawbead_in_mu():
+    """With a drawbead across the flange (its 23 nodes slipping), d/dmu of the punch force and
+    the rim's draw-in against two runs to 1e-4 (measured 2e-6 and 6e-6): the bead's forces move
+    with the positions (its shares), its history and the committed positions, and its uplift
+    enters the holder's split and friction's normal forces."""
+    s = _holder_cup_against_differences("tools.friction", 1e-4, _bead())
+    assert s.corrected and max(s.free_residual) < 1e-3
+
+
+@pytest.mark.slow  # three runs each, about 12 s
+@pytest.mark.parametrize("key, rel", [("material.K", 1e-5), ("tools.blank_holder_force", 1e-4), ("material.E", 2e-3)])
+def test_the_cup_with_a_drawbead_in_k_f_and_e(key, rel):
+    """The drawbead's cup in K, the holder's force and E (whose stiffness k_i = E t l_i / h the
+    bead's stick law takes): measured 3e-8 / 6e-7, 3e-6 / 5e-6 and 1e-5 / 4e-4 (E's draw-in: the
+    holder's edge strip moves with E as well)."""
+    _holder_cup_against_differences(key, rel, _bead())
 
 
 @pytest.mark.parametrize("effect, changes, why", [

@@ -24,6 +24,15 @@ its force of the last increment f_n and a stiffness k_i = E t l_i / h before the
 acting along d_i; the uplift F_u l_i acts along +z on the sheet, which the holder takes. Sliding
 across the line the restraint is F_r times the line's length to round-off. (The shares' change
 with the positions is left out of the tangent: a node's share moves as it crosses the line.)
+
+Sensitivities (nonlinear/sensitivity.py): the beads' forces depend on a parameter p at fixed q
+through their history (the committed restraint), the committed positions (the slip is measured
+from them) and, for the material's E, the stiffness k_i; after the solve also through the
+positions, along which the shares move. Both are central differences of the same return mapping
+with the stick and slip states held as converged (forces_at); the shares' move, which the
+tangent leaves out, is corrected for (tangent_misses). The beads' derivative enters dR itself,
+as their forces enter R before the contact set reads the reactions, so that the holder's split
+and friction see the uplift's.
 """
 
 from dataclasses import dataclass
@@ -32,6 +41,7 @@ import numpy as np
 from dolfinx import fem, la
 
 from shellform.assembly.sheet_element import BS
+from shellform.material.layout import E_
 from shellform.nonlinear.frames import add_tangent_slot_stiffness, subtract_nodal_forces
 from shellform.nonlinear.parts import Part
 
@@ -94,9 +104,18 @@ class Drawbeads(Part):
         self.history = np.zeros(n)
         self.force = np.zeros((n, 3))  # of the current iterate, on the sheet (x, y, z)
         self.rate = np.zeros((n, 2, 2))  # -df/dx in the nodes' tangent slots
+        self.slipping = np.zeros(n, dtype=bool)  # of the current iterate
+        self.E = E
+        self.dhistory, self.drestraint = {}, {}  # per parameter: d/dp of the history, of this increment's restraint
+        self._work = fem.Function(V)  # the owned nodes' position derivatives shared with the ghosts
 
     def shares(self, x_local: np.ndarray) -> None:
         """l_i, d_i, F_r l_i and F_u l_i at the current positions of the local nodes."""
+        self.length, self.across, self.limit, self.uplift = self.shares_at(x_local)
+
+    def shares_at(self, x_local: np.ndarray) -> tuple:
+        """(l_i, d_i, F_r l_i, F_u l_i) of the owned nodes at the positions x_local of the local
+        nodes (nothing of the part's state changes)."""
         arr = self._shares.x.array.reshape(-1, BS)
         arr[:] = 0.0
         tri = x_local[self.dofs][:, :, :2]  # (cells, 3, 2)
@@ -123,18 +142,21 @@ class Drawbeads(Part):
                     np.add.at(arr[:, col], nodes.ravel(), values.ravel())
         self._shares.x.scatter_reverse(la.InsertMode.add)
         own = arr[: self.n]
-        self.length = own[:, 0].copy()
         size = np.hypot(own[:, 1], own[:, 2])
-        self.across = np.where(size[:, None] > 0, own[:, 1:3] / np.maximum(size, 1e-300)[:, None], 0.0)
-        self.limit, self.uplift = own[:, 3].copy(), own[:, 4].copy()
+        across = np.where(size[:, None] > 0, own[:, 1:3] / np.maximum(size, 1e-300)[:, None], 0.0)
+        return own[:, 0].copy(), across, own[:, 3].copy(), own[:, 4].copy()
 
     # -- the increment's history ----------------------------------------------------------------
     def start(self, lam: float = 0.0, predicting: bool = False) -> None:
         self.history = self.committed.copy()
 
     def commit(self, lam: float = 0.0) -> None:
+        """The increment converged: its restraint is the next one's history (and its derivatives,
+        where carry gave them, the next one's history derivatives)."""
         self.committed = np.einsum("ni,ni->n", self.force[:, :2], self.across)
         self.history = self.committed.copy()
+        self.dhistory.update(self.drestraint)
+        self.drestraint = {}
 
     def checkpoint(self) -> dict:
         return {"nodes": {"drawbead_restraint": self.committed}}
@@ -155,6 +177,69 @@ class Drawbeads(Part):
     def add_tangent(self, K, R: np.ndarray, fixed: np.ndarray) -> None:
         add_tangent_slot_stiffness(K, self.rate)
 
+    # -- the part's protocol: sensitivities ------------------------------------------------------
+    def derivatives(self) -> str | None:
+        """Differentiated with the stick and slip states held (pseudo_load, carry)."""
+        return None
+
+    def tangent_misses(self) -> bool:
+        """The tangent leaves out the shares' move with the positions: corrected where a bead
+        crosses the sheet."""
+        return bool(np.any(self.length > 0))
+
+    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, parameter=None) -> None:
+        """rhs -= the beads' forces' derivative at fixed q, turned into the frames: through the
+        history's derivative, the committed positions' and the stiffness's (E)."""
+        x = self.nodes.local_positions()
+        df, _ = self._differences(key, eps, x, np.zeros_like(x), dx_n, parameter)
+        rhs[:, :3] -= np.einsum("nij,nj->ni", self.frames, df)
+
+    def carry(self, key: str, dx: np.ndarray, dx_n: np.ndarray, dR: np.ndarray, lam: float, eps: float,
+              parameter=None) -> None:
+        """The beads' forces' total derivative along the positions' dx as well, subtracted from dR
+        as the forces are from R (before the contact set and friction read it); the restraint's,
+        the next increment's history derivative, kept for commit."""
+        work = self._work.x.array.reshape(-1, BS)
+        work[:] = 0.0
+        work[: self.n, :3] = dx
+        self._work.x.scatter_forward()
+        df, self.drestraint[key] = self._differences(key, eps, self.nodes.local_positions(), work[:, :3].copy(),
+                                                     dx_n, parameter)
+        dR[:, :3] -= np.einsum("nij,nj->ni", self.frames, df)
+
+    def derivative_state(self, key: str) -> dict:
+        return {"drawbead_dhistory": self.dhistory.get(key, np.zeros_like(self.history))}
+
+    def restore_derivative_state(self, key: str, state: dict) -> None:
+        self.dhistory[key] = state["drawbead_dhistory"].copy()
+
+    def _differences(self, key, eps, x, dx, dx_n, parameter) -> tuple[np.ndarray, np.ndarray]:
+        """Central differences of forces_at along (dx: the local nodes' positions', dx_n, the
+        history's derivative, the stiffness's): (d force, d restraint along d_i) per owned node."""
+        dh = self.dhistory.get(key, np.zeros_like(self.history))
+        k = [self.k_per_length * self._modulus(parameter, s * eps) / self.E for s in (1.0, -1.0)]
+        ends = [self.forces_at(x + s * eps * dx, self.nodes.x_n + s * eps * dx_n, self.history + s * eps * dh, kk)
+                for s, kk in zip((1.0, -1.0), k)]
+        return (ends[0][0] - ends[1][0]) / (2 * eps), (ends[0][1] - ends[1][1]) / (2 * eps)
+
+    def _modulus(self, parameter, step: float) -> float:
+        """E at the parameter moved by step (the scene's E where the parameter is not the material's)."""
+        material = parameter.respond(parameter.value + step).get("material") if parameter is not None else None
+        return float(material[E_]) if material is not None else self.E
+
+    def forces_at(self, x_local: np.ndarray, x_n: np.ndarray, history: np.ndarray, k_per_length: float):
+        """(force on the sheet (n, 3), restraint along d_i) of the owned nodes at the local nodes'
+        positions x_local from x_n and the history, with the current iterate's stick and slip
+        states held (the sensitivities' differences)."""
+        length, d, limit, uplift = self.shares_at(x_local)
+        ds = np.einsum("ni,ni->n", x_local[: self.n, :2] - x_n[:, :2], d)
+        trial = history - k_per_length * length * ds
+        f = np.where(self.slipping, limit * np.sign(trial), trial)
+        force = np.zeros((self.n, 3))
+        force[:, :2] = f[:, None] * d
+        force[:, 2] = uplift
+        return force, f
+
     # -- one iterate ---------------------------------------------------------------------------
     def slide(self, x_local: np.ndarray, x_n: np.ndarray, frames: np.ndarray) -> None:
         """The restraint and uplift at the current positions (x_local: every local node; x_n:
@@ -166,6 +251,7 @@ class Drawbeads(Part):
         k = self.k_per_length * self.length
         trial = self.history - k * ds
         slip = np.abs(trial) > self.limit
+        self.slipping = slip
         f = np.where(slip, self.limit * np.sign(trial), trial)
         self.force[:] = 0.0
         self.force[:, :2] = f[:, None] * d

@@ -44,8 +44,10 @@ differences of its own return mapping with the stick and slip states held (Part.
 sheet's is carried. On a node the closed holder pinches, friction presses with the holder's
 split of its force F (contact/holder_split.py), differentiated the same way in F, the net
 normal forces, the positions and the edge load (PinchingHolder.face_derivatives); the held
-slopes are known rows (Part.known_derivatives). A part whose forces on the free rows depend on
-p otherwise (the open holder's lift, the ironing's penalty, the drawbeads) says so
+slopes are known rows (Part.known_derivatives). The drawbeads' rigid-plastic restraint is
+differentiated as friction's is, its derivative entering dR itself (contact/drawbead.py). A part
+whose forces on the free rows depend on p otherwise (the open holder's lift, the ironing's
+penalty) says so
 (Part.derivatives, or when it opens) and the sensitivities are refused, as is a tool scene
 without finite strains or one whose parameter moves the tools (the thickness: the tools are
 placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
@@ -215,7 +217,7 @@ class Sensitivity(Record):
                 why = "material.thickness places the tools around the sheet: not differentiated with tools yet"
             if why is not None:
                 raise InputError("output.sensitivities", f"{why}; a tool scene's sensitivities need rigid tools, "
-                                 "with or without friction and a force-controlled holder, and no ironing or drawbeads")
+                                 "with or without friction, drawbeads and a force-controlled holder, and no ironing")
         self._known = fem.Function(self.model.V)  # the known rows' derivatives, shared with the ghosts
         zeros = lambda a: np.zeros_like(a)  # noqa: E731
         start = self.model.history()

@@ -242,13 +242,12 @@ def _validate_sensitivities(s) -> None:
 
 
 def _validate_tool_sensitivities(s) -> None:
-    """A tool scene's sensitivities: its rigid tools, its closed holder and friction have
-    derivatives (not ironing or drawbeads), with finite strains (the nodes' thickness), and no
-    parameter that moves the tools."""
-    for effect in ("ironing", "drawbeads"):
-        require(effect not in s.effects, "effects", f"the effect {effect!r} has no derivatives yet: a tool scene's "
-                "output.sensitivities are its rigid tools', its holder's and friction's alone (docs/sensitivity.md, "
-                "Tool scenes)")
+    """A tool scene's sensitivities: its rigid tools, its closed holder, friction and drawbeads
+    have derivatives (not ironing), with finite strains (the nodes' thickness), and no parameter
+    that moves the tools."""
+    require("ironing" not in s.effects, "effects", "the effect 'ironing' has no derivatives yet: a tool scene's "
+            "output.sensitivities are its rigid tools', its holder's, friction's and drawbeads' alone "
+            "(docs/sensitivity.md, Tool scenes)")
     require("finite_strain" in s.effects, "effects",
             "a tool scene's output.sensitivities need the effect 'finite_strain' (the nodes' thickness)")
     for name in s.output.sensitivities:
