@@ -178,7 +178,7 @@ def test_the_cup_with_a_holder_in_k_and_mu(key):
     _holder_cup_against_differences(key, 1e-3)
 
 
-def _bead():
+def _bead(restraint=30.0, uplift=5.0):
     """A drawbead on the round cup's flange: a quarter circle of radius 47 mm (7 points), 30 N/mm
     restraint, 5 N/mm uplift."""
     from shellform import demos, scene
@@ -186,7 +186,24 @@ def _bead():
     effects = [e for e in scene.load(demos.path("round_cup.toml")).effects if e != "ironing"] + ["drawbeads"]
     angles = np.linspace(0.0, np.pi / 2, 7)
     return {"effects": effects, "tools.drawbead": [{"points": [[47 * np.cos(a), 47 * np.sin(a)] for a in angles],
-                                                    "restraint": 30.0, "uplift": 5.0}]}
+                                                    "restraint": restraint, "uplift": uplift}]}
+
+
+@pytest.mark.parametrize("key", ["restraint", pytest.param("uplift", marks=pytest.mark.slow)])
+def test_the_cup_in_a_drawbeads_own_forces(key):
+    """tools.drawbead[0].restraint and .uplift as parameters: d/dp of the punch force and the
+    rim's draw-in against two runs with that bead's force at p (1 +- 1e-5), to 1e-4 (measured
+    3e-6 and 5e-6 in both)."""
+    p, s = drawn_cup(_bead(), sensitivities=(f"tools.drawbead[0].{key}",), friction=True, holder=True)
+    i = rim_node(p)
+    value = float(s.parameters[0].value)
+    h = 1e-5 * value
+    plus, minus = (drawn_cup(_bead(**{key: value + sign * h}), friction=True, holder=True)[0] for sign in (1, -1))
+    name = s.parameters[0].name
+    force = (plus.punch_force() - minus.punch_force()) / (2 * h)
+    draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
+    assert p.punch_force(residual=s.residual(name)) == pytest.approx(force, rel=1e-4)
+    assert -s.carrier(name).reshape(-1, BS)[i, 0] == pytest.approx(draw, rel=1e-4)
 
 
 def test_the_cup_with_a_drawbead_in_mu():
@@ -279,12 +296,16 @@ def test_a_tool_scene_reports_its_answers_sensitivities(tmp_path):
     ({"effects": "friction", "tools.friction": 0.1, "tools.punch_friction": 0.02,
       "output.sensitivities": ["tools.die_friction"]}, "output.sensitivities (tools.die_friction)"),  # unset
     ({"output.sensitivities": ["material.thickness"]}, "output.sensitivities (material.thickness)"),
+    ({"output.sensitivities": ["tools.drawbead[0].restraint"]}, "output.sensitivities (tools.drawbead[0].restraint)"),
+    ({"output.sensitivities": ["tools.drawbead[1].uplift"], "effects": "drawbeads",
+      "tools.drawbead": [{"points": [[47.0, 0.0], [0.0, 47.0]], "restraint": 30.0}]},
+     "output.sensitivities (tools.drawbead[1].uplift)"),
     ({"effects": "no finite_strain"}, "effects"),
 ])
 def test_a_tool_scenes_bad_sensitivities_are_named(changes, field):
     scene_, _ = drawn_cup(scene_only=True)
     effects = list(scene_.effects)
-    if changes.get("effects") in ("friction", "ironing"):
+    if changes.get("effects") in ("friction", "ironing", "drawbeads"):
         effects.append(changes["effects"])
     elif changes.get("effects") == "no finite_strain":
         effects.remove("finite_strain")

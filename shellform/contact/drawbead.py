@@ -27,7 +27,8 @@ with the positions is left out of the tangent: a node's share moves as it crosse
 
 Sensitivities (nonlinear/sensitivity.py): the beads' forces depend on a parameter p at fixed q
 through their history (the committed restraint), the committed positions (the slip is measured
-from them) and, for the material's E, the stiffness k_i; after the solve also through the
+from them), for the material's E the stiffness k_i, and for a bead's own restraint or uplift
+(tools.drawbead[i].restraint, .uplift) that force; after the solve also through the
 positions, along which the shares move. Both are central differences of the same return mapping
 with the stick and slip states held as converged (forces_at); the shares' move, which the
 tangent leaves out, is corrected for (tangent_misses). The beads' derivative enters dR itself,
@@ -113,14 +114,14 @@ class Drawbeads(Part):
         """l_i, d_i, F_r l_i and F_u l_i at the current positions of the local nodes."""
         self.length, self.across, self.limit, self.uplift = self.shares_at(x_local)
 
-    def shares_at(self, x_local: np.ndarray) -> tuple:
+    def shares_at(self, x_local: np.ndarray, lines=None) -> tuple:
         """(l_i, d_i, F_r l_i, F_u l_i) of the owned nodes at the positions x_local of the local
-        nodes (nothing of the part's state changes)."""
+        nodes, of `lines` (default the part's; nothing of the part's state changes)."""
         arr = self._shares.x.array.reshape(-1, BS)
         arr[:] = 0.0
         tri = x_local[self.dofs][:, :, :2]  # (cells, 3, 2)
         lo, hi = tri.min(axis=1), tri.max(axis=1)  # the cells' boxes: a segment is clipped to those it meets
-        for line in self.lines:
+        for line in self.lines if lines is None else lines:
             pts = np.asarray(line.points, dtype=float)
             for P0, P1 in zip(pts[:-1], pts[1:]):
                 d = P1 - P0
@@ -218,8 +219,10 @@ class Drawbeads(Part):
         history's derivative, the stiffness's): (d force, d restraint along d_i) per owned node."""
         dh = self.dhistory.get(key, np.zeros_like(self.history))
         k = [self.k_per_length * self._modulus(parameter, s * eps) / self.E for s in (1.0, -1.0)]
-        ends = [self.forces_at(x + s * eps * dx, self.nodes.x_n + s * eps * dx_n, self.history + s * eps * dh, kk)
-                for s, kk in zip((1.0, -1.0), k)]
+        lines = [parameter.beads(self.lines, parameter.value + s * eps) if parameter is not None else None
+                 for s in (1.0, -1.0)]
+        ends = [self.forces_at(x + s * eps * dx, self.nodes.x_n + s * eps * dx_n, self.history + s * eps * dh, kk, ll)
+                for s, kk, ll in zip((1.0, -1.0), k, lines)]
         return (ends[0][0] - ends[1][0]) / (2 * eps), (ends[0][1] - ends[1][1]) / (2 * eps)
 
     def _modulus(self, parameter, step: float) -> float:
@@ -227,11 +230,11 @@ class Drawbeads(Part):
         material = parameter.respond(parameter.value + step).get("material") if parameter is not None else None
         return float(material[E_]) if material is not None else self.E
 
-    def forces_at(self, x_local: np.ndarray, x_n: np.ndarray, history: np.ndarray, k_per_length: float):
+    def forces_at(self, x_local: np.ndarray, x_n: np.ndarray, history: np.ndarray, k_per_length: float, lines=None):
         """(force on the sheet (n, 3), restraint along d_i) of the owned nodes at the local nodes'
-        positions x_local from x_n and the history, with the current iterate's stick and slip
-        states held (the sensitivities' differences)."""
-        length, d, limit, uplift = self.shares_at(x_local)
+        positions x_local from x_n and the history, of `lines` (default the part's), with the
+        current iterate's stick and slip states held (the sensitivities' differences)."""
+        length, d, limit, uplift = self.shares_at(x_local, lines)
         ds = np.einsum("ni,ni->n", x_local[: self.n, :2] - x_n[:, :2], d)
         trial = history - k_per_length * length * ds
         f = np.where(self.slipping, limit * np.sign(trial), trial)

@@ -73,7 +73,7 @@ converged increment before it is committed, and `checkpoint`/`restore` carry q' 
 a resume.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 from typing import NamedTuple
 
@@ -84,7 +84,7 @@ from mpi4py import MPI
 from shellform.assembly.sheet_element import BS
 from shellform.errors import InputError
 from shellform.results.listeners import Record
-from shellform.scene.schema import FRICTION_KEYS, FRICTION_TOOLS
+from shellform.scene.schema import DRAWBEAD_PARAMETER, FRICTION_KEYS, FRICTION_TOOLS
 
 STEP = 1e-5  # the central differences' step, relative to the parameter
 CORRECT_ABOVE = 1e-4  # a solve is corrected while its free rows' total passes this share of the loads' scale
@@ -97,8 +97,9 @@ KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
 class Parameter:
     """A number the sheet's equations depend on, by name (its scene key) and value. A kind
     says how a value enters: `respond(value)` -> the keywords of SheetModel.respond at that
-    value (material, thickness), and `external(driver, lam)` -> dR/dp from the loads (owned
-    rows, solve coordinates; None where the loads do not depend on it)."""
+    value (material, thickness), `external(driver, lam)` -> dR/dp from the loads (owned
+    rows, solve coordinates; None where the loads do not depend on it), and `beads(lines,
+    value)` -> the drawbeads' lines at that value."""
 
     name: str
     value: float
@@ -110,6 +111,10 @@ class Parameter:
 
     def external(self, driver, lam: float):
         return None
+
+    def beads(self, lines, value: float) -> tuple:
+        """The drawbeads' lines (contact/drawbead.py DrawbeadLine) at that value: as they are."""
+        return tuple(lines)
 
 
 @dataclass
@@ -146,6 +151,19 @@ class HolderForceParameter(Parameter):
     friction presses with that split (contact/holder.py)."""
 
     holder_force = True
+
+
+@dataclass
+class DrawbeadParameter(Parameter):
+    """A drawbead's restraint or uplift per unit length (tools.drawbead[i].restraint, .uplift):
+    the sheet does not depend on it; the drawbeads' part does (contact/drawbead.py), through
+    `beads(lines, value)`, the beads with this one's force at value."""
+
+    index: int = 0
+    key: str = "restraint"
+
+    def beads(self, lines, value: float) -> tuple:
+        return tuple(replace(line, **{self.key: value}) if i == self.index else line for i, line in enumerate(lines))
 
 
 @dataclass
@@ -189,6 +207,10 @@ def scene_parameters(scene) -> list[Parameter]:
             own = {tool: getattr(t, f"{tool}_friction") for tool in FRICTION_TOOLS}
             carried = [own[tool] is None if key == "friction" else key == f"{tool}_friction" for tool in own]
             out.append(FrictionParameter(name, float(getattr(t, key)), rates=tuple(float(c) for c in carried)))
+        elif DRAWBEAD_PARAMETER.fullmatch(name):
+            index, key = DRAWBEAD_PARAMETER.fullmatch(name).groups()
+            out.append(DrawbeadParameter(name, float(getattr(scene.tools.drawbead[int(index)], key)), index=int(index),
+                                         key=key))
         elif name == "tools.blank_holder_force":
             out.append(HolderForceParameter(name, float(scene.tools.blank_holder_force)))
         elif name == "material.thickness":

@@ -19,7 +19,7 @@ from shellform.scene import machine
 from shellform.scene.rules import keys_of_effects, require, sheet_effects
 from shellform.scene.tool_checks import validate_tools
 from shellform.scene.schema import (ANISOTROPY_LISTS, ANISOTROPY_PARAMETERS, CIRCLE_REGIONS, CURVE_PARAMETERS,
-                                    DIAGONALS, FRICTION_KEYS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS,
+                                    DIAGONALS, DRAWBEAD_PARAMETER, FRICTION_KEYS, FRICTION_TOOLS, HARDENING, LOAD_STEP_KEYS,
                                     MAY_BE_INFINITE, STROKE_STEP_KEYS, YIELD_FUNCTIONS, YIELD_PARAMETERS, MESH_KINDS,
                                     MIRROR_SUPPORTS, NONLINEAR_SUPPORTS, PRESSURE_PER, REGIONS, SIDES, SUPPORTS, bounds)
 
@@ -220,6 +220,14 @@ def _validate_sensitivities(s) -> None:
             require(s.tools.holder != "gap" and s.tools.blank_holder_force > 0, field_,
                     "needs a holder pressing with a force > 0 (not one held at a gap)")
             continue
+        bead = DRAWBEAD_PARAMETER.fullmatch(name)
+        if bead is not None and s.tools is not None:
+            index = int(bead.group(1))
+            require("drawbeads" in s.effects and index < len(s.tools.drawbead), field_,
+                    f"needs the effect 'drawbeads' and a [[tools.drawbead]] number {index} (counted from 0; the "
+                    f"scene has {len(s.tools.drawbead)})")
+            require(getattr(s.tools.drawbead[index], bead.group(2)) > 0, field_, "needs that force > 0")
+            continue
         if section == "tools" and s.tools is not None and key in FRICTION_KEYS:
             value = getattr(s.tools, key)
             require("friction" in s.effects and value is not None and value > 0, field_,
@@ -230,7 +238,8 @@ def _validate_sensitivities(s) -> None:
             continue
         require(section == "material" and key in numbers, field_,
                 "must be material.<a number of [material]>, material.thickness or loads.pressure (a tool scene: "
-                "tools.friction, a tool's own coefficient or tools.blank_holder_force too)")
+                "tools.friction, a tool's own coefficient, tools.blank_holder_force or tools.drawbead[i].restraint "
+                "and .uplift too)")
         value = getattr(s.material, key)
         require(not np.array_equal(s.with_material(key, value * (1 + 1e-3) if value else 1e-3).hill79().pack(),
                                    base), field_,

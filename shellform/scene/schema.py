@@ -13,6 +13,7 @@ shellform.scene.checks, shellform.scene.machine); a changed scene is a new one, 
 """
 
 import math
+import re
 from dataclasses import dataclass, field, fields, make_dataclass
 
 from shellform.material import criteria
@@ -207,6 +208,7 @@ def _complete_tools(self):
         tool_kinds.kind(self.shape).complete(self)
 
 
+DRAWBEAD_PARAMETER = re.compile(r"tools\.drawbead\[(\d+)\]\.(restraint|uplift)")  # a bead's force as a sensitivity's parameter
 FRICTION_TOOLS = ("punch", "die", "holder")  # each has its own key NAME_friction (unset: `friction`)
 FRICTION_KEYS = ("friction",) + tuple(f"{name}_friction" for name in FRICTION_TOOLS)  # [tools]' coefficients
 
