@@ -14,8 +14,9 @@ many increments the plus and minus runs' counts of nodes on the punch, the die a
 holder differ (the set-held derivative does not see such a change; equal counts do not prove
 equal sets).
 
-The run with the sensitivities and one without are timed alone, one thread each (the cost); the
-differences' runs then go two at a time (subprocesses).
+The run with the sensitivities and one without are timed alone, one thread each (the cost), after
+a short run with the sensitivities that compiles the kernels (numba's cache), so that neither
+timed run pays for compiling; the differences' runs then go two at a time (subprocesses).
 
     shellform study sensitivity-cup --out docs/results/sensitivity_cup     (about 45 minutes)
 
@@ -38,6 +39,7 @@ SCENE = "numisheet93_aluminium.toml"
 LEVELS = (16, 24)
 QUICK_LEVELS = (6,)
 STROKE = 40.0
+WARM_UP_MM = 1.0
 REPORTS = (15.0, 40.0)
 PARAMETERS = ("tools.blank_holder_force", "tools.friction", "material.K", "material.n", "material.r0")
 STEPS = (1e-3, 1e-4)
@@ -105,7 +107,9 @@ def set_differs(plus: Path, minus: Path, stroke: float) -> int:
 def level(out: Path, n: int, stroke: float = STROKE) -> tuple[list[dict], dict]:
     """The rows of one mesh level and its cost row."""
     base = Path(out) / f"n_{n}"
-    say(f"sensitivity-cup: n {n}, the run with the sensitivities and the one without, alone")
+    say(f"sensitivity-cup: n {n}, a short run that compiles the kernels, then the run with the sensitivities and "
+        "the one without, alone")
+    _run(base / "warm_up", settings(n, WARM_UP_MM, sensitivities=True))  # numba's cache, so that no timed run compiles
     with_s = _run(base / "one_run", settings(n, stroke, sensitivities=True))
     without = _run(base / "plain", settings(n, stroke))
     jobs, values = {}, {name: _value(name) for name in PARAMETERS}
