@@ -447,6 +447,12 @@ def _springback_against_differences(tmp_path, names, holder):
     base = scene_.changed({"process.springback": True, "output.png": False, "output.vtx": False,
                            "output.fld": False})
     one = run(base.changed({"output.sensitivities": names}), tmp_path / "one")["springback"]["sensitivities"]
+    import csv
+
+    rows = list(csv.DictReader(open(tmp_path / "one" / "springback_sensitivities.csv")))
+    assert len(rows) == 6 * len(names) and {r["parameter"] for r in rows} == set(names)
+    assert float(next(r for r in rows if r["answer"] == "flange_edge_dz_mm.transverse")["derivative"]) == \
+        pytest.approx(one[names[0]]["flange_edge_dz_mm"]["transverse"], rel=1e-5)  # the CSV's six digits
     out = []
     for name in names:
         section, _, key = name.partition(".")

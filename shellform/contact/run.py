@@ -63,7 +63,8 @@ Writes into the output folder (forces and draw-in for the whole blank, pictures 
                              after the tools withdraw (contact/springback.py releases them,
                              results/springback.py writes; the picture: after minus before);
                              summary.json: wall angle, flange edge, re-yield,
-                             residual resultants
+                             residual resultants; with [output] sensitivities their derivatives
+                             (springback_sensitivities.csv, summary.json springback.sensitivities)
     checkpoint.npz           the last converged state (at every report, every output.checkpoint_every
                              seconds, at the end, at a stop: no convergence, Ctrl-C, SIGTERM),
                              any number of ranks, and the one before (checkpoint.previous.npz):

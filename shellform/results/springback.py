@@ -87,7 +87,8 @@ def write(outdir: Path, p, title: str, before: dict, released, sensitivities: di
     """What springback changed (shellform.contact.springback released the tools' forces into
     `released`): wall angle and flange edge along the transverse line, the diagonal's corner (changes()),
     the unloading's plastic layers, the residual resultants, and their `sensitivities` where
-    given (derivatives()); springback.csv (both profiles) and
+    given (derivatives(); also springback_sensitivities.csv: answer, parameter, derivative);
+    springback.csv (both profiles) and
     springback.png (the change along each line: sprung back minus drawn, in z and in the distance
     from the centre, against the node's initial distance from the centre, which runs along the
     wall where the drawn distance folds back on itself)."""
@@ -96,6 +97,10 @@ def write(outdir: Path, p, title: str, before: dict, released, sensitivities: di
     rows = [{"line": k, "initial_position_mm": b[0], "before_r_mm": b[1], "before_z_mm": b[2],
              "after_r_mm": a[1], "after_z_mm": a[2]} for k in lines for b, a in zip(before[k], after[k])]
     write_csv(outdir / "springback.csv", rows, list(rows[0]))
+    if sensitivities is not None:
+        write_csv(outdir / "springback_sensitivities.csv",
+                  [{"answer": f"{key}.{k}", "parameter": name, "derivative": d} for name, per in sensitivities.items()
+                   for key, values in per.items() for k, d in values.items()], ["answer", "parameter", "derivative"])
     resultants = p.resultants()
     N, M = resultants[..., :3], resultants[..., 3:]
     comm = p.comm
