@@ -18,7 +18,9 @@ Cases (each sensitivity from the one run that also gives the answer):
 - round cup (demos/round_cup.toml, n 6, 3 mm): frictionless, with friction, with friction and
   its holder, the punch force and the rim's draw-in (cup); as a scene with the forming-limit
   view and springback, the smallest margin and the flange edge's springback (cup_scene); against
-  central differences of two runs at p (1 +- 1e-5).
+  central differences of two runs at p (1 +- 1e-5);
+- aluminium cup (demos/numisheet93_aluminium.toml, n 16, 25 mm, sprung back): the wall's angle
+  before and after springback and the flange edge's moves in K and mu (aluminium_springback).
 
 Writes sensitivity.csv (case, answer, parameter, the one run's derivative, the reference, the
 reference's kind, the relative error against max(|reference|, the answer's scale / |p|)) and
@@ -304,6 +306,39 @@ def cup_scene(folder: Path, holder: bool = False) -> tuple[list[dict], dict]:
                   "parameters": len(names)}
 
 
+ALUMINIUM_SPRINGBACK = ("material.K", "tools.friction")
+SPRINGBACK_ROWS = (("wall_angle_deg", "before"), ("wall_angle_deg", "after"), ("flange_edge_dr_mm", "transverse"),
+                   ("flange_edge_dz_mm", "diagonal"))
+
+
+def aluminium_springback(folder: Path, n: int = 16, stroke: float = 25.0) -> tuple[list[dict], dict]:
+    """demos/numisheet93_aluminium.toml on n = 16 drawn 25 mm (a wall to measure) and sprung back:
+    the wall's angle before and after springback and the flange edge's moves, in K and mu
+    against central differences of two whole runs at p (1 +- CUP_STEP)."""
+    from shellform import demos, scene
+    from shellform.contact.run import run as run_scene
+
+    case = f"aluminium cup n {n}, {stroke:g} mm, springback"
+    base = scene.load(demos.path("numisheet93_aluminium.toml")).changed({
+        "mesh.n": n, "tools.stroke": stroke, "process.report": [1.0], "process.springback": True, "process.rtol": 1e-10,
+        "output.png": False, "output.vtx": False, "output.vtu": False, "output.fld": False})
+    plain = run_scene(base, folder / "plain")
+    one = run_scene(base.changed({"output.sensitivities": list(ALUMINIUM_SPRINGBACK)}), folder / "one_run")
+    sprung = one["springback"]["sensitivities"]
+    rows = []
+    for name in ALUMINIUM_SPRINGBACK:
+        section, _, key = name.partition(".")
+        value = float(getattr(getattr(base, section), key))
+        h = CUP_STEP * value
+        ends = [run_scene(base.changed({name: value + sign * h}), folder / f"{key}_{sign:+d}")["springback"]
+                for sign in (1, -1)]
+        for answer, line in SPRINGBACK_ROWS:
+            rows.append(_row(case, f"springback {answer} ({line})", name, sprung[name][answer][line],
+                             (ends[0][answer][line] - ends[1][answer][line]) / (2 * h), "central differences"))
+    return rows, {"case": case, "with_s": one["wall_time_s"]["total"], "without_s": plain["wall_time_s"]["total"],
+                  "parameters": len(ALUMINIUM_SPRINGBACK)}
+
+
 def plates() -> tuple[list[dict], dict]:
     E, P = 70e3, 5.0
     effects = ("bending", "membrane", "geometric_nonlinearity")
@@ -347,7 +382,8 @@ def run(outdir) -> list[dict]:
     rows, times = [], []
     for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
                  lambda: cup(friction=True), lambda: cup(friction=True, holder=True),
-                 lambda: cup_scene(out / "runs" / "cup"), lambda: cup_scene(out / "runs" / "cup_holder", holder=True)):
+                 lambda: cup_scene(out / "runs" / "cup"), lambda: cup_scene(out / "runs" / "cup_holder", holder=True),
+                 lambda: aluminium_springback(out / "runs" / "aluminium")):
         r, t = case()
         rows += r
         times.append(t)
