@@ -278,9 +278,7 @@ class Sensitivity(Record):
             for part in driver.parts:
                 part.pseudo_load(par.name, rhs[:owned].reshape(-1, BS), dx_n, eps, par)
             rhs[~free] = 0.0
-            delta = np.zeros_like(q)  # the known rows' derivatives (solve coordinates, ghosts from their owners)
-            # the supports keep theirs: 0 where their values do not depend on p, a springback's held node its drawn one
-            delta[driver.bc_dofs] = self.dq[par.name][driver.bc_dofs]
+            # the known rows' derivatives (solve coordinates, ghosts from their owners)
             if driver.parts:
                 de33 = self.thickness_strain(par.name)  # d/dp of ln(t/t0) per cell, committed (h_n, dh)
                 self._known.x.array[:] = 0.0
@@ -288,6 +286,9 @@ class Sensitivity(Record):
                     part.known_derivatives(self._known.x.array[:owned].reshape(-1, BS), de33)
                 self._known.x.scatter_forward()
                 delta = self._known.x.array.copy()
+            else:  # the supports keep theirs: 0 where their values do not depend on p, a springback's held node its drawn one
+                delta = np.zeros_like(q)
+                delta[driver.bc_dofs] = self.dq[par.name][driver.bc_dofs]
             out = driver.dq  # the step's work array, free after convergence
             if not driver.solve_lifted(delta, out, extra=-rhs):
                 raise RuntimeError(f"the sensitivity solve for {par.name} failed at load factor {lam:.6g}")
@@ -403,7 +404,7 @@ class Sensitivity(Record):
         the tools' rows the reactions') turned from the nodes' frames, held, into x, y, z, 0 on
         the springback's supports as f is. (The springback's f is f_int at the drawn state from
         its committed material state, whose lever arm is the last increment's stretch; f' leaves
-        out the derivative of that lever's change: docs/sensitivity.md measures it.)"""
+        out the derivative of that lever's change: docs/sensitivity.md bounds its effect.)"""
         owned = driver.n_owned * BS
         parameters = []
         for par in self.parameters:

@@ -271,7 +271,39 @@ def cup(friction: bool = False, holder: bool = False) -> tuple[list[dict], dict]
 
 SCENE_PARAMETERS = ("material.K", "material.n", "material.r")
 SCENE_HOLDER_PARAMETERS = ("material.r", "tools.friction")
-SPRINGBACK_ANSWERS = ("flange_edge_dz_mm", "flange_edge_dr_mm")
+ALUMINIUM_SPRINGBACK = ("material.K", "tools.friction")
+
+
+def _springback(answer: str, line: str) -> tuple:
+    """(label, its value in a run's summary, its derivative in the one run's) of a springback answer
+    (results/springback.changes) on one line."""
+    return (f"springback {answer} ({line})", lambda s: s["springback"][answer][line],
+            lambda s, name: s["springback"]["sensitivities"][name][answer][line])
+
+
+MARGIN = ("smallest FLD margin", lambda s: s["min_margin"],
+          lambda s, name: s["reports"][-1]["sensitivities"][name]["min_margin"])
+
+
+def _against_two_runs(case: str, base, names, folder: Path, answers) -> tuple[list[dict], dict]:
+    """The scene `base` run plain and with `[output] sensitivities` = names, and for each name twice
+    more at p (1 +- CUP_STEP): per name and answer ((label, value of a summary, derivative of the one
+    run's summary and a name)) the one run's derivative against the central difference."""
+    from shellform.contact.run import run as run_scene
+
+    plain = run_scene(base, folder / "plain")
+    one = run_scene(base.changed({"output.sensitivities": list(names)}), folder / "one_run")
+    rows = []
+    for name in names:
+        section, _, key = name.partition(".")
+        value = float(getattr(getattr(base, section), key))
+        h = CUP_STEP * value
+        ends = [run_scene(base.changed({name: value + sign * h}), folder / f"{key}_{sign:+d}") for sign in (1, -1)]
+        for label, value_of, derivative_of in answers:
+            rows.append(_row(case, label, name, derivative_of(one, name),
+                             (value_of(ends[0]) - value_of(ends[1])) / (2 * h), "central differences"))
+    return rows, {"case": case, "with_s": one["wall_time_s"]["total"], "without_s": plain["wall_time_s"]["total"],
+                  "parameters": len(names)}
 
 
 def cup_scene(folder: Path, holder: bool = False) -> tuple[list[dict], dict]:
@@ -280,35 +312,12 @@ def cup_scene(folder: Path, holder: bool = False) -> tuple[list[dict], dict]:
     at the end of the stroke and the flange edge's springback on the transverse line (its move
     in z and in the distance from the centre), in each parameter against central differences of
     two whole runs at p (1 +- CUP_STEP)."""
-    from shellform.contact.run import run as run_scene
-
-    names = SCENE_HOLDER_PARAMETERS if holder else SCENE_PARAMETERS
     case = "round cup scene, holder 10 kN, friction 0.07" if holder else "round cup scene, frictionless"
     scene_, _ = drawn_cup(scene_only=True, friction=holder, holder=holder)
     base = scene_.changed({"process.springback": True, "output.png": False, "output.vtx": False, "output.vtu": False,
                            "output.fld": True})
-    plain = run_scene(base, folder / "plain")
-    one = run_scene(base.changed({"output.sensitivities": list(names)}), folder / "one_run")
-    derivatives, sprung = one["reports"][-1]["sensitivities"], one["springback"]["sensitivities"]
-    rows = []
-    for name in names:
-        section, _, key = name.partition(".")
-        value = float(getattr(getattr(base, section), key))
-        h = CUP_STEP * value
-        ends = [run_scene(base.changed({name: value + sign * h}), folder / f"{key}_{sign:+d}") for sign in (1, -1)]
-        rows.append(_row(case, "smallest FLD margin", name, derivatives[name]["min_margin"],
-                         (ends[0]["min_margin"] - ends[1]["min_margin"]) / (2 * h), "central differences"))
-        for answer in SPRINGBACK_ANSWERS:
-            fd = (ends[0]["springback"][answer]["transverse"] - ends[1]["springback"][answer]["transverse"]) / (2 * h)
-            rows.append(_row(case, f"springback {answer} (transverse)", name, sprung[name][answer]["transverse"], fd,
-                             "central differences"))
-    return rows, {"case": case, "with_s": one["wall_time_s"]["total"], "without_s": plain["wall_time_s"]["total"],
-                  "parameters": len(names)}
-
-
-ALUMINIUM_SPRINGBACK = ("material.K", "tools.friction")
-SPRINGBACK_ROWS = (("wall_angle_deg", "before"), ("wall_angle_deg", "after"), ("flange_edge_dr_mm", "transverse"),
-                   ("flange_edge_dz_mm", "diagonal"))
+    answers = [MARGIN, _springback("flange_edge_dz_mm", "transverse"), _springback("flange_edge_dr_mm", "transverse")]
+    return _against_two_runs(case, base, SCENE_HOLDER_PARAMETERS if holder else SCENE_PARAMETERS, folder, answers)
 
 
 def aluminium_springback(folder: Path, n: int = 16, stroke: float = 25.0) -> tuple[list[dict], dict]:
@@ -316,27 +325,14 @@ def aluminium_springback(folder: Path, n: int = 16, stroke: float = 25.0) -> tup
     the wall's angle before and after springback and the flange edge's moves, in K and mu
     against central differences of two whole runs at p (1 +- CUP_STEP)."""
     from shellform import demos, scene
-    from shellform.contact.run import run as run_scene
 
-    case = f"aluminium cup n {n}, {stroke:g} mm, springback"
     base = scene.load(demos.path("numisheet93_aluminium.toml")).changed({
         "mesh.n": n, "tools.stroke": stroke, "process.report": [1.0], "process.springback": True, "process.rtol": 1e-10,
         "output.png": False, "output.vtx": False, "output.vtu": False, "output.fld": False})
-    plain = run_scene(base, folder / "plain")
-    one = run_scene(base.changed({"output.sensitivities": list(ALUMINIUM_SPRINGBACK)}), folder / "one_run")
-    sprung = one["springback"]["sensitivities"]
-    rows = []
-    for name in ALUMINIUM_SPRINGBACK:
-        section, _, key = name.partition(".")
-        value = float(getattr(getattr(base, section), key))
-        h = CUP_STEP * value
-        ends = [run_scene(base.changed({name: value + sign * h}), folder / f"{key}_{sign:+d}")["springback"]
-                for sign in (1, -1)]
-        for answer, line in SPRINGBACK_ROWS:
-            rows.append(_row(case, f"springback {answer} ({line})", name, sprung[name][answer][line],
-                             (ends[0][answer][line] - ends[1][answer][line]) / (2 * h), "central differences"))
-    return rows, {"case": case, "with_s": one["wall_time_s"]["total"], "without_s": plain["wall_time_s"]["total"],
-                  "parameters": len(ALUMINIUM_SPRINGBACK)}
+    answers = [_springback("wall_angle_deg", "before"), _springback("wall_angle_deg", "after"),
+               _springback("flange_edge_dr_mm", "transverse"), _springback("flange_edge_dz_mm", "diagonal")]
+    return _against_two_runs(f"aluminium cup n {n}, {stroke:g} mm, springback", base, ALUMINIUM_SPRINGBACK, folder,
+                             answers)
 
 
 def plates() -> tuple[list[dict], dict]:
