@@ -26,8 +26,7 @@ parser.add_argument("--stroke", type=float, default=12.0)
 parser.add_argument("--capture", type=Path, default=Path("/tmp/section_states.pkl"))
 args = parser.parse_args()
 
-KEYS = ("strain", "taper", "material", "thickness", "plastic", "finite", "zeta", "wz", "ep_n", "p_n", "lever", "ep",
-        "p")
+KEYS = ("strain", "taper", "material", "thickness", "plastic", "finite", "zeta", "wz", "ep_n", "p_n", "ep", "p")
 
 if not args.capture.exists():
     import shellform.nonlinear.model as model
@@ -58,7 +57,7 @@ def sweep(threads: int) -> float:
         ep, p = r["ep"].copy(), r["p"].copy()  # the last state: the warm start
         out = np.ones((nc, nq)), np.zeros((nc, nq, 6)), np.zeros((nc, nq, 6, 6))
         t0 = time.perf_counter()
-        section_update(*(r[k] for k in KEYS[:11]), ep, p, *out, threads=threads)
+        section_update(*(r[k] for k in KEYS[:10]), ep, p, *out, threads=threads)
         total += time.perf_counter() - t0
     return 1e3 * total / len(records)
 

@@ -438,7 +438,7 @@ def test_strain_guard_counts_and_skips_unphysical_points():
     ep_n, p_n = np.zeros((3, 1, 3, 3)), np.zeros((3, 1, 3))
     ep, p = np.full_like(ep_n, 7.0), np.full_like(p_n, 7.0)
     S, D = np.full((3, 1, 6), np.nan), np.full((3, 1, 6, 6), np.nan)
-    nplastic, nfail, nguard = section_update(e, np.zeros((3, 1, 3)), mat, 0.8, True, False, zeta, wz, ep_n, p_n, np.ones((3, 1)), ep, p,
+    nplastic, nfail, nguard = section_update(e, np.zeros((3, 1, 3)), mat, 0.8, True, False, zeta, wz, ep_n, p_n, ep, p,
                                              np.ones((3, 1)), S, D)
     assert (nplastic, nfail, nguard) == (3, 0, 2)
     assert np.all(S[:2] == 0.0) and np.all(np.isfinite(D))

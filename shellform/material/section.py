@@ -2,11 +2,22 @@
 
 Layer strain e(z) = em + z k, z = zeta h, zeta in [-1/2, 1/2]; em = (e11, e22, g12) membrane
 strain, k = (k11, k22, 2 k12) curvature, h the lever arm: the current thickness (t at small
-strain, t lambda3 with finite strains, lambda3 of the last converged state). With the Gauss rule
+strain; with finite strains t / J, the thickness of a sheet that keeps its volume, J the
+mid-surface's area stretch at the iterate: incompressible_lever). With the Gauss rule
 (zeta_i, w_i), sum w_i = 1, and t the initial thickness (the layers' volume per unit blank area):
 
     N = t sum w s,   M = t sum w z s,
     D = [[A, B], [B, Dd]],  A = t sum w Dt,  B = t sum w z Dt,  Dd = t sum w z^2 Dt,
+
+and, where h follows em, D[:, :3] += dS/dh (x) dh/dem (section_response's dlever).
+
+Why t / J and not the layers' own mean stretch lambda3 = exp(sum w e33): a lever read from the
+layers is known only after they are evaluated, so it has to lag (one increment, as it did), and
+on a strongly bent cell the layers' mean e33 of the linear-in-z strain e = em + z k grows with
+the lever itself (ln(1 + 2 e) is concave: bending alone reads as a mean compression, hence
+thickening). The lag then made each increment start out of balance by what the lever moved
+(docs/cup.md, "The step bounds tried"). t / J is a function of the iterate, exact for a
+plastically incompressible membrane, and its tangent is closed-form.
 
 s the layer's stress conjugate to e (S of Green-Lagrange; with finite strains P^T T from the
 logarithmic-space stress T), Dt its consistent tangent. nz >= 2 points integrate the elastic
@@ -73,13 +84,34 @@ def _layer(e, ep_n, p_n, mat, finite, elastic_tangent, s, Dt, ep_new, p_w, w):
 
 
 @jit.njit
+def incompressible_lever(em, t, dlever):
+    """The lever arm of a sheet that keeps its volume: h = t / J, J = sqrt(det(I + 2E)) the
+    mid-surface's area stretch, E = (e11, e22, g12 / 2) the membrane strain em; writes
+    dh/dem into dlever (3). Returns t (and dlever = 0) where I + 2E is not positive definite:
+    no stretch gives such a strain, and the layers' own return mapping refuses it."""
+    c11, c22, c12 = 1.0 + 2.0 * em[0], 1.0 + 2.0 * em[1], em[2]
+    det = c11 * c22 - c12 * c12
+    if c11 <= 0.0 or det <= 0.0:
+        dlever[0] = dlever[1] = dlever[2] = 0.0
+        return t
+    J = np.sqrt(det)
+    h = t / J
+    f = -h / det  # dh/d(det) = -h / (2 det), d(det)/dem = (2 c22, 2 c11, -2 c12)
+    dlever[0], dlever[1], dlever[2] = f * c22, f * c11, -f * c12
+    return h
+
+
+@jit.njit
 def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_tangent,
-                     S, D, ep_new, p_new, w=None):
+                     S, D, ep_new, p_new, w=None, dlever=None):
     """Resultants S = (N, M) (6) and section tangent D (6x6) of the layered section of initial
     thickness t whose layers sit at z = zeta * lever (lever: the current thickness, t at small
     strain); writes the layers' new plastic strains ep_new (nz, 3) and p_new (nz,). On entry
     these hold the layers' last solution in this increment, the return map's warm start (or
-    ep_n, p_n, or zeros: a cold start). w: scratch (4, 16), allocated here if None.
+    ep_n, p_n, or zeros: a cold start). w: scratch (4, 16), allocated here if None. dlever:
+    the lever's derivative in em where it follows the membrane strain (incompressible_lever);
+    D then carries its term, dS/dem += dS/dh (x) dh/dem with dN/dh = t sum w Dt zeta k and
+    dM/dh = t sum w zeta (s + z Dt zeta k), which makes D unsymmetric.
     Returns (number of plastic layers or -1 if any layer failed, mean thickness strain)."""
     for i in range(6):
         S[i] = 0.0
@@ -92,6 +124,11 @@ def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_
         w = np.zeros((4, 16))
     s, e = w[3, :3], w[3, 3:6]
     Dt = w[3, 6:15].reshape((3, 3))
+    follows = dlever is not None
+    dS = w[2, 9:15]  # dS/dh
+    if follows:
+        for a in range(6):
+            dS[a] = 0.0
     for i in range(zeta.shape[0]):
         z = zeta[i] * lever
         for a in range(3):
@@ -111,9 +148,20 @@ def section_response(em, k, t, lever, zeta, wz, ep_n, p_n, mat, finite, elastic_
                 D[a, b] += c0 * Dt[a, b]
                 D[a, 3 + b] += c0 * z * Dt[a, b]
                 D[3 + a, 3 + b] += c0 * z * z * Dt[a, b]
+        if follows:
+            for a in range(3):
+                de = 0.0
+                for b in range(3):
+                    de += Dt[a, b] * zeta[i] * k[b]
+                dS[a] += c0 * de
+                dS[3 + a] += c0 * (zeta[i] * s[a] + z * de)
     for a in range(3):
         for b in range(3):
             D[3 + a, b] = D[b, 3 + a]
+    if follows:
+        for a in range(6):
+            for b in range(3):
+                D[a, b] += dS[a] * dlever[b]
     return (-1 if failed else nplastic), e33
 
 

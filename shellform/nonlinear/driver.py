@@ -139,7 +139,6 @@ class Driver(Newton):
         that state."""
         for part in self.parts:
             part.start(self.lam, False)
-        self.model.converged_lever()
         self._set_dirichlet(self.lam)
         self.constrain(self.lam)
         self.residual(self.lam, tangent=False)

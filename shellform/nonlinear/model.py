@@ -129,10 +129,8 @@ class SheetModel:
         shape = (self.num_cells, self.nqp, nz)
         self.ep_n, self.p_n = np.zeros(shape + (3,)), np.zeros(shape)
         self.ep, self.p = np.zeros(shape + (3,)), np.zeros(shape)
-        # thickness stretch lambda3 per point (finite strain): committed and trial, and the one
-        # the layers' lever arm t lambda3 uses in this increment (that of the last commit)
+        # the layers' thickness stretch lambda3 per point (finite strain): committed and trial
         self.stretch_n, self.stretch = np.ones(shape[:2]), np.ones(shape[:2])
-        self.lever, self._lever_before = np.ones(shape[:2]), np.ones(shape[:2])
         self.z = np.zeros((self.num_cells, el.nz))
         self.strain = np.zeros((self.num_cells, self.nqp, 6))
         self.taper = np.zeros((self.num_cells, self.nqp, 3))  # curvature carried without a moment (follow_taper)
@@ -157,14 +155,15 @@ class SheetModel:
         out = {"z": self.z, "strain": self.strain, "ep": self.ep, "p": self.p, "stretch": self.stretch,
                "resultants": self.resultants, "tangents": self.tangents, "face_pressure": self.face_pressure,
                "ironed_d": self.ironed_d, "ironed": self.ironed, "vectors": self.forms.vectors}
-        ev, self.pressed = self._loops(q.x.array, self.ep_n, self.p_n, self.lever, self.material, self.thickness,
-                                       out, tangent, elastic_tangent)
+        ev, self.pressed = self._loops(q.x.array, self.ep_n, self.p_n, self.material, self.thickness, out, tangent,
+                                       elastic_tangent)
         return ev
 
-    def _loops(self, q, ep_n, p_n, lever, material, thickness, out, tangent=False, elastic_tangent=False):
-        """The element and material loops at the carrier array q from the state (ep_n, p_n, the
-        lever arm) with `material` and `thickness`, into the arrays of `out` (SheetModel's names;
-        the tangents into the copy forms' matrices with `tangent`): (Evaluation, points pressed)."""
+    def _loops(self, q, ep_n, p_n, material, thickness, out, tangent=False, elastic_tangent=False):
+        """The element and material loops at the carrier array q from the committed state
+        (ep_n, p_n) with `material` and `thickness`, into the arrays of `out` (SheetModel's
+        names; the tangents into the copy forms' matrices with `tangent`): (Evaluation, points
+        pressed)."""
         k = self.kernels
         t0 = time.perf_counter()
         k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q, self.P, self.consts, self.beta,
@@ -172,7 +171,7 @@ class SheetModel:
         t1 = time.perf_counter()
         nplastic, nfail, nguard = section_update(
             out["strain"], self.taper, material, thickness, self.plastic, self.finite, self.zeta, self.wz,
-            ep_n, p_n, lever, out["ep"], out["p"], out["stretch"], out["resultants"], out["tangents"],
+            ep_n, p_n, out["ep"], out["p"], out["stretch"], out["resultants"], out["tangents"],
             elastic_tangent, self.threads)
         pressed = 0
         if self.ironing:
@@ -190,15 +189,15 @@ class SheetModel:
     def history(self) -> dict:
         """The committed material state an increment starts from, as copies: per cell, point
         and layer the plastic strain "ep" (3) and the equivalent plastic strain "p", and per
-        point the thickness stretch "stretch" (which is also the next increment's lever arm)."""
+        point the layers' thickness stretch "stretch"."""
         return {"ep": self.ep_n.copy(), "p": self.p_n.copy(), "stretch": self.stretch_n.copy()}
 
     def respond(self, q: np.ndarray, history: dict, material: np.ndarray | None = None,
                 thickness: float | None = None) -> tuple[np.ndarray, dict, bool]:
         """The element forces and the updated material state at the carrier array q (with
-        ghosts) from the committed state `history` (as history() gives it, its stretch the
-        lever arm), with another material or thickness where given: the map
-        (q, h_n, material) -> (f_e, h_n+1) that one evaluation computes (the same loops), on
+        ghosts) from the committed state `history` (as history() gives it), with another
+        material or thickness where given: the map (q, h_n, material) -> (f_e, h_n+1) that one
+        evaluation computes (the same loops), on
         arrays of its own, so that nothing of the model's state changes. Returns (element
         vectors (cells, NDOF), the updated state in history()'s keys, whether the material
         update failed)."""
@@ -209,7 +208,7 @@ class SheetModel:
                "resultants": np.zeros_like(self.resultants), "tangents": np.zeros_like(self.tangents),
                "face_pressure": np.zeros_like(self.face_pressure), "ironed_d": np.zeros_like(self.ironed_d),
                "ironed": self.ironed.copy(), "vectors": np.zeros_like(self.forms.vectors)}
-        ev, _ = self._loops(q, history["ep"], history["p"], history["stretch"], mat, t, out)
+        ev, _ = self._loops(q, history["ep"], history["p"], mat, t, out)
         return out["vectors"], {"ep": out["ep"], "p": out["p"], "stretch": out["stretch"]}, ev.failed
 
     def tensor_arrays(self, tangent: bool) -> None:
@@ -255,8 +254,6 @@ class SheetModel:
         self.ep_n[...] = self.ep
         self.p_n[...] = self.p
         self.stretch_n[...] = self.stretch
-        self._lever_before[...] = self.lever
-        self.lever[...] = self.stretch  # the next increment's lever arm
         self.state_version += 1
 
     def follow_taper(self, cells: np.ndarray, q: fem.Function | None = None) -> None:
@@ -286,34 +283,25 @@ class SheetModel:
         return strain
 
     def checkpoint(self) -> dict:
-        """The committed material state; the next increment's lever arm is its stretch."""
-        return {"ep": self.ep_n, "p": self.p_n, "thickness_stretch": self.stretch_n, "lever_before": self._lever_before,
-                "taper": self.taper}
+        """The committed material state."""
+        return {"ep": self.ep_n, "p": self.p_n, "thickness_stretch": self.stretch_n, "taper": self.taper}
 
     def restore(self, data, q: fem.Function) -> None:
         """The committed material state from a checkpoint() (refused if it does not fit), at the
         converged carrier state q: the last evaluated state becomes the checkpoint's, evaluated
-        at q with the lever arm its increment was solved with, so that what is read from it
-        (cell_fields, thickness_strain, volume_change) is what the run had there; the next
-        increment's lever arm is the committed stretch."""
+        at q, so that what is read from it (cell_fields, thickness_strain, volume_change) is what
+        the run had there."""
         pairs = (("ep", self.ep_n), ("p", self.p_n), ("thickness_stretch", self.stretch_n),
-                 ("lever_before", self._lever_before), ("taper", self.taper))
+                 ("taper", self.taper))
         for key, target in pairs:
             if key not in data or data[key].shape != target.shape:
                 raise InputError("resume", f"the checkpoint's {key!r} does not fit this model (another mesh "
                                            "or effects)")
         for key, target in pairs:
             target[...] = data[key]
-        self.lever[...] = self._lever_before
         self.evaluate(q, tangent=False)
-        self.ep[...], self.p[...], self.stretch[...], self.lever[...] = self.ep_n, self.p_n, self.stretch_n, self.stretch_n
+        self.ep[...], self.p[...], self.stretch[...] = self.ep_n, self.p_n, self.stretch_n
         self.stability_n[...] = np.nan  # not known until an increment converges
-        self.state_version += 1
-
-    def converged_lever(self) -> None:
-        """The lever arm with which the last converged increment was solved (it lags one
-        increment): evaluating the committed state with it reproduces that state's forces."""
-        self.lever[...] = self._lever_before
         self.state_version += 1
 
     # -- output fields ------------------------------------------------------------------------

@@ -7,7 +7,7 @@ converged increment n -> n+1 satisfies, on the free rows of the carrier q,
 
 R the residual (the element forces of the material update from the committed state h_n, less
 lambda f_ext), H the update of the material state h (plastic strains, equivalent plastic strain,
-thickness stretch, which is also the next increment's lever arm), the known rows (the
+thickness stretch), the known rows (the
 supports) independent of p. Differentiating along the path (direct differentiation of a
 path-dependent problem: Kleiber, Antunez, Hien and Kowalczyk, Parameter Sensitivity in
 Nonlinear Mechanics, Wiley 1997, ch. 5 and 7):
@@ -402,9 +402,7 @@ class Sensitivity(Record):
         where the drawing left them: q' and h' of the drawn state, and f' its element forces'
         dR/dp (residual(): the derivative of f_int at the converged drawn state, every row; on
         the tools' rows the reactions') turned from the nodes' frames, held, into x, y, z, 0 on
-        the springback's supports as f is. (The springback's f is f_int at the drawn state from
-        its committed material state, whose lever arm is the last increment's stretch; f' leaves
-        out the derivative of that lever's change: docs/sensitivity.md bounds its effect.)"""
+        the springback's supports as f is."""
         owned = driver.n_owned * BS
         parameters = []
         for par in self.parameters:
