@@ -413,6 +413,20 @@ def gap_holder(out: Path, levels=(16, 20, 24)) -> list[dict]:
     return tables(out, {**{m: levels for m in GAP_HOLDER}, **{m: levels[:1] for m in GAP_HOLDER_SUSPECTS}})
 
 
+def lever(out: Path) -> list[dict]:
+    """The runs that stopped while the layers' lever arm lagged an increment (docs/cup.md, "The
+    lever follows the iterate"): Yld2000-2d with the holder at the gap on n = 12, 16 and 24 (it
+    stopped on 12), and Poly6 fitted to either laboratory's data on n = 16 (both stopped), into
+    their own folder:
+
+        python -c "from shellform.studies import esaform_cup as e; e.lever('docs/results/esaform_lever')"
+    """
+    levels = {"yld2000-gap-holder": (12, 16, 24), "poly6-gap-holder": (16,), "poly6-ua-gap-holder": (16,)}
+    for model, ns in levels.items():
+        draw(out, ns, (model,))
+    return tables(out, levels)
+
+
 def circle(quadrant: np.ndarray) -> np.ndarray:
     """A profile over the circle (the last row repeating the first, as MEASURED) from its first
     quadrant mirrored about 90, 180 and 270 degrees."""
