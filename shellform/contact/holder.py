@@ -44,7 +44,6 @@ from shellform.contact.holder_split import HolderSplit
 from shellform.contact.lifted_face import LiftedFace
 from shellform.contact.nodes import W_SLOPES
 from shellform.contact.pinch_edge import edge_weights
-from shellform.errors import InputError
 from shellform.nonlinear.parts import Part
 from shellform.results.log import say
 
@@ -352,24 +351,33 @@ class PinchingHolder(Part):
 
     def derivatives(self) -> str | None:
         """The closed holder's split is differentiated (face_derivatives), its pinched nodes'
-        known slopes too (known_derivatives); the open holder's lift is not (pseudo_load refuses
-        it when the holder opens)."""
+        known slopes too (known_derivatives); the open holder's lift is solved with the
+        derivative as it is with Newton's step (border_derivative)."""
         return None
 
     def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
         """The nodes the faces hold flat take the slopes of the surface a half thickness above
         the die (constrain): their slope rows' derivative is that surface's
-        (SheetNodes.surface_slopes_derivative). Their w row is the die's (the contact set's)."""
+        (SheetNodes.surface_slopes_derivative). A node on the die or under the flat ("rigid")
+        open face lies its half thickness from it: the contact set's h_i'. Under the conforming
+        ("area") open face, which lies 2 h_i - t0 above the flat one, the node lies t0 - h_i
+        from it: -h_i' along the normal, so -2 h_i' here on the contact set's +h_i'. The
+        lift's own derivative is border_derivative's."""
         if self.force > 0:  # every rank: the gradient gathers the cells of every rank
             delta[self.sloped, W_SLOPES] += self.nodes.surface_slopes_derivative(de33)[self.sloped]
+        if self.is_open and self.lifted_face.spread != "rigid":
+            on = self.on_face()[0]
+            delta[on, 2] -= 2.0 * self.nodes.half_thickness_derivative(de33)[on]
 
-    def pseudo_load(self, key: str, rhs: np.ndarray, dx_n: np.ndarray, eps: float, parameter=None) -> None:
-        """No forces of its own (its split presses through friction: face_derivatives); the open
-        holder's lift, an unknown of its own, has no derivatives yet: refused where it is open."""
-        if self.is_open:
-            raise InputError("output.sensitivities", f"the holder opened (lift {self.lift:.3g} mm): the open "
-                             "holder's lift has no derivatives yet; run without output.sensitivities, or with a "
-                             "holder that stays closed")
+    def border_derivative(self, key: str, driver, out, dR: np.ndarray, parameter=None) -> bool:
+        """The open holder's lift z' (LiftedFace.border_derivative), its force's derivative F' 1
+        where the parameter is the holder's force."""
+        on, count = self.on_face() if self.is_open else (None, 0)
+        if count == 0:
+            return False
+        dforce = self.force / parameter.value if parameter is not None and parameter.holder_force else 0.0
+        self.lifted_face.border_derivative(driver, on, dforce, dR, out)
+        return True
 
     def face_derivatives(self, parameter, net: np.ndarray, dnet: np.ndarray, x: np.ndarray, dx: np.ndarray,
                          eps: float) -> tuple[np.ndarray, np.ndarray]:

@@ -73,6 +73,26 @@ class LiftedFace:
         self._dlift = float(dz)
         return self._dlift
 
+    def border_derivative(self, driver, on: np.ndarray, dforce: float, dR: np.ndarray, out) -> float:
+        """The lift's derivative z' in a sensitivity (nonlinear/sensitivity.py): with q' = q'_a +
+        z' q'_b (q'_a the derivative in `out`, q'_b the response to the face lifted by 1), the
+        face's equation F - sum p_i = 0 differentiated, sum dR_i + z' sum (K q'_b)_i = F' over
+        the normal rows of the owned nodes `on` the face (dR: the residual's total along q'_a,
+        owned rows, the frames; dforce: F'). Adds z' q'_b to out and returns z'."""
+        rows = BS * np.flatnonzero(on) + 2
+        unit = self._unit.x.array
+        unit[:] = 0.0
+        unit[rows] = -1.0  # the face up by 1, as in border
+        self._unit.x.scatter_forward()
+        if not driver.solve_lifted(unit, self._response):
+            raise RuntimeError("the open holder's lift response failed in a sensitivity solve")
+        response = self._response.x.array
+        sums = self.comm.allreduce(np.array([driver.apply_tangent(response)[rows].sum(), dR[rows].sum()]),
+                                   op=MPI.SUM)
+        dz = (dforce - sums[1]) / sums[0]
+        out.x.array[:] += dz * response
+        return float(dz)
+
     def slope(self, imbalance: float) -> float:
         """The lift's share of the energy slope: dz_H (F - sum p)."""
         return self._dlift * imbalance

@@ -185,6 +185,14 @@ class Part:
         """After the solve: the derivative of the part's history at this increment (dx: the
         positions', dR: the residual's total, (n_owned, BS) in the frames), taken at commit."""
 
+    def border_derivative(self, key: str, driver, out, dR: np.ndarray, parameter=None) -> bool:
+        """Where the part has an unknown of its own (the open holder's lift), add to the solved
+        derivative in `out` (a Function, the solve's frames) that unknown's derivative times its
+        unit response, from the part's equation differentiated along dR (the residual's total,
+        owned rows, the frames), as border does for Newton's step; whether it added one (every
+        rank alike)."""
+        return False
+
     def total_derivative(self, key: str, dR: np.ndarray) -> None:
         """dR ((n_owned, BS), the frames) += the total derivative of the part's forces (after
         carry): the free rows' check of the sensitivities."""

@@ -68,6 +68,11 @@ larger) and each correction at least halves it (a defect correction with the inc
 factors, at most MAX_CORRECTIONS; where one no longer halves it, the better of the last two is
 kept).
 
+A part's own unknown (the open holder's lift z_H, with its equation F - sum p_i = 0) is solved
+with the derivative as Newton's step solves it (Part.border_derivative): q' = q'_a + z' q'_b,
+q'_b the response to a unit change of the unknown, z' from the equation differentiated along the
+total; BORDER_PASSES times, each followed by the check and its corrections.
+
 The sensitivity is a Record of the driver (driver.records): `converged` runs with each
 converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through
 a resume.
@@ -90,6 +95,7 @@ STEP = 1e-5  # the central differences' step, relative to the parameter
 CORRECT_ABOVE = 1e-4  # a solve is corrected while its free rows' total passes this share of the loads' scale
 CORRECTED_BY = 0.5  # ... and each correction shrinks it at least by this factor
 MAX_CORRECTIONS = 8
+BORDER_PASSES = 2  # a part's own unknown solved with the derivative (Part.border_derivative), then again
 KEYS = ("ep", "p", "stretch")  # the material state (SheetModel.history)
 
 
@@ -301,6 +307,13 @@ class Sensitivity(Record):
                 corrections += taken_corrections
             else:
                 taken = real()
+            for _ in range(BORDER_PASSES):  # a part's own unknown (the open holder's lift), then the total again
+                if not any([part.border_derivative(par.name, driver, out, taken.dR, par) for part in driver.parts]):
+                    break
+                taken = real()
+                if self.corrected:
+                    taken, taken_corrections = self._correct(par, out, q, lam, taken, pseudo, real)
+                    corrections += taken_corrections
             scale = max(pseudo, taken.size)  # the pseudo-load's or the reactions' derivatives, the larger
             ends = taken.ends
             self.dq[par.name] = taken.dq
