@@ -178,6 +178,8 @@ def strip_edge(material, thickness: float, radius: float) -> EdgeLoad:
 def edge_weights(s: np.ndarray, h: np.ndarray) -> np.ndarray:
     """(2 / b) sin^2(pi s / b) for 0 <= s < b = 2 h, else 0 (1/mm): the band's kernel over rows of
     nodes h apart."""
-    b = 2.0 * h
-    inside = (s >= 0.0) & (s < b)
-    return np.where(inside, 2.0 / b * np.sin(np.pi * np.clip(s / b, 0.0, 1.0)) ** 2, 0.0)
+    s, b = np.broadcast_arrays(np.asarray(s, dtype=float), 2.0 * np.asarray(h, dtype=float))
+    inside = (s >= 0.0) & (s < b)  # so b > 0 there
+    w = np.zeros(s.shape)
+    w[inside] = 2.0 / b[inside] * np.sin(np.pi * (s[inside] / b[inside])) ** 2
+    return w
