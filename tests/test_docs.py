@@ -37,7 +37,7 @@ def test_the_pages_tables_are_their_studies_files():
     included = {t.partition("#")[0] for p in (ROOT / "docs").glob("*.md") for t, _, _ in docs_include.blocks(p)}
     assert included == {f"results/{s}.md" for s in (
         "cup_convergence/cup_convergence", "cup_hard/hard_cases", "cup_mesh/cup_mesh", "cup_paper/cup_paper",
-        "cup_strain/cup_strain", "esaform_cup/esaform_cup", "esaform_gap_holder/esaform_cup",
+        "cup_strain/cup_strain", "esaform_cup/esaform_cup", "esaform_gap_holder/esaform_cup", "esaform_lever/esaform_cup",
         "esaform_hypotheses/esaform_hypotheses", "esaform_poly6/esaform_cup", "esaform_poly6/peers",
         "yld2000_fit/residuals", "yld2000_fit/poly6_residuals",
         "binder_wrap/binder_wrap", "curved_binder/channel", "curved_binder/cup", "levy/levy",

@@ -245,21 +245,26 @@ def rim_node(p) -> int:
     return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
 
 
-def cup(friction: bool = False, holder: bool = False) -> tuple[list[dict], dict]:
+def cup(friction: bool = False, holder: bool = False, light: bool = False) -> tuple[list[dict], dict]:
     """The round cup drawn 3 mm (drawn_cup), frictionless, with its friction, or with its
-    friction and its holder: the punch force and the rim's draw-in on y = 0, in each parameter
-    against central differences of two runs at p (1 +- CUP_STEP)."""
+    friction and its holder (10 kN, closed; with `light` 300 N, which opens and rides on the
+    flange: its lift's derivative): the punch force and the rim's draw-in on y = 0, in each
+    parameter against central differences of two runs at p (1 +- CUP_STEP)."""
     names = HOLDER_PARAMETERS if holder else FRICTION_PARAMETERS if friction else CUP_PARAMETERS
-    case = "round cup, holder 10 kN, friction 0.07" if holder else \
-        "round cup, friction 0.07" if friction else "round cup, frictionless"
-    (p, s), with_s, without = _costs(lambda: drawn_cup(friction=friction, holder=holder),
-                                     lambda: drawn_cup(sensitivities=names, friction=friction, holder=holder))
+    changes = {"tools.blank_holder_force": 300.0} if light else {}
+    case = ("round cup, holder 300 N (open), friction 0.07" if light else "round cup, holder 10 kN, friction 0.07") \
+        if holder else "round cup, friction 0.07" if friction else "round cup, frictionless"
+    (p, s), with_s, without = _costs(lambda: drawn_cup(changes, friction=friction, holder=holder),
+                                     lambda: drawn_cup(changes, sensitivities=names, friction=friction, holder=holder))
+    if light and not p.driver.holder.is_open:
+        raise RuntimeError("the 300 N holder was to be open at the end of the cup's 3 mm")
     i = rim_node(p)
     rows = []
     for par in s.parameters:
         k, value = par.name, par.value
         h = CUP_STEP * value
-        plus, minus = (drawn_cup({k: value + sign * h}, friction=friction, holder=holder)[0] for sign in (1, -1))
+        plus, minus = (drawn_cup({**changes, k: value + sign * h}, friction=friction, holder=holder)[0]
+                       for sign in (1, -1))
         fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)
         fd_draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
         rows.append(_row(case, "punch force", k, p.punch_force(residual=s.residual(k)), fd_force,
@@ -378,6 +383,7 @@ def run(outdir) -> list[dict]:
     rows, times = [], []
     for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
                  lambda: cup(friction=True), lambda: cup(friction=True, holder=True),
+                 lambda: cup(friction=True, holder=True, light=True),
                  lambda: cup_scene(out / "runs" / "cup"), lambda: cup_scene(out / "runs" / "cup_holder", holder=True),
                  lambda: aluminium_springback(out / "runs" / "aluminium")):
         r, t = case()
