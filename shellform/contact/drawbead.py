@@ -234,14 +234,24 @@ class Drawbeads(Part):
         """(force on the sheet (n, 3), restraint along d_i) of the owned nodes at the local nodes'
         positions x_local from x_n and the history, of `lines` (default the part's), with the
         current iterate's stick and slip states held (the sensitivities' differences)."""
-        length, d, limit, uplift = self.shares_at(x_local, lines)
+        force, f, _, _ = self._restrained(x_local, x_n, history, k_per_length, self.shares_at(x_local, lines),
+                                          self.slipping)
+        return force, f
+
+    def _restrained(self, x_local, x_n, history, k_per_length, shares, slipping=None):
+        """The rigid-plastic return mapping of the owned nodes (module docstring) with their
+        shares (l_i, d_i, F_r l_i, F_u l_i): (force on the sheet (n, 3), restraint along d_i,
+        slipping, stick stiffness k_i), the slipping states decided here or, given, held."""
+        length, d, limit, uplift = shares
         ds = np.einsum("ni,ni->n", x_local[: self.n, :2] - x_n[:, :2], d)
-        trial = history - k_per_length * length * ds
-        f = np.where(self.slipping, limit * np.sign(trial), trial)
+        k = k_per_length * length
+        trial = history - k * ds
+        slip = np.abs(trial) > limit if slipping is None else slipping
+        f = np.where(slip, limit * np.sign(trial), trial)
         force = np.zeros((self.n, 3))
         force[:, :2] = f[:, None] * d
         force[:, 2] = uplift
-        return force, f
+        return force, f, slip, k
 
     # -- one iterate ---------------------------------------------------------------------------
     def slide(self, x_local: np.ndarray, x_n: np.ndarray, frames: np.ndarray) -> None:
@@ -250,15 +260,10 @@ class Drawbeads(Part):
         self.shares(x_local)
         n = self.n
         d = self.across
-        ds = np.einsum("ni,ni->n", x_local[:n, :2] - x_n[:, :2], d)
-        k = self.k_per_length * self.length
-        trial = self.history - k * ds
-        slip = np.abs(trial) > self.limit
+        force, _, slip, k = self._restrained(x_local, x_n, self.history, self.k_per_length,
+                                             (self.length, d, self.limit, self.uplift))
+        self.force[:] = force
         self.slipping = slip
-        f = np.where(slip, self.limit * np.sign(trial), trial)
-        self.force[:] = 0.0
-        self.force[:, :2] = f[:, None] * d
-        self.force[:, 2] = self.uplift
         d3 = np.zeros((n, 3))
         d3[:, :2] = d
         d2 = np.einsum("nij,nj->ni", frames[:n, :2], d3)  # d in the frames' tangent slots
