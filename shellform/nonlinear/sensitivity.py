@@ -45,12 +45,11 @@ sheet's is carried. On a node the closed holder pinches, friction presses with t
 split of its force F (contact/holder_split.py), differentiated the same way in F, the net
 normal forces, the positions and the edge load (PinchingHolder.face_derivatives); the held
 slopes are known rows (Part.known_derivatives). The drawbeads' rigid-plastic restraint is
-differentiated as friction's is, its derivative entering dR itself (contact/drawbead.py). A part
-whose forces on the free rows depend on p otherwise (the open holder's lift, the ironing's
-penalty) says so
-(Part.derivatives, or when it opens) and the sensitivities are refused, as is a tool scene
-without finite strains or one whose parameter moves the tools (the thickness: the tools are
-placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
+differentiated as friction's is, its derivative entering dR itself (contact/drawbead.py); the
+open holder's lift is solved with the derivative (below). A part whose forces on the free rows
+depend on p otherwise (the ironing's penalty) says so (Part.derivatives) and the sensitivities
+are refused, as is a tool scene without finite strains or one whose parameter moves the tools
+(the thickness: the tools are placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
 jumps and the derivative of the fixed set does not: the comparison holds on a path whose set
 does not change within the difference (docs/sensitivity.md).
 

@@ -16,7 +16,7 @@ Cases (each sensitivity from the one run that also gives the answer):
 - plate: the simply supported elastic plate in large deflection, whose w(E, P) = W(P / E):
   E dw/dE + P dw/dP = 0 (error: that sum over |w|), and the linear plate's dw/dE = -w / E;
 - round cup (demos/round_cup.toml, n 6, 3 mm): frictionless, with friction, with friction and
-  its holder, the punch force and the rim's draw-in (cup); as a scene with the forming-limit
+  its holder (10 kN, closed; 300 N, open: its lift), the punch force and the rim's draw-in (cup); as a scene with the forming-limit
   view and springback, the smallest margin and the flange edge's springback (cup_scene); against
   central differences of two runs at p (1 +- 1e-5);
 - aluminium cup (demos/numisheet93_aluminium.toml, n 16, 25 mm, sprung back): the wall's angle
