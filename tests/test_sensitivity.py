@@ -4,6 +4,7 @@ the increments against closed forms and against finite differences of whole runs
 
 import shellform  # noqa: F401  (must come before dolfinx / petsc4py)
 
+import csv
 from dataclasses import replace
 
 import numpy as np
@@ -132,10 +133,11 @@ def test_the_cup_with_friction_against_finite_differences_of_two_runs():
     assert max(s.free_residual) < 1e-3
 
 
-def _holder_cup_against_differences(key, rel, changes=None, closed=True):
+def _holder_cup_against_differences(key, rel, changes=None, closed=True, at=None):
     """d/dp of the punch force and the rim's draw-in of the round cup with its holder (10 kN)
     and friction (n 6, 3 mm; with `changes` to its scene) against central differences of two
-    runs at p (1 +- 1e-5); the holder closed at the end (or open, with `closed` False)."""
+    runs at p (1 +- 1e-5), whose scenes are at(p) (default: `changes` with the key at p); the
+    holder closed at the end (or open, with `closed` False)."""
     p, s = drawn_cup(changes, sensitivities=(key,), friction=True, holder=True)
     if closed:
         assert p.driver.holder.closed and p.driver.holder.pinched.sum() > 10
@@ -144,8 +146,8 @@ def _holder_cup_against_differences(key, rel, changes=None, closed=True):
     i = rim_node(p)
     value = float(s.parameters[0].value)
     h = 1e-5 * value
-    plus, minus = (drawn_cup({**(changes or {}), key: value + sign * h}, friction=True, holder=True)[0]
-                   for sign in (1, -1))
+    at = at or (lambda v: {**(changes or {}), key: v})
+    plus, minus = (drawn_cup(at(value + sign * h), friction=True, holder=True)[0] for sign in (1, -1))
     force = (plus.punch_force() - minus.punch_force()) / (2 * h)
     draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
     assert p.punch_force(residual=s.residual(key)) == pytest.approx(force, rel=rel)
@@ -200,16 +202,7 @@ def test_the_cup_in_a_drawbeads_own_forces(key):
     """tools.drawbead[0].restraint and .uplift as parameters: d/dp of the punch force and the
     rim's draw-in against two runs with that bead's force at p (1 +- 1e-5), to 1e-4 (measured
     3e-6 and 5e-6 in both)."""
-    p, s = drawn_cup(_bead(), sensitivities=(f"tools.drawbead[0].{key}",), friction=True, holder=True)
-    i = rim_node(p)
-    value = float(s.parameters[0].value)
-    h = 1e-5 * value
-    plus, minus = (drawn_cup(_bead(**{key: value + sign * h}), friction=True, holder=True)[0] for sign in (1, -1))
-    name = s.parameters[0].name
-    force = (plus.punch_force() - minus.punch_force()) / (2 * h)
-    draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
-    assert p.punch_force(residual=s.residual(name)) == pytest.approx(force, rel=1e-4)
-    assert -s.carrier(name).reshape(-1, BS)[i, 0] == pytest.approx(draw, rel=1e-4)
+    _holder_cup_against_differences(f"tools.drawbead[0].{key}", 1e-4, _bead(), at=lambda v: _bead(**{key: v}))
 
 
 def test_the_cup_with_a_drawbead_in_mu():
@@ -453,8 +446,6 @@ def _springback_against_differences(tmp_path, names, holder):
     base = scene_.changed({"process.springback": True, "output.png": False, "output.vtx": False,
                            "output.fld": False})
     one = run(base.changed({"output.sensitivities": names}), tmp_path / "one")["springback"]["sensitivities"]
-    import csv
-
     rows = list(csv.DictReader(open(tmp_path / "one" / "springback_sensitivities.csv")))
     assert len(rows) == 6 * len(names) and {r["parameter"] for r in rows} == set(names)
     assert float(next(r for r in rows if r["answer"] == "flange_edge_dz_mm.transverse")["derivative"]) == \
