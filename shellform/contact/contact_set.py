@@ -151,6 +151,13 @@ class ContactSet(Part):
             gaps.append(self.holder.face_gap(x, h))
         return gaps
 
+    def shape_of(self, k: int, x, lam) -> np.ndarray:
+        """(len(x), 3, 3): dn/dx of tool k's surface at positions x, load factor lam (the open
+        holder's flat face: 0)."""
+        if k == self.holder_tool:
+            return np.zeros((len(x), 3, 3))
+        return self.tools[k].shape(x, 0.0, self.paths[k].at(lam))
+
     def normals_at(self, x, lam) -> np.ndarray:
         """(n_owned, 3): each node's tool's normal at positions x (+z off the tools)."""
         out = np.tile([0.0, 0.0, 1.0], (x.shape[0], 1))
@@ -467,7 +474,12 @@ class ContactSet(Part):
     def known_derivatives(self, delta: np.ndarray, de33: np.ndarray) -> None:
         """A node on a tool lies its half thickness h_i from the tool's surface along the normal
         (its frame's third row): d(d(x))/dp = h_i' on that known row (SheetNodes'
-        half_thickness_derivative), the tool not moving with p."""
+        half_thickness_derivative), the tool not moving with p; where a part bounds the
+        thickness (bound_by) and the node's faces lie at its bound, 0 here and the bound's
+        derivative from that part (Ironing.border_derivative)."""
         on = np.flatnonzero(self.tool != FREE)
         if on.size:
-            delta[on, 2] += self.nodes.half_thickness_derivative(de33)[on]
+            dh = self.nodes.half_thickness_derivative(de33)
+            if self.bound is not None:  # there the clearance's half: the bounding part's (Part.border_derivative)
+                dh = np.where(self.bound.bounds(), 0.0, dh)
+            delta[on, 2] += dh[on]

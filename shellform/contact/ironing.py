@@ -17,7 +17,8 @@ thinner from leaving the set and thickening back into it in the next pass. The s
 after every converged pass from the pass's positions, as the contact set's is; its changes
 count as the parts' changes, and the driver runs another pass on the new set. Within a pass the
 set's clearances follow every iterate's positions, with their gradients dc_i/dx_i = n_a + n_b
-(SheetModel.squeeze): the element's energy depends on the vertices' positions through them, and
+and those gradients' turn d^2 c_i/dx_i^2 = H_a + H_b (the two tools' shape operators dn/dx:
+SheetModel.squeeze): the element's energy depends on the vertices' positions through them, and
 its force and tangent carry that (shellform.material.ironing). A node of the set that leaves
 the faces within a pass keeps its last clearance, with no gradient, until the pass ends.
 
@@ -38,8 +39,10 @@ neither joins it nor moves the node when it switches.
 """
 
 import numpy as np
+from dolfinx import fem
 from mpi4py import MPI
 
+from shellform.assembly.sheet_element import BS
 from shellform.contact.contact_set import FREE
 from shellform.nonlinear.parts import Change, Part
 
@@ -79,8 +82,10 @@ class Ironing(Part):
         self.between = np.zeros(n, dtype=bool)  # the owned nodes between faces
         self.pair = np.full((n, 2), FREE, dtype=np.int8)  # the two tools whose faces they lie between
         self.normals = np.zeros((n, 2, 3))  # the two faces' normals there (towards the sheet)
+        self.turn = np.zeros((n, 3, 3))  # their sum's derivative d(n_a + n_b)/dx_i there
         self.last = np.full(n, np.inf)  # each node's last clearance
         self.cells = np.zeros(model.num_cells, dtype=bool)  # the cells pressed
+        self.bounded = np.zeros(n, dtype=bool)  # the owned nodes whose faces the clearance bounds (half_thickness)
         self.committed = None
 
     def _nodal(self, lam: float) -> np.ndarray:
@@ -88,8 +93,14 @@ class Ironing(Part):
         between faces); sets the two tools whose faces it lies between and their normals."""
         x = self.nodes.positions()
         gaps = self.contact.gaps(x, lam, bounded=False)
-        clearance, self.pair, self.normals = between_faces(gaps, self.nodes.half_thickness)
+        h = self.nodes.half_thickness
+        clearance, self.pair, self.normals = between_faces(gaps, h)
         self.between = np.isfinite(clearance)
+        self.bounded = 0.5 * clearance < h
+        self.turn = np.zeros((h.size, 3, 3))
+        for a, b in {tuple(pair) for pair in self.pair[self.between]}:
+            on = np.flatnonzero(self.between & (self.pair[:, 0] == a) & (self.pair[:, 1] == b))
+            self.turn[on] = self.contact.shape_of(a, x[on], lam) + self.contact.shape_of(b, x[on], lam)
         return clearance
 
     def half_thickness(self, gaps, h: np.ndarray) -> np.ndarray:
@@ -114,13 +125,17 @@ class Ironing(Part):
         g = self.normals.sum(axis=1)  # d c_i / d x_i
         gradient = np.stack([self.nodes.at_vertices(g[:, k]) for k in range(3)], axis=2)
         gradient = np.where(cells[:, None, None], gradient, 0.0)
+        turn = self.turn.reshape(-1, 9)  # d^2 c_i / d x_i^2
+        curvature = np.stack([self.nodes.at_vertices(turn[:, k]) for k in range(9)], axis=2)
+        curvature = np.where(cells[:, None, None], curvature, 0.0)
         changed = int(np.sum(cells != self.cells))
         self.cells = cells
-        self.model.squeeze(values, gradient)
+        self.model.squeeze(values, gradient, curvature)
         return int(self.model.mesh.comm.allreduce(changed, op=MPI.SUM))
 
     # -- the part's protocol -------------------------------------------------------------------
     def bind(self, driver) -> None:
+        self._jump, self._response = fem.Function(self.model.V), fem.Function(self.model.V)  # border_derivative's
         self._squeeze(0.0, decide=True)
         self.committed = self._copy()
 
@@ -146,6 +161,39 @@ class Ironing(Part):
         """Per owned node its share of the pressed cells' face forces at the last evaluation,
         a third of each (N)."""
         return self.nodes.cell_sums(self.model.face_forces() / 3.0)[:, 0]
+
+    def bounds(self) -> np.ndarray:
+        """The owned nodes whose faces lie at the half clearance, c_i / 2 < h_i (half_thickness),
+        at the last iterate's positions."""
+        return self.bounded
+
+    def derivatives(self) -> str | None:
+        """None: the faces' penalty is the element's (its material's modulus, the clearance and
+        its gradient moved with the vertices: SheetModel.respond, moved_squeeze), and a node
+        whose faces the clearance bounds has the known normal row c_i'/2 (border_derivative)."""
+        return None
+
+    def border_derivative(self, key: str, driver, out, dR: np.ndarray, parameter=None) -> bool:
+        """A node on a tool whose faces lie at the half clearance has n . x' = c_i'/2 =
+        (n_a + n_b) . x'_i / 2 on its known normal row (n its tool's normal), where the faces are
+        not parallel a value of the solved x' itself: set from the derivative in `out` (the
+        solve's frames), with the free rows' response to that jump (a lifted solve with the
+        increment's factors) added. Whether it changed `out` (all ranks alike; the contact set
+        gives these rows 0: ContactSet.known_derivatives)."""
+        push = self.normals.sum(axis=1)  # d c_i / d x_i
+        inclined = np.flatnonzero(self.bounded & self.contact.on_tools() & (np.abs(push).max(axis=1) > 0.0))
+        if not self.model.mesh.comm.allreduce(inclined.size, op=MPI.SUM):
+            return False
+        dx = driver.to_xyz(out.x.array).reshape(-1, BS)[inclined, :3]
+        rows = BS * inclined + 2
+        jump = self._jump.x.array
+        jump[:] = 0.0
+        jump[rows] = 0.5 * np.einsum("ni,ni->n", push[inclined], dx) - out.x.array[rows]
+        self._jump.x.scatter_forward()
+        if not driver.solve_lifted(jump, self._response):
+            raise RuntimeError("the ironed nodes' known rows failed in a sensitivity solve")
+        out.x.array[:] += self._response.x.array
+        return True
 
     def update(self, lam: float, changes: int) -> Change:
         n = self._squeeze(lam, decide=True)

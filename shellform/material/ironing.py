@@ -44,7 +44,10 @@ clearance is the tools' at the cell's vertices, c = sum_i c_i(x_i) / 3, and move
 its gradient n_i = dc_i/dx_i (the facing tool's normal: the clearance grows as the node moves
 away from it) gives the faces' push on the vertices, dPhi/dx_i = -A0 phi' n_i / 3, and the
 rank-one term in full is phi'' / A0 v v^T with v = G - A0 / 3 sum_i n_i on vertex i's
-displacement rows: the push's stiffness and its coupling to the strains. The
+displacement rows: the push's stiffness and its coupling to the strains. Where the faces are
+curved the push turns with the vertex, n_i(x_i) with dn_i/dx_i = H_i (the two tools' shape
+operators), which adds -A0 phi' / 3 H_i on vertex i's displacement block (SheetModel adds it
+after the element loop). The
 pressure on the faces is p = phi'(t_bar) / J_g (N_g = -p J t b: the Cauchy membrane force
 -p t I pulled back). The bound is met to the elastic through-thickness strain at p:
 (t_bar - c) / t0 = phi' / M, 0.2 % at p = 200 MPa on aluminium.

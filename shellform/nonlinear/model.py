@@ -144,8 +144,8 @@ class SheetModel:
         self.face_pressure = np.zeros((self.num_cells, self.nqp))
         self.ironed_d = np.zeros((self.num_cells, self.nqp, 3))  # d_g of the pressed cells' points
         self.ironed = np.zeros((self.num_cells, 11))  # phi'', phi' (0: not pressed), the clearance's gradient
+        self.clearance_curvature = np.zeros((self.num_cells, 3, 3, 3))  # its second derivative at the vertices
         self.pressed = 0  # points the last evaluation pressed
-        self.modulus33 = ironing.through_thickness_modulus(self.material)  # M of the faces' penalty
         self.forms = CellArrayForms(self.V, self.cells, NDOF)
         self.state_version = 0  # changes with the committed material state (Driver's reuse of an evaluation)
 
@@ -153,6 +153,7 @@ class SheetModel:
     def evaluate(self, q: fem.Function, tangent: bool = True, elastic_tangent: bool = False) -> Evaluation:
         """Element forces (and tangents) at the carrier state q, into the copy forms."""
         out = {"z": self.z, "strain": self.strain, "ep": self.ep, "p": self.p, "stretch": self.stretch,
+               "clearance": self.clearance,
                "resultants": self.resultants, "tangents": self.tangents, "face_pressure": self.face_pressure,
                "ironed_d": self.ironed_d, "ironed": self.ironed, "vectors": self.forms.vectors}
         ev, self.pressed = self._loops(q.x.array, self.ep_n, self.p_n, self.material, self.thickness, out, tangent,
@@ -161,9 +162,10 @@ class SheetModel:
 
     def _loops(self, q, ep_n, p_n, material, thickness, out, tangent=False, elastic_tangent=False):
         """The element and material loops at the carrier array q from the committed state
-        (ep_n, p_n) with `material` and `thickness`, into the arrays of `out` (SheetModel's
-        names; the tangents into the copy forms' matrices with `tangent`): (Evaluation, points
-        pressed)."""
+        (ep_n, p_n) with `material` and `thickness` (and the faces' penalty modulus of that
+        material), the cells' clearance `out["clearance"]` (its gradient in out["ironed"]), into
+        the arrays of `out` (SheetModel's names; the tangents into the copy forms' matrices with
+        `tangent`): (Evaluation, points pressed)."""
         k = self.kernels
         t0 = time.perf_counter()
         k.strain_loop(self.threads, self.cells, self.cell_coords, self.dofs, q, self.P, self.consts, self.beta,
@@ -175,7 +177,8 @@ class SheetModel:
             elastic_tangent, self.threads)
         pressed = 0
         if self.ironing:
-            pressed, failed = ironing.squeeze(out["strain"], self.clearance, thickness, self.modulus33,
+            modulus = ironing.through_thickness_modulus(material)  # the faces' penalty, of this material
+            pressed, failed = ironing.squeeze(out["strain"], out["clearance"], thickness, modulus,
                                               2.0 * k.element.weights, out["resultants"], out["tangents"],
                                               out["face_pressure"], out["ironed_d"], out["ironed"])
             nguard += failed  # a mid-surface turned inside out: past the strain guard
@@ -183,6 +186,8 @@ class SheetModel:
         k.tensor_loop(self.threads, self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying, out["z"],
                       out["resultants"], out["tangents"], out["ironed_d"], out["ironed"], tangent, out["vectors"],
                       self.forms.matrices)
+        if tangent and pressed:
+            self._faces_turn(out["ironed"])
         t3 = time.perf_counter()
         return Evaluation(int(nplastic), int(nfail), (t1 - t0) + (t3 - t2), t2 - t1, int(nguard)), pressed
 
@@ -193,11 +198,12 @@ class SheetModel:
         return {"ep": self.ep_n.copy(), "p": self.p_n.copy(), "stretch": self.stretch_n.copy()}
 
     def respond(self, q: np.ndarray, history: dict, material: np.ndarray | None = None,
-                thickness: float | None = None) -> tuple[np.ndarray, dict, bool]:
+                thickness: float | None = None, squeeze: tuple | None = None) -> tuple[np.ndarray, dict, bool]:
         """The element forces and the updated material state at the carrier array q (with
         ghosts) from the committed state `history` (as history() gives it), with another
-        material or thickness where given: the map (q, h_n, material) -> (f_e, h_n+1) that one
-        evaluation computes (the same loops), on
+        material, thickness or cells' clearance and its gradient (`squeeze`, as moved_squeeze
+        gives them) where given: the map
+        (q, h_n, material) -> (f_e, h_n+1) that one evaluation computes (the same loops), on
         arrays of its own, so that nothing of the model's state changes. Returns (element
         vectors (cells, NDOF), the updated state in history()'s keys, whether the material
         update failed)."""
@@ -207,9 +213,32 @@ class SheetModel:
                "p": np.zeros_like(self.p), "stretch": np.ones_like(self.stretch),
                "resultants": np.zeros_like(self.resultants), "tangents": np.zeros_like(self.tangents),
                "face_pressure": np.zeros_like(self.face_pressure), "ironed_d": np.zeros_like(self.ironed_d),
-               "ironed": self.ironed.copy(), "vectors": np.zeros_like(self.forms.vectors)}
+               "ironed": self.ironed.copy(), "vectors": np.zeros_like(self.forms.vectors), "clearance": self.clearance}
+        if squeeze is not None:
+            out["clearance"], out["ironed"][:, 2:] = squeeze
         ev, _ = self._loops(q, history["ep"], history["p"], mat, t, out)
         return out["vectors"], {"ep": out["ep"], "p": out["p"], "stretch": out["stretch"]}, ev.failed
+
+    def moved_squeeze(self, dq: np.ndarray) -> tuple | None:
+        """The cells' clearances and their gradients with the vertices moved by the carrier's
+        change dq (with ghosts), to first order: c + sum_i n_i . dx_i / 3 over the cell's vertices
+        and n_i + H_i dx_i (n_i = dc_i/dx_i and H_i = d n_i/dx_i, as squeeze holds them; 0 at a
+        vertex that keeps its last clearance). None without the effect 'ironing'."""
+        if not self.ironing:
+            return None
+        dx = dq[self.unrolled_dofs].reshape(self.num_cells, 3, BS)[:, :, :3]
+        gradient = self.ironed[:, 2:].reshape(self.num_cells, 3, 3)
+        change = np.einsum("cvk,cvk->c", gradient, dx) / 3.0
+        moved = gradient + np.einsum("cvkl,cvl->cvk", self.clearance_curvature, dx)
+        return np.where(np.isfinite(self.clearance), self.clearance + change, np.inf), moved.reshape(self.num_cells, 9)
+
+    def _faces_turn(self, ironed: np.ndarray) -> None:
+        """The pressed cells' tangents += -phi' A0 / 3 H_i on each vertex's displacement rows:
+        the faces' push -phi' A0 / 3 n_i turning with the vertex (shellform.material.ironing)."""
+        k = np.flatnonzero(ironed[:, 0] > 0.0)
+        blocks = -(ironed[k, 1] * self.cell_area[k] / 3.0)[:, None, None, None] * self.clearance_curvature[k]
+        for i in range(3):
+            self.forms.matrices[k, BS * i:BS * i + 3, BS * i:BS * i + 3] += blocks[:, i]
 
     def tensor_arrays(self, tangent: bool) -> None:
         """The element vectors (and tangents) from the last evaluation's strains, stresses and
@@ -217,13 +246,18 @@ class SheetModel:
         self.kernels.tensor_loop(self.threads, self.cells, self.cell_coords, self.P, self.consts, self.beta, self.tying,
                                  self.z, self.resultants, self.tangents, self.ironed_d, self.ironed, tangent,
                                  self.forms.vectors, self.forms.matrices)
+        if tangent and self.pressed:
+            self._faces_turn(self.ironed)
 
-    def squeeze(self, clearance: np.ndarray, gradient: np.ndarray | None = None) -> None:
+    def squeeze(self, clearance: np.ndarray, gradient: np.ndarray | None = None,
+                curvature: np.ndarray | None = None) -> None:
         """The clearance between two tools over each owned cell (mm; inf where no two tools
-        face each other across it), the mean of its vertices' c_i, and their gradients
-        dc_i/dx_i (cells, 3 vertices, 3; default 0: a clearance fixed in space): where the sheet
-        is thicker, the tools press its faces (shellform.material.ironing) from the next
-        evaluation on. Refused without the effect 'ironing'."""
+        face each other across it), the mean of its vertices' c_i, their gradients dc_i/dx_i
+        (cells, 3 vertices, 3; default 0: a clearance fixed in space) and the gradients'
+        derivatives H_i = d^2 c_i/dx_i^2 (cells, 3 vertices, 3, 3; default 0: faces that do not
+        turn): where the sheet is thicker, the tools press its faces
+        (shellform.material.ironing) from the next evaluation on. Refused without the effect
+        'ironing'."""
         if not self.ironing:
             raise InputError("effects", "a clearance between tools squeezes the sheet only with the effect 'ironing'")
         clearance = np.asarray(clearance, dtype=float)
@@ -231,9 +265,13 @@ class SheetModel:
             raise InputError("clearance", f"needs one positive value (or inf) per owned cell, {self.num_cells}")
         gradient = np.zeros((self.num_cells, 9)) if gradient is None else np.asarray(gradient, dtype=float)
         gradient = gradient.reshape(self.num_cells, 9)
-        if not (np.array_equal(clearance, self.clearance) and np.array_equal(gradient, self.ironed[:, 2:])):
+        curvature = (np.zeros_like(self.clearance_curvature) if curvature is None
+                     else np.asarray(curvature, dtype=float).reshape(self.clearance_curvature.shape))
+        if not (np.array_equal(clearance, self.clearance) and np.array_equal(gradient, self.ironed[:, 2:])
+                and np.array_equal(curvature, self.clearance_curvature)):
             self.clearance[...] = clearance
             self.ironed[:, 2:] = gradient
+            self.clearance_curvature[...] = curvature
             self.state_version += 1
 
     def face_forces(self) -> np.ndarray:

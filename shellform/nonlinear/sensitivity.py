@@ -46,10 +46,14 @@ split of its force F (contact/holder_split.py), differentiated the same way in F
 normal forces, the positions and the edge load (PinchingHolder.face_derivatives); the held
 slopes are known rows (Part.known_derivatives). The drawbeads' rigid-plastic restraint is
 differentiated as friction's is, its derivative entering dR itself (contact/drawbead.py); the
-open holder's lift is solved with the derivative (below). A part whose forces on the free rows
-depend on p otherwise (the ironing's penalty) says so (Part.derivatives) and the sensitivities
-are refused, as is a tool scene without finite strains or one whose parameter moves the tools
-(the thickness: the tools are placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
+open holder's lift is solved with the derivative (below). Ironing's penalty is the element's:
+the differences take it with the material's modulus and with the cells' clearance and its
+gradient moved along q' (SheetModel.moved_squeeze), and a node on a tool whose faces lie at the
+half clearance has the known row c_i'/2 = (n_a + n_b) . x'_i / 2 instead of h_i', a value of
+the solved x' itself where the faces are not parallel (Ironing.border_derivative, below). A part
+whose forces on the free rows depend on p otherwise says so (Part.derivatives) and the
+sensitivities are refused, as is a tool scene without finite strains or one whose parameter
+moves the tools (the thickness: the tools are placed around the sheet). Where the set changes between p - dp and p + dp a finite difference
 jumps and the derivative of the fixed set does not: the comparison holds on a path whose set
 does not change within the difference (docs/sensitivity.md).
 
@@ -70,7 +74,8 @@ kept).
 A part's own unknown (the open holder's lift z_H, with its equation F - sum p_i = 0) is solved
 with the derivative as Newton's step solves it (Part.border_derivative): q' = q'_a + z' q'_b,
 q'_b the response to a unit change of the unknown, z' from the equation differentiated along the
-total; BORDER_PASSES times, each followed by the check and its corrections.
+total; a known row that depends on q' (the ironed node's c_i'/2) is set from the solved q' and
+its response added; BORDER_PASSES times, each followed by the check and its corrections.
 
 The sensitivity is a Record of the driver (driver.records): `converged` runs with each
 converged increment before it is committed, and `checkpoint`/`restore` carry q' and h' through
@@ -244,7 +249,7 @@ class Sensitivity(Record):
                 why = "material.thickness places the tools around the sheet: not differentiated with tools yet"
             if why is not None:
                 raise InputError("output.sensitivities", f"{why}; a tool scene's sensitivities need rigid tools, "
-                                 "with or without friction, drawbeads and a force-controlled holder, and no ironing")
+                                 "with or without friction, drawbeads, a holder and ironing")
         self._known = fem.Function(self.model.V)  # the known rows' derivatives, shared with the ghosts
         zeros = lambda a: np.zeros_like(a)  # noqa: E731
         start = self.model.history()
@@ -360,8 +365,8 @@ class Sensitivity(Record):
         driver, model, comm = self.driver, self.model, self.model.mesh.comm
         owned = driver.n_owned * BS
         dq = driver.to_xyz(out.x.array)
-        ends = [model.respond(q + s * eps * dq, _along(h_n, dh, s * eps), **par.respond(par.value + s * eps))
-                for s in (1, -1)]
+        ends = [model.respond(q + s * eps * dq, _along(h_n, dh, s * eps), squeeze=model.moved_squeeze(s * eps * dq),
+                              **par.respond(par.value + s * eps)) for s in (1, -1)]
         dR = driver.assembled(ends[0][0] - ends[1][0]) / (2 * eps)
         if load is not None:
             dR[: load.size] += load

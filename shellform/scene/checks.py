@@ -251,12 +251,9 @@ def _validate_sensitivities(s) -> None:
 
 
 def _validate_tool_sensitivities(s) -> None:
-    """A tool scene's sensitivities: its rigid tools, its closed holder, friction and drawbeads
-    have derivatives (not ironing), with finite strains (the nodes' thickness), and no parameter
-    that moves the tools."""
-    require("ironing" not in s.effects, "effects", "the effect 'ironing' has no derivatives yet: a tool scene's "
-            "output.sensitivities are its rigid tools', its holder's, friction's and drawbeads' alone "
-            "(docs/sensitivity.md, Tool scenes)")
+    """A tool scene's sensitivities: its rigid tools, its holder, friction, drawbeads and ironing
+    have derivatives, with finite strains (the nodes' thickness), and no parameter that moves the
+    tools."""
     require("finite_strain" in s.effects, "effects",
             "a tool scene's output.sensitivities need the effect 'finite_strain' (the nodes' thickness)")
     for name in s.output.sensitivities:

@@ -16,7 +16,9 @@ Cases (each sensitivity from the one run that also gives the answer):
 - plate: the simply supported elastic plate in large deflection, whose w(E, P) = W(P / E):
   E dw/dE + P dw/dP = 0 (error: that sum over |w|), and the linear plate's dw/dE = -w / E;
 - round cup (demos/round_cup.toml, n 6, 3 mm): frictionless, with friction, with friction and
-  its holder (10 kN, closed; 300 N, open: its lift), the punch force and the rim's draw-in (cup); as a scene with the forming-limit
+  its holder (10 kN, closed; 300 N, open: its lift), with friction and ironing (its flange at a
+  1.0 mm gap; and a 1.19 mm sheet drawn 30 mm into the 1.2 mm clearance, where the die's
+  shoulder and the punch's wall iron it), the punch force and the rim's draw-in (cup); as a scene with the forming-limit
   view and springback, the smallest margin and the flange edge's springback (cup_scene); against
   central differences of two runs at p (1 +- 1e-5);
 - aluminium cup (demos/numisheet93_aluminium.toml, n 16, 25 mm, sprung back): the wall's angle
@@ -30,6 +32,7 @@ that compiles what it needs), the cantilever's also on 1,024 cells.
 
 import time
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -208,20 +211,26 @@ CUP_STEP = 1e-5  # the drawn cup's differences: at 1e-4 layers yield between p -
 CUP_PARAMETERS = ("material.K", "material.n")
 FRICTION_PARAMETERS = ("material.K", "tools.friction")
 HOLDER_PARAMETERS = ("material.K", "tools.friction", "tools.blank_holder_force")
+IRONED = {  # the cups that ironing presses (cup): case, scene changes, parameters, stroke (mm)
+    "gap": ("round cup ironed at a 1.0 mm gap, friction 0.07", {"tools.holder": "gap", "tools.holder_gap": 1.0},
+            ("material.K", "material.E", "tools.friction"), 3.0),
+    "wall": ("round cup, 1.19 mm ironed in the 1.2 mm clearance, 30 mm, friction 0.07",
+             {"tools.holder": "gap", "tools.holder_gap": 1.3, "material.thickness": 1.19}, ("material.K",), 30.0),
+}
 
 
 def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False,
-              friction: bool = False, holder: bool = False):
-    """demos/round_cup.toml with its rigid punch and die (no ironing), with `holder` its
-    force-controlled holder (10 kN), else none, and with `friction` its Coulomb friction (0.07),
-    else none: parts that have derivatives; n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10,
+              friction: bool = False, holder: bool = False, ironing: bool = False):
+    """demos/round_cup.toml with its rigid punch and die, with `holder` its force-controlled
+    holder (10 kN), else none, with `friction` its Coulomb friction (0.07), else none, and with
+    `ironing` its ironing, else none; n = n, `stroke` mm in steps of 0.1 mm, rtol 1e-10,
     with `changes` {scene key: value}: (problem, Sensitivity of the scene keys `sensitivities`
     or None); with scene_only, (the scene, None), not run."""
     from shellform import demos, scene
     from shellform.contact.problem import DrawingProblem
 
     base = scene.load(demos.path("round_cup.toml"))
-    drop = ("ironing",) if friction else ("friction", "ironing")
+    drop = ((() if ironing else ("ironing",)) + (() if friction else ("friction",)))
     s = base.changed({"mesh.n": n, "tools.stroke": stroke,
                       **({} if holder else {"tools.blank_holder_force": 0.0}),
                       **({} if friction else {"tools.friction": 0.0}),
@@ -245,17 +254,23 @@ def rim_node(p) -> int:
     return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
 
 
-def cup(friction: bool = False, holder: bool = False, light: bool = False) -> tuple[list[dict], dict]:
+def cup(friction: bool = False, holder: bool = False, light: bool = False, ironed: str | None = None
+        ) -> tuple[list[dict], dict]:
     """The round cup drawn 3 mm (drawn_cup), frictionless, with its friction, or with its
     friction and its holder (10 kN, closed; with `light` 300 N, which opens and rides on the
-    flange: its lift's derivative): the punch force and the rim's draw-in on y = 0, in each
-    parameter against central differences of two runs at p (1 +- CUP_STEP)."""
-    names = HOLDER_PARAMETERS if holder else FRICTION_PARAMETERS if friction else CUP_PARAMETERS
-    changes = {"tools.blank_holder_force": 300.0} if light else {}
-    case = ("round cup, holder 300 N (open), friction 0.07" if light else "round cup, holder 10 kN, friction 0.07") \
-        if holder else "round cup, friction 0.07" if friction else "round cup, frictionless"
-    (p, s), with_s, without = _costs(lambda: drawn_cup(changes, friction=friction, holder=holder),
-                                     lambda: drawn_cup(changes, sensitivities=names, friction=friction, holder=holder))
+    flange: its lift's derivative), or with its friction `ironed` ("gap": its flange at a 1.0 mm
+    gap; "wall": a 1.19 mm sheet in the 1.2 mm clearance, 30 mm: IRONED): the punch force and
+    the rim's draw-in on y = 0, in each parameter against central differences of two runs at p
+    (1 +- CUP_STEP)."""
+    names = IRONED[ironed][2] if ironed else (HOLDER_PARAMETERS if holder else FRICTION_PARAMETERS if friction
+                                              else CUP_PARAMETERS)
+    changes = IRONED[ironed][1] if ironed else {"tools.blank_holder_force": 300.0} if light else {}
+    stroke = IRONED[ironed][3] if ironed else 3.0
+    case = IRONED[ironed][0] if ironed else ((
+        "round cup, holder 300 N (open), friction 0.07" if light else "round cup, holder 10 kN, friction 0.07")
+        if holder else "round cup, friction 0.07" if friction else "round cup, frictionless")
+    draw = partial(drawn_cup, friction=friction, holder=holder, ironing=ironed is not None, stroke=stroke)
+    (p, s), with_s, without = _costs(lambda: draw(changes), lambda: draw(changes, sensitivities=names))
     if light and not p.driver.holder.is_open:
         raise RuntimeError("the 300 N holder was to be open at the end of the cup's 3 mm")
     i = rim_node(p)
@@ -263,8 +278,10 @@ def cup(friction: bool = False, holder: bool = False, light: bool = False) -> tu
     for par in s.parameters:
         k, value = par.name, par.value
         h = CUP_STEP * value
-        plus, minus = (drawn_cup({**changes, k: value + sign * h}, friction=friction, holder=holder)[0]
-                       for sign in (1, -1))
+        plus, minus = (draw({**changes, k: value + sign * h})[0] for sign in (1, -1))
+        steps = [len(r.driver.history) for r in (p, plus, minus)]
+        if len(set(steps)) > 1:
+            say(f"sensitivity: {case}, {k}: the runs took {steps} increments (a step decision between p - h and p + h)")
         fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)
         fd_draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
         rows.append(_row(case, "punch force", k, p.punch_force(residual=s.residual(k)), fd_force,
@@ -383,7 +400,8 @@ def run(outdir) -> list[dict]:
     rows, times = [], []
     for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
                  lambda: cup(friction=True), lambda: cup(friction=True, holder=True),
-                 lambda: cup(friction=True, holder=True, light=True),
+                 lambda: cup(friction=True, holder=True, light=True), lambda: cup(friction=True, ironed="gap"),
+                 lambda: cup(friction=True, ironed="wall"),
                  lambda: cup_scene(out / "runs" / "cup"), lambda: cup_scene(out / "runs" / "cup_holder", holder=True),
                  lambda: aluminium_springback(out / "runs" / "aluminium")):
         r, t = case()
