@@ -346,6 +346,16 @@ class PinchingHolder(Part):
     def report(self) -> dict:
         return {"holder_closed": bool(self.closed), "holder_lift": float(self.lift)}
 
+    def iterate_state(self) -> dict:
+        """Its own state, its face's lift and its split's band (Part.iterate_state)."""
+        return {"own": super().iterate_state(), "face": self.lifted_face.iterate_state(),
+                "split": self.split.iterate_state()}
+
+    def set_iterate_state(self, state: dict) -> None:
+        super().set_iterate_state(state["own"])
+        self.lifted_face.set_iterate_state(state["face"])
+        self.split.set_iterate_state(state["split"])
+
     # -- derivatives (nonlinear/sensitivity.py) ------------------------------------------------
     EDGE_STEP = 1e-3  # the edge load's central differences in a material parameter, relative to it
 

@@ -30,6 +30,8 @@ name in shellform.scene.SPREADS):
 import numpy as np
 from mpi4py import MPI
 
+from shellform.nonlinear.parts import copy_state, put_state
+
 
 def holder_height(tops: np.ndarray, k: np.ndarray, force: float) -> float:
     """Z with sum k_i max(tops_i - Z, 0) = force (the highest top when force is 0)."""
@@ -82,6 +84,13 @@ class HolderSplit:
         self.force, self.comm, self.spread = float(force), comm, spread
         self.area, self.k = np.asarray(area, dtype=float), np.asarray(stiffness, dtype=float)
         self.band_ratio, self.band_force = 0.0, 0.0  # the die's force on the band over the holder's, the holder's
+
+    def iterate_state(self) -> dict:
+        """The band's ratio and force of the last split, copied (Part.iterate_state)."""
+        return copy_state(self)
+
+    def set_iterate_state(self, state: dict) -> None:
+        put_state(self, state)
 
     def _sum(self, v) -> float:
         return _sum(v, self.comm)

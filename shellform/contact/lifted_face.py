@@ -21,6 +21,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from shellform.assembly.sheet_element import BS
+from shellform.nonlinear.parts import copy_state, put_state
 
 
 class LiftedFace:
@@ -92,6 +93,13 @@ class LiftedFace:
         dz = (dforce - sums[1]) / sums[0]
         out.x.array[:] += dz * response
         return float(dz)
+
+    def iterate_state(self) -> dict:
+        """The lift and its step, copied (Part.iterate_state)."""
+        return copy_state(self)
+
+    def set_iterate_state(self, state: dict) -> None:
+        put_state(self, state)
 
     def slope(self, imbalance: float) -> float:
         """The lift's share of the energy slope: dz_H (F - sum p)."""

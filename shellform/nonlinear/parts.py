@@ -25,7 +25,9 @@ says what it is doing (``report``). Every method has a default that contributes 
 Sensitivities (sensitivity.py) differentiate the converged increment with the parts' sets
 held: a part says whether it can (``derivatives``: None, or why not) and gives the derivatives
 of its known rows (``known_derivatives``: a node on a tool lies its half thickness from it,
-which moves with the thickness strain).
+which moves with the thickness strain). They linearize the converged state as Newton's iterates
+see it and put the parts back as the last iterate left them (``iterate_state``,
+``set_iterate_state``; Driver.linearized), so that a run with them is the run without.
 """
 
 from dataclasses import dataclass
@@ -63,6 +65,24 @@ class Change:
     back: int = 0
     settled: bool = True
     line: str = ""
+
+
+def copy_state(obj) -> dict:
+    """obj's own arrays (copied), numbers, flags, tuples and Nones: the state an iterate writes
+    (Part.iterate_state)."""
+    return {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in vars(obj).items()
+            if v is None or isinstance(v, (np.ndarray, bool, int, float, tuple))}
+
+
+def put_state(obj, state: dict) -> None:
+    """Put back copy_state(obj)'s state: a writeable array in place where it keeps its shape
+    (whoever shares it sees the old values again), else the saved value."""
+    for k, v in state.items():
+        now = getattr(obj, k)
+        if isinstance(v, np.ndarray) and isinstance(now, np.ndarray) and now.shape == v.shape and now.flags.writeable:
+            now[...] = v
+        else:
+            setattr(obj, k, v)
 
 
 class Part:
@@ -156,6 +176,17 @@ class Part:
     def report(self) -> dict:
         """What the part is doing, for the increment's record."""
         return {}
+
+    def iterate_state(self) -> dict:
+        """The part's state as this iterate left it (what constrain, follow and the residual
+        write), copied: by default its own arrays and numbers (copy_state); a part that keeps
+        such state in objects of its own adds theirs. The derivatives' own state (dicts per
+        parameter) is not in it."""
+        return copy_state(self)
+
+    def set_iterate_state(self, state: dict) -> None:
+        """Put back iterate_state()'s state."""
+        put_state(self, state)
 
     def derivatives(self) -> str | None:
         """None where this part's equations are differentiated by known_derivatives alone (its

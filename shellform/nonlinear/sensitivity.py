@@ -266,11 +266,16 @@ class Sensitivity(Record):
 
     # -- the record's protocol ------------------------------------------------------------------
     def converged(self, driver, lam: float) -> None:
-        """The increment to lam converged and is not committed yet: q'_n+1, h'_n+1 and dR/dp."""
+        """The increment to lam converged and is not committed yet: q'_n+1, h'_n+1 and dR/dp,
+        with the consistent tangent at the converged state, from h_n (the parts put back as
+        the last iterate left them: Driver.linearized)."""
+        with driver.linearized(lam):
+            self._differentiate(driver, lam)
+
+    def _differentiate(self, driver, lam: float) -> None:
         model, comm = self.model, self.model.mesh.comm
         h_n = model.history()
         q = driver.q.x.array.copy()
-        driver.linearize(lam)  # the consistent tangent at the converged state, from h_n
         switched, ratio, corrections = 0, 0.0, 0
         owned = driver.n_owned * BS
         free = np.ones(owned, dtype=bool)

@@ -22,6 +22,7 @@ needs them. The solve factorises the free rows alone where that pays (free_rows.
 """
 
 import time
+from contextlib import contextmanager
 
 import dolfinx.fem.petsc as fem_petsc
 import numpy as np
@@ -215,6 +216,22 @@ class System:
     evaluations = property(lambda self: self.arrays.evaluations)
     reused = property(lambda self: self.arrays.reused)
     tangents = property(lambda self: self.arrays.tangents)
+
+    @contextmanager
+    def linearized(self, lam):
+        """linearize(lam) for an observer (the sensitivities): within the block R and K are those
+        of the converged q as Newton's iterates see them; after it the parts' iterate state
+        (Part.iterate_state) and the residual are as the last iterate left them, so that the run
+        goes on as it would have without the observer."""
+        held = [part.iterate_state() for part in self.parts]
+        residual = self.residual_full.copy()
+        try:
+            self.linearize(lam)
+            yield
+        finally:
+            for part, state in zip(self.parts, held):
+                part.set_iterate_state(state)
+            self.residual_full = residual
 
     def linearize(self, lam, tangent: bool = True) -> float:
         """R (and K) at the current q as Newton's iterates after a pass's first see them: the
