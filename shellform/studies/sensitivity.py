@@ -17,7 +17,7 @@ Cases (each sensitivity from the one run that also gives the answer):
   E dw/dE + P dw/dP = 0 (error: that sum over |w|), and the linear plate's dw/dE = -w / E;
 - round cup (demos/round_cup.toml, n 6, 3 mm): frictionless, with friction, with friction and
   its holder (10 kN, closed; 300 N, open: its lift), with friction and ironing (its flange at a
-  1.0 mm gap; and a 1.19 mm sheet drawn 30 mm into the 1.2 mm clearance, where the die's
+  1.0 mm gap; and a 1.19 mm sheet drawn 25 mm into the 1.2 mm clearance, where the die's
   shoulder and the punch's wall iron it), the punch force and the rim's draw-in (cup); as a scene with the forming-limit
   view and springback, the smallest margin and the flange edge's springback (cup_scene); against
   central differences of two runs at p (1 +- 1e-5);
@@ -214,8 +214,8 @@ HOLDER_PARAMETERS = ("material.K", "tools.friction", "tools.blank_holder_force")
 IRONED = {  # the cups that ironing presses (cup): case, scene changes, parameters, stroke (mm)
     "gap": ("round cup ironed at a 1.0 mm gap, friction 0.07", {"tools.holder": "gap", "tools.holder_gap": 1.0},
             ("material.K", "material.E", "tools.friction"), 3.0),
-    "wall": ("round cup, 1.19 mm ironed in the 1.2 mm clearance, 30 mm, friction 0.07",
-             {"tools.holder": "gap", "tools.holder_gap": 1.3, "material.thickness": 1.19}, ("material.K",), 30.0),
+    "wall": ("round cup, 1.19 mm ironed in the 1.2 mm clearance, 25 mm, friction 0.07",
+             {"tools.holder": "gap", "tools.holder_gap": 1.3, "material.thickness": 1.19}, ("material.K",), 25.0),
 }
 
 
@@ -259,7 +259,7 @@ def cup(friction: bool = False, holder: bool = False, light: bool = False, irone
     """The round cup drawn 3 mm (drawn_cup), frictionless, with its friction, or with its
     friction and its holder (10 kN, closed; with `light` 300 N, which opens and rides on the
     flange: its lift's derivative), or with its friction `ironed` ("gap": its flange at a 1.0 mm
-    gap; "wall": a 1.19 mm sheet in the 1.2 mm clearance, 30 mm: IRONED): the punch force and
+    gap; "wall": a 1.19 mm sheet in the 1.2 mm clearance, 25 mm: IRONED): the punch force and
     the rim's draw-in on y = 0, in each parameter against central differences of two runs at p
     (1 +- CUP_STEP)."""
     names = IRONED[ironed][2] if ironed else (HOLDER_PARAMETERS if holder else FRICTION_PARAMETERS if friction
