@@ -90,7 +90,8 @@ class Ironing(Part):
 
     def _nodal(self, lam: float) -> np.ndarray:
         """The owned nodes' clearances c_i at the current positions (inf where a node is not
-        between faces); sets the two tools whose faces it lies between and their normals."""
+        between faces); sets the two tools whose faces it lies between, their normals, the
+        normals' turn and the nodes whose faces the clearance bounds."""
         x = self.nodes.positions()
         gaps = self.contact.gaps(x, lam, bounded=False)
         h = self.nodes.half_thickness
