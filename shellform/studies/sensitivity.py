@@ -34,6 +34,7 @@ import time
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from dolfinx import fem
@@ -208,15 +209,36 @@ def cantilever(folder: Path) -> tuple[list[dict], dict]:
 
 
 CUP_STEP = 1e-5  # the drawn cup's differences: at 1e-4 layers yield between p - h and p + h (docs/sensitivity.md)
-CUP_PARAMETERS = ("material.K", "material.n")
-FRICTION_PARAMETERS = ("material.K", "tools.friction")
-HOLDER_PARAMETERS = ("material.K", "tools.friction", "tools.blank_holder_force")
-IRONED = {  # the cups that ironing presses (cup): case, scene changes, parameters, stroke (mm)
-    "gap": ("round cup ironed at a 1.0 mm gap, friction 0.07", {"tools.holder": "gap", "tools.holder_gap": 1.0},
-            ("material.K", "material.E", "tools.friction"), 3.0),
-    "wall": ("round cup, 1.19 mm ironed in the 1.2 mm clearance, 25 mm, friction 0.07",
-             {"tools.holder": "gap", "tools.holder_gap": 1.3, "material.thickness": 1.19}, ("material.K",), 25.0),
-}
+
+
+class CupCase(NamedTuple):
+    """A round cup of the study (cup): its name in the tables, its parameters, drawn_cup's
+    switches and scene changes, its stroke (mm), and whether its holder opens."""
+
+    case: str
+    parameters: tuple
+    friction: bool = False
+    holder: bool = False
+    ironing: bool = False
+    changes: dict = {}
+    stroke: float = 3.0
+    opens: bool = False
+
+
+CUPS = (
+    CupCase("round cup, frictionless", ("material.K", "material.n")),
+    CupCase("round cup, friction 0.07", ("material.K", "tools.friction"), friction=True),
+    CupCase("round cup, holder 10 kN, friction 0.07", ("material.K", "tools.friction", "tools.blank_holder_force"),
+            friction=True, holder=True),
+    CupCase("round cup, holder 300 N (open), friction 0.07",
+            ("material.K", "tools.friction", "tools.blank_holder_force"), friction=True, holder=True,
+            changes={"tools.blank_holder_force": 300.0}, opens=True),
+    CupCase("round cup ironed at a 1.0 mm gap, friction 0.07", ("material.K", "material.E", "tools.friction"),
+            friction=True, ironing=True, changes={"tools.holder": "gap", "tools.holder_gap": 1.0}),
+    CupCase("round cup, 1.19 mm ironed in the 1.2 mm clearance, 25 mm, friction 0.07", ("material.K",),
+            friction=True, ironing=True,
+            changes={"tools.holder": "gap", "tools.holder_gap": 1.3, "material.thickness": 1.19}, stroke=25.0),
+)
 
 
 def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke: float = 3.0, scene_only=False,
@@ -230,11 +252,11 @@ def drawn_cup(changes: dict | None = None, sensitivities=(), n: int = 6, stroke:
     from shellform.contact.problem import DrawingProblem
 
     base = scene.load(demos.path("round_cup.toml"))
-    drop = ((() if ironing else ("ironing",)) + (() if friction else ("friction",)))
+    keep = {"ironing": ironing, "friction": friction}
     s = base.changed({"mesh.n": n, "tools.stroke": stroke,
                       **({} if holder else {"tools.blank_holder_force": 0.0}),
                       **({} if friction else {"tools.friction": 0.0}),
-                      "effects": [e for e in base.effects if e not in drop],
+                      "effects": [e for e in base.effects if keep.get(e, True)],
                       "process.report": [], "process.initial_step_mm": 0.1, "process.max_step_mm": 0.1,
                       "process.min_step_mm": 0.001, "process.rtol": 1e-10, **(changes or {})})
     if scene_only:
@@ -254,41 +276,32 @@ def rim_node(p) -> int:
     return int(np.argmax(np.where(np.abs(X[:, 1]) < 1e-9, X[:, 0], -np.inf)))
 
 
-def cup(friction: bool = False, holder: bool = False, light: bool = False, ironed: str | None = None
-        ) -> tuple[list[dict], dict]:
-    """The round cup drawn 3 mm (drawn_cup), frictionless, with its friction, or with its
-    friction and its holder (10 kN, closed; with `light` 300 N, which opens and rides on the
-    flange: its lift's derivative), or with its friction `ironed` ("gap": its flange at a 1.0 mm
-    gap; "wall": a 1.19 mm sheet in the 1.2 mm clearance, 25 mm: IRONED): the punch force and
-    the rim's draw-in on y = 0, in each parameter against central differences of two runs at p
-    (1 +- CUP_STEP)."""
-    names = IRONED[ironed][2] if ironed else (HOLDER_PARAMETERS if holder else FRICTION_PARAMETERS if friction
-                                              else CUP_PARAMETERS)
-    changes = IRONED[ironed][1] if ironed else {"tools.blank_holder_force": 300.0} if light else {}
-    stroke = IRONED[ironed][3] if ironed else 3.0
-    case = IRONED[ironed][0] if ironed else ((
-        "round cup, holder 300 N (open), friction 0.07" if light else "round cup, holder 10 kN, friction 0.07")
-        if holder else "round cup, friction 0.07" if friction else "round cup, frictionless")
-    draw = partial(drawn_cup, friction=friction, holder=holder, ironing=ironed is not None, stroke=stroke)
-    (p, s), with_s, without = _costs(lambda: draw(changes), lambda: draw(changes, sensitivities=names))
-    if light and not p.driver.holder.is_open:
-        raise RuntimeError("the 300 N holder was to be open at the end of the cup's 3 mm")
+def cup(c: CupCase) -> tuple[list[dict], dict]:
+    """The round cup `c` (CUPS: frictionless, with its friction, with its holder at 10 kN,
+    closed, or 300 N, which opens and rides on the flange (its lift's derivative), ironed at a
+    gap or on its wall; drawn_cup): the punch force and the rim's draw-in on y = 0, in each
+    parameter against central differences of two runs at p (1 +- CUP_STEP)."""
+    draw = partial(drawn_cup, friction=c.friction, holder=c.holder, ironing=c.ironing, stroke=c.stroke)
+    (p, s), with_s, without = _costs(lambda: draw(c.changes), lambda: draw(c.changes, sensitivities=c.parameters))
+    if c.opens and not p.driver.holder.is_open:
+        raise RuntimeError(f"the holder of '{c.case}' was to be open at the end of its stroke")
     i = rim_node(p)
     rows = []
     for par in s.parameters:
         k, value = par.name, par.value
         h = CUP_STEP * value
-        plus, minus = (draw({**changes, k: value + sign * h})[0] for sign in (1, -1))
+        plus, minus = (draw({**c.changes, k: value + sign * h})[0] for sign in (1, -1))
         steps = [len(r.driver.history) for r in (p, plus, minus)]
         if len(set(steps)) > 1:
-            say(f"sensitivity: {case}, {k}: the runs took {steps} increments (a step decision between p - h and p + h)")
+            say(f"sensitivity: {c.case}, {k}: the runs took {steps} increments (a step decision between p - h and "
+                "p + h)")
         fd_force = (plus.punch_force() - minus.punch_force()) / (2 * h)
         fd_draw = -(plus.driver.positions()[i, 0] - minus.driver.positions()[i, 0]) / (2 * h)
-        rows.append(_row(case, "punch force", k, p.punch_force(residual=s.residual(k)), fd_force,
+        rows.append(_row(c.case, "punch force", k, p.punch_force(residual=s.residual(k)), fd_force,
                          "central differences", abs(p.punch_force() / value)))
-        rows.append(_row(case, "rim draw-in (y = 0)", k, -float(s.carrier(k).reshape(-1, BS)[i, 0]), fd_draw,
+        rows.append(_row(c.case, "rim draw-in (y = 0)", k, -float(s.carrier(k).reshape(-1, BS)[i, 0]), fd_draw,
                          "central differences"))
-    return rows, {"case": case, "with_s": with_s, "without_s": without, "parameters": len(names)}
+    return rows, {"case": c.case, "with_s": with_s, "without_s": without, "parameters": len(c.parameters)}
 
 
 SCENE_PARAMETERS = ("material.K", "material.n", "material.r")
@@ -398,10 +411,8 @@ def run(outdir) -> list[dict]:
     out = Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
     rows, times = [], []
-    for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates, cup,
-                 lambda: cup(friction=True), lambda: cup(friction=True, holder=True),
-                 lambda: cup(friction=True, holder=True, light=True), lambda: cup(friction=True, ironed="gap"),
-                 lambda: cup(friction=True, ironed="wall"),
+    for case in (homogeneous_strip, end_pulled_strip, lambda: cantilever(out / "runs"), plates,
+                 *(partial(cup, c) for c in CUPS),
                  lambda: cup_scene(out / "runs" / "cup"), lambda: cup_scene(out / "runs" / "cup_holder", holder=True),
                  lambda: aluminium_springback(out / "runs" / "aluminium")):
         r, t = case()
