@@ -128,7 +128,8 @@ class ContactSet(Part):
     def bound_by(self, part) -> None:
         """Where two tools face each other across the sheet closer than its thickness, `part`
         (the ironing) bounds the thickness: its ``half_thickness(gaps, h)`` is the half thickness
-        the sheet's faces lie at there (module docstring)."""
+        the sheet's faces lie at there (module docstring), its ``bounds()`` the owned nodes whose
+        faces lie at the bound (their known rows' derivatives are the part's)."""
         self.bound = part
 
     # -- geometry ------------------------------------------------------------------------------

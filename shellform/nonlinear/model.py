@@ -230,7 +230,7 @@ class SheetModel:
         gradient = self.ironed[:, 2:].reshape(self.num_cells, 3, 3)
         change = np.einsum("cvk,cvk->c", gradient, dx) / 3.0
         moved = gradient + np.einsum("cvkl,cvl->cvk", self.clearance_curvature, dx)
-        return np.where(np.isfinite(self.clearance), self.clearance + change, np.inf), moved.reshape(self.num_cells, 9)
+        return self.clearance + change, moved.reshape(self.num_cells, 9)  # inf stays inf
 
     def _faces_turn(self, ironed: np.ndarray) -> None:
         """The pressed cells' tangents += -phi' A0 / 3 H_i on each vertex's displacement rows:
